@@ -1,0 +1,434 @@
+//! The only contract shared between rins processes: fixed-size `#[repr(C)]` payloads that travel
+//! zero-copy over iceoryx2 shared memory, the common header that makes latency measurable end to end,
+//! and the service names.
+//!
+//! Every payload starts with a `version` field; a consumer rejects a payload whose version differs
+//! from [`PAYLOAD_VERSION`] instead of misreading it.
+
+use iceoryx2::prelude::ZeroCopySend;
+use serde::Serialize;
+
+pub mod names;
+
+/// Version of every payload layout in this crate. Bump it on any layout change.
+pub const PAYLOAD_VERSION: u16 = 1;
+
+/// Up to this many single-axis channels per sensor type (gyro, accelerometer).
+pub const MAX_CHANNELS: usize = 16;
+
+/// Up to this many module temperature sensors in the sensor block.
+pub const MAX_TEMPERATURES: usize = 4;
+
+/// Pipeline stages that stamp their publish time into [`Header::stage_pub_ns`].
+#[repr(usize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    Acquisition = 0,
+    Fusion = 1,
+    Altimeter = 2,
+    Navigator = 3,
+}
+
+impl Stage {
+    pub const COUNT: usize = 4;
+    pub const ALL: [Stage; Stage::COUNT] = [
+        Stage::Acquisition,
+        Stage::Fusion,
+        Stage::Altimeter,
+        Stage::Navigator,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Acquisition => "acquisition",
+            Stage::Fusion => "fusion",
+            Stage::Altimeter => "altimeter",
+            Stage::Navigator => "navigator",
+        }
+    }
+}
+
+/// Carried by every message: where the data came from and when each stage published it.
+/// Times are CLOCK_MONOTONIC nanoseconds; 0 means "stage not passed".
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+pub struct Header {
+    /// Sequence number of the originating serial frame, extended to 64 bits by acquisition.
+    pub origin_seq: u64,
+    /// Device time of the originating frame in microseconds, extended to 64 bits.
+    pub origin_device_time_us: u64,
+    /// When acquisition had the whole originating frame (CLOCK_MONOTONIC ns).
+    pub origin_rx_ns: u64,
+    /// Publish time of each stage passed, indexed by [`Stage`].
+    pub stage_pub_ns: [u64; Stage::COUNT],
+}
+
+impl Header {
+    pub fn stamp(&mut self, stage: Stage, now_ns: u64) {
+        self.stage_pub_ns[stage as usize] = now_ns;
+    }
+
+    pub fn stage_ns(&self, stage: Stage) -> u64 {
+        self.stage_pub_ns[stage as usize]
+    }
+}
+
+/// Device status bits carried in [`RawImu::status`].
+pub mod status {
+    /// The device reports an internal error (self-test failed, bus error).
+    pub const DEVICE_ERROR: u32 = 1 << 0;
+    /// At least one channel is saturated in this frame.
+    pub const SATURATION: u32 = 1 << 1;
+}
+
+/// One raw IMU frame: every gyro and accelerometer channel in 12-bit signed ADC counts.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::RawImu")]
+pub struct RawImu {
+    pub version: u16,
+    pub n_gyro: u8,
+    pub n_accel: u8,
+    pub n_temperature: u8,
+    pub _pad: [u8; 3],
+    /// Device status bits, see [`status`].
+    pub status: u32,
+    /// Bit i: gyro channel i valid; bit 16 + i: accel channel i valid.
+    pub valid_mask: u32,
+    pub header: Header,
+    pub gyro_counts: [i16; MAX_CHANNELS],
+    pub accel_counts: [i16; MAX_CHANNELS],
+    /// Module temperatures in degrees Celsius.
+    pub temperature_c: [f32; MAX_TEMPERATURES],
+}
+
+impl Default for RawImu {
+    fn default() -> Self {
+        Self {
+            version: PAYLOAD_VERSION,
+            n_gyro: 0,
+            n_accel: 0,
+            n_temperature: 0,
+            _pad: [0; 3],
+            status: 0,
+            valid_mask: 0,
+            header: Header::default(),
+            gyro_counts: [0; MAX_CHANNELS],
+            accel_counts: [0; MAX_CHANNELS],
+            temperature_c: [0.0; MAX_TEMPERATURES],
+        }
+    }
+}
+
+/// One raw barometer sample.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::RawBaro")]
+pub struct RawBaro {
+    pub version: u16,
+    pub _pad: [u8; 6],
+    pub header: Header,
+    pub pressure_pa: f64,
+    pub temperature_c: f32,
+    pub _pad2: u32,
+}
+
+/// One raw magnetometer sample, body frame (FRD), microtesla.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::RawMag")]
+pub struct RawMag {
+    pub version: u16,
+    pub _pad: [u8; 6],
+    pub header: Header,
+    pub field_ut: [f32; 3],
+    pub _pad2: u32,
+}
+
+/// One auxiliary sample: foot-pressure (force-sensitive resistor) reading, normalised 0..1.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::RawAux")]
+pub struct RawAux {
+    pub version: u16,
+    pub _pad: [u8; 6],
+    pub header: Header,
+    pub foot_pressure: f32,
+    pub _pad2: u32,
+}
+
+/// State of one redundant channel as judged by fusion.
+#[repr(u8)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ChannelState {
+    #[default]
+    Ok = 0,
+    Suspect = 1,
+    Excluded = 2,
+    /// Not fitted in this sensor block.
+    Absent = 3,
+}
+
+impl ChannelState {
+    pub fn from_u8(v: u8) -> Self {
+        match v {
+            0 => ChannelState::Ok,
+            1 => ChannelState::Suspect,
+            2 => ChannelState::Excluded,
+            _ => ChannelState::Absent,
+        }
+    }
+}
+
+/// Body rate and specific force fused from the redundant channels.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::FusedImu")]
+pub struct FusedImu {
+    pub version: u16,
+    pub n_gyro: u8,
+    pub n_accel: u8,
+    pub flags: u32,
+    pub header: Header,
+    /// Body rate, FRD, rad/s.
+    pub rate_rps: [f64; 3],
+    /// Specific force, FRD, m/s².
+    pub specific_force_mps2: [f64; 3],
+    /// Variance of each rate axis, (rad/s)².
+    pub rate_var: [f64; 3],
+    /// Variance of each specific-force axis, (m/s²)².
+    pub specific_force_var: [f64; 3],
+    /// Per-channel state, [`ChannelState`] as u8.
+    pub gyro_state: [u8; MAX_CHANNELS],
+    pub accel_state: [u8; MAX_CHANNELS],
+    /// Parity test statistic per sensor type (0 when no parity space).
+    pub gyro_test_statistic: f32,
+    pub accel_test_statistic: f32,
+}
+
+/// Bits of [`FusedImu::flags`].
+pub mod fused_flags {
+    pub const GYRO_FAULT_DETECTED_NOT_ISOLATED: u32 = 1 << 0;
+    pub const ACCEL_FAULT_DETECTED_NOT_ISOLATED: u32 = 1 << 1;
+    /// Fewer than three usable channels of a type: the solution is not valid.
+    pub const GYRO_INSUFFICIENT: u32 = 1 << 2;
+    pub const ACCEL_INSUFFICIENT: u32 = 1 << 3;
+}
+
+impl Default for FusedImu {
+    fn default() -> Self {
+        Self {
+            version: PAYLOAD_VERSION,
+            n_gyro: 0,
+            n_accel: 0,
+            flags: 0,
+            header: Header::default(),
+            rate_rps: [0.0; 3],
+            specific_force_mps2: [0.0; 3],
+            rate_var: [0.0; 3],
+            specific_force_var: [0.0; 3],
+            gyro_state: [ChannelState::Absent as u8; MAX_CHANNELS],
+            accel_state: [ChannelState::Absent as u8; MAX_CHANNELS],
+            gyro_test_statistic: 0.0,
+            accel_test_statistic: 0.0,
+        }
+    }
+}
+
+/// Barometric altitude.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::Altitude")]
+pub struct Altitude {
+    pub version: u16,
+    pub valid: u8,
+    pub _pad: [u8; 5],
+    pub header: Header,
+    /// Height above mean sea level (ISA with the configured QNH), metres.
+    pub height_m: f64,
+    /// Vertical speed, positive up, m/s.
+    pub vertical_speed_mps: f64,
+    /// Variance of `height_m`, m².
+    pub height_var: f64,
+}
+
+/// Bits of [`NavState::aiding`].
+pub mod aiding {
+    pub const BARO: u32 = 1 << 0;
+    pub const MAG: u32 = 1 << 1;
+    pub const ZUPT: u32 = 1 << 2;
+}
+
+/// Navigator mode, [`NavState::mode`].
+#[repr(u8)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum NavMode {
+    /// Collecting the static alignment window.
+    #[default]
+    Aligning = 0,
+    /// Aligned and navigating.
+    Navigating = 1,
+    /// Navigating on inertial only: an aiding source expected by the profile is missing.
+    Coasting = 2,
+}
+
+impl NavMode {
+    pub fn from_u8(v: u8) -> Self {
+        match v {
+            1 => NavMode::Navigating,
+            2 => NavMode::Coasting,
+            _ => NavMode::Aligning,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            NavMode::Aligning => "aligning",
+            NavMode::Navigating => "navigating",
+            NavMode::Coasting => "coasting",
+        }
+    }
+}
+
+/// Length of [`NavState::covariance_diag`]: attitude error, velocity, position, gyro bias, accel bias.
+pub const NAV_STATES: usize = 15;
+
+/// Navigation solution.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::NavState")]
+pub struct NavState {
+    pub version: u16,
+    /// [`NavMode`] as u8.
+    pub mode: u8,
+    pub _pad: [u8; 1],
+    /// Aiding sources used in this solution, bits of [`aiding`].
+    pub aiding: u32,
+    pub header: Header,
+    /// Attitude quaternion body (FRD) → NED, Hamilton, scalar first.
+    pub quaternion: [f64; 4],
+    /// Velocity NED, m/s.
+    pub velocity_ned_mps: [f64; 3],
+    /// Latitude, longitude in radians; altitude above mean sea level in metres.
+    pub latitude_rad: f64,
+    pub longitude_rad: f64,
+    pub altitude_m: f64,
+    pub covariance_diag: [f64; NAV_STATES],
+}
+
+impl Default for NavState {
+    fn default() -> Self {
+        Self {
+            version: PAYLOAD_VERSION,
+            mode: NavMode::Aligning as u8,
+            _pad: [0],
+            aiding: 0,
+            header: Header::default(),
+            quaternion: [1.0, 0.0, 0.0, 0.0],
+            velocity_ned_mps: [0.0; 3],
+            latitude_rad: 0.0,
+            longitude_rad: 0.0,
+            altitude_m: 0.0,
+            covariance_diag: [0.0; NAV_STATES],
+        }
+    }
+}
+
+/// Simulator ground truth for one IMU frame (same `header.origin_seq` as the frame).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::Truth")]
+pub struct Truth {
+    pub version: u16,
+    pub _pad: [u8; 6],
+    pub header: Header,
+    pub quaternion: [f64; 4],
+    pub velocity_ned_mps: [f64; 3],
+    pub latitude_rad: f64,
+    pub longitude_rad: f64,
+    pub altitude_m: f64,
+}
+
+impl Default for Truth {
+    fn default() -> Self {
+        Self {
+            version: PAYLOAD_VERSION,
+            _pad: [0; 6],
+            header: Header::default(),
+            quaternion: [1.0, 0.0, 0.0, 0.0],
+            velocity_ned_mps: [0.0; 3],
+            latitude_rad: 0.0,
+            longitude_rad: 0.0,
+            altitude_m: 0.0,
+        }
+    }
+}
+
+/// Which process a [`Health`] message speaks for.
+#[repr(u8)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ServiceKind {
+    Simulator = 0,
+    Acquisition = 1,
+    Fusion = 2,
+    Altimeter = 3,
+    Navigator = 4,
+    Watchdog = 5,
+}
+
+impl ServiceKind {
+    pub const ALL: [ServiceKind; 6] = [
+        ServiceKind::Simulator,
+        ServiceKind::Acquisition,
+        ServiceKind::Fusion,
+        ServiceKind::Altimeter,
+        ServiceKind::Navigator,
+        ServiceKind::Watchdog,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ServiceKind::Simulator => "sim",
+            ServiceKind::Acquisition => "acquisition",
+            ServiceKind::Fusion => "fusion",
+            ServiceKind::Altimeter => "altimeter",
+            ServiceKind::Navigator => "navigator",
+            ServiceKind::Watchdog => "watchdog",
+        }
+    }
+
+    pub fn from_u8(v: u8) -> Option<Self> {
+        Self::ALL.get(v as usize).copied()
+    }
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+}
+
+/// Periodic heartbeat and counters of one process.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::Health")]
+pub struct Health {
+    pub version: u16,
+    /// [`ServiceKind`] as u8.
+    pub service: u8,
+    pub _pad: [u8; 1],
+    pub pid: u32,
+    /// CLOCK_MONOTONIC ns when this heartbeat was published.
+    pub now_ns: u64,
+    /// Messages taken in and published since start.
+    pub received: u64,
+    pub published: u64,
+    /// Serial frames with a bad CRC (acquisition).
+    pub crc_errors: u64,
+    /// Frames missing from the device's sequence (acquisition), or input samples lost (others).
+    pub lost: u64,
+    /// Bytes skipped while resynchronising (acquisition).
+    pub resync_bytes: u64,
+    /// Times the input device was reopened (acquisition).
+    pub reconnects: u64,
+    /// Payloads rejected for a wrong version or malformed content.
+    pub rejected: u64,
+}

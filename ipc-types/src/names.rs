@@ -1,0 +1,24 @@
+//! Service names: the one place where topics are named.
+
+pub const RAW_IMU: &str = "rins/raw/imu";
+pub const RAW_BARO: &str = "rins/raw/baro";
+pub const RAW_MAG: &str = "rins/raw/mag";
+pub const RAW_AUX: &str = "rins/raw/aux";
+pub const FUSED_IMU: &str = "rins/fused/imu";
+pub const ALTITUDE: &str = "rins/altitude";
+pub const NAV_STATE: &str = "rins/nav/state";
+pub const TRUTH: &str = "rins/sim/truth";
+pub const HEALTH: &str = "rins/health";
+
+/// Every published topic, with the short name `rins echo` accepts.
+pub const TOPICS: [(&str, &str); 9] = [
+    ("raw-imu", RAW_IMU),
+    ("raw-baro", RAW_BARO),
+    ("raw-mag", RAW_MAG),
+    ("raw-aux", RAW_AUX),
+    ("fused-imu", FUSED_IMU),
+    ("altitude", ALTITUDE),
+    ("nav", NAV_STATE),
+    ("truth", TRUTH),
+    ("health", HEALTH),
+];

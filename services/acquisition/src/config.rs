@@ -1,0 +1,78 @@
+//! `[acquisition]` configuration.
+
+use serde::Deserialize;
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct AcquisitionConfig {
+    /// Serial device path (a real port, or the simulator's link). `rins up` fills it in for the simulator.
+    pub port: Option<String>,
+    pub baud: u32,
+    /// Longest a read blocks before the loop looks at shutdown and heartbeats again.
+    pub read_timeout_ms: u64,
+    /// First delay before reopening a lost port; doubles up to `reconnect_max_ms`.
+    pub reconnect_initial_ms: u64,
+    pub reconnect_max_ms: u64,
+}
+
+impl Default for AcquisitionConfig {
+    fn default() -> Self {
+        Self {
+            port: None,
+            baud: 921_600,
+            read_timeout_ms: 50,
+            reconnect_initial_ms: 20,
+            reconnect_max_ms: 2_000,
+        }
+    }
+}
+
+impl AcquisitionConfig {
+    pub fn validate(&self) -> Result<(), String> {
+        if self.baud == 0 {
+            return Err("acquisition.baud = 0: must be > 0".into());
+        }
+        if !(1..=10_000).contains(&self.read_timeout_ms) {
+            return Err(format!(
+                "acquisition.read_timeout_ms = {}: must be in 1..=10000",
+                self.read_timeout_ms
+            ));
+        }
+        if self.reconnect_initial_ms == 0 || self.reconnect_initial_ms > self.reconnect_max_ms {
+            return Err(format!(
+                "acquisition.reconnect_initial_ms = {}: must be > 0 and <= reconnect_max_ms ({})",
+                self.reconnect_initial_ms, self.reconnect_max_ms
+            ));
+        }
+        if let Some(port) = &self.port
+            && port.is_empty()
+        {
+            return Err("acquisition.port = \"\": must name a device path".into());
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_bad_values_are_named() {
+        assert!(AcquisitionConfig::default().validate().is_ok());
+        let bad = AcquisitionConfig {
+            baud: 0,
+            ..Default::default()
+        };
+        assert!(bad.validate().unwrap_err().contains("acquisition.baud = 0"));
+        let bad = AcquisitionConfig {
+            reconnect_initial_ms: 5000,
+            ..Default::default()
+        };
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .contains("reconnect_initial_ms = 5000")
+        );
+    }
+}

@@ -1,0 +1,112 @@
+//! Extension of the wrapping wire counters (16-bit sequence, 32-bit microsecond clock) to 64 bits.
+
+/// Extends one frame type's 16-bit sequence number and counts the frames missing in between.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SeqExtender {
+    last: Option<u64>,
+}
+
+impl SeqExtender {
+    /// Extended sequence number of `seq` and the number of frames lost since the previous one.
+    ///
+    /// The first call sets the reference (extended = wire value, nothing lost). After that a step
+    /// of k (mod 2^16, 1 ≤ k ≤ 65535) from the previous number means k − 1 frames were lost. A
+    /// repeated number (k = 0) is taken as a repeat, not as 65535 losses: it loses nothing and
+    /// keeps the extended value.
+    pub fn extend(&mut self, seq: u16) -> (u64, u64) {
+        let Some(last) = self.last else {
+            self.last = Some(u64::from(seq));
+            return (u64::from(seq), 0);
+        };
+        // Truncation intended: the step is the difference of the low 16 bits.
+        let step = seq.wrapping_sub(last as u16);
+        if step == 0 {
+            return (last, 0);
+        }
+        let extended = last.wrapping_add(u64::from(step));
+        self.last = Some(extended);
+        (extended, u64::from(step) - 1)
+    }
+
+    /// Forgets the reference; the next frame sets it again.
+    pub fn reset(&mut self) {
+        self.last = None;
+    }
+}
+
+/// Extends the device's 32-bit microsecond clock (wraps every 2^32 µs ≈ 71.6 min) to 64 bits.
+///
+/// All frame types share the one device clock, so one extender serves them all. Each time is
+/// placed at the 64-bit value congruent to it (mod 2^32) that lies closest to the previous
+/// frame's time, i.e. within −2^31..2^31 µs (±35.8 min). Wraps are thus followed as long as
+/// consecutive frames are less than 35.8 min apart, and frames of different types may arrive
+/// slightly out of time order without being mistaken for a wrap.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct TimeExtender {
+    /// Signed so that a frame stamped just before the first one stays congruent to its wire value.
+    last: Option<i64>,
+}
+
+impl TimeExtender {
+    /// Extended device time of `time_us`. The first call sets the reference (extended = wire
+    /// value). A time that would precede zero (stamped before the first frame and before the
+    /// device clock's first wrap) is reported as 0.
+    pub fn extend(&mut self, time_us: u32) -> u64 {
+        let extended = match self.last {
+            None => i64::from(time_us),
+            Some(last) => {
+                // Truncations intended: the step is the signed difference of the low 32 bits.
+                let step = time_us.wrapping_sub(last as u32) as i32;
+                last.saturating_add(i64::from(step))
+            }
+        };
+        self.last = Some(extended);
+        u64::try_from(extended).unwrap_or(0)
+    }
+
+    /// Forgets the reference; the next frame sets it again.
+    pub fn reset(&mut self) {
+        self.last = None;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sequence_gaps_across_the_wrap() {
+        let mut s = SeqExtender::default();
+        assert_eq!(s.extend(65534), (65534, 0));
+        assert_eq!(s.extend(65535), (65535, 0));
+        assert_eq!(s.extend(0), (65536, 0));
+        assert_eq!(s.extend(3), (65539, 2));
+        // 65535 steps forward: 65534 lost.
+        assert_eq!(s.extend(2), (65539 + 65535, 65534));
+        assert_eq!(s.extend(2), (65539 + 65535, 0));
+        s.reset();
+        assert_eq!(s.extend(100), (100, 0));
+    }
+
+    #[test]
+    fn time_follows_wraps_and_small_reversals() {
+        let mut t = TimeExtender::default();
+        let wrap = 1u64 << 32;
+        assert_eq!(t.extend(u32::MAX - 10), wrap - 11);
+        // A frame of another type stamped slightly earlier.
+        assert_eq!(t.extend(u32::MAX - 20), wrap - 21);
+        assert_eq!(t.extend(5), wrap + 5);
+        // Largest forward step that is still taken as forward: 2^31 - 1.
+        assert_eq!(t.extend(5 + (1 << 31) - 1), wrap + 5 + (1 << 31) - 1);
+        // A further 2^31 (wire 4, after wrapping) is taken as 2^31 backwards.
+        assert_eq!(t.extend(4), wrap + 4);
+    }
+
+    #[test]
+    fn time_before_the_first_frame_clamps_at_zero_but_stays_congruent() {
+        let mut t = TimeExtender::default();
+        assert_eq!(t.extend(5), 5);
+        assert_eq!(t.extend(u32::MAX - 2), 0); // 8 µs before the first frame: −3
+        assert_eq!(t.extend(6), 6);
+    }
+}

@@ -1,0 +1,121 @@
+//! Decoded serial frames: what the sensor block sends, in device units.
+//! Wire layout and encoding: `docs/protocol.md`, `layout.rs` and `codec.rs`.
+
+use ipc_types::{MAX_CHANNELS, MAX_TEMPERATURES};
+
+/// Frame type byte on the wire.
+#[repr(u8)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameType {
+    Imu = 1,
+    Baro = 2,
+    Mag = 3,
+    Aux = 4,
+}
+
+impl FrameType {
+    pub const COUNT: usize = 4;
+
+    pub fn from_u8(v: u8) -> Option<Self> {
+        match v {
+            1 => Some(FrameType::Imu),
+            2 => Some(FrameType::Baro),
+            3 => Some(FrameType::Mag),
+            4 => Some(FrameType::Aux),
+            _ => None,
+        }
+    }
+
+    /// Index 0..COUNT, for per-type counters.
+    pub fn index(self) -> usize {
+        self as usize - 1
+    }
+}
+
+/// IMU frame: N gyro and N accel channels as signed 12-bit ADC counts (-2048..=2047).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImuFrame {
+    pub n_gyro: u8,
+    pub n_accel: u8,
+    pub n_temperature: u8,
+    /// Device status bits (`ipc_types::status`).
+    pub status: u16,
+    /// Bit i: gyro i valid; bit 16 + i: accel i valid.
+    pub valid_mask: u32,
+    pub gyro_counts: [i16; MAX_CHANNELS],
+    pub accel_counts: [i16; MAX_CHANNELS],
+    /// Module temperatures, hundredths of a degree Celsius.
+    pub temperature_centi_c: [i16; MAX_TEMPERATURES],
+}
+
+impl Default for ImuFrame {
+    fn default() -> Self {
+        Self {
+            n_gyro: 0,
+            n_accel: 0,
+            n_temperature: 0,
+            status: 0,
+            valid_mask: 0,
+            gyro_counts: [0; MAX_CHANNELS],
+            accel_counts: [0; MAX_CHANNELS],
+            temperature_centi_c: [0; MAX_TEMPERATURES],
+        }
+    }
+}
+
+/// Barometer frame.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct BaroFrame {
+    /// Static pressure, pascal.
+    pub pressure_pa: f32,
+    /// Sensor temperature, hundredths of a degree Celsius.
+    pub temperature_centi_c: i16,
+}
+
+/// Magnetometer frame, body frame (FRD), in nanotesla.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MagFrame {
+    pub field_nt: [i32; 3],
+}
+
+/// Auxiliary frame: foot-pressure sensor reading, raw 16-bit (0 = no load, 65535 = full scale).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct AuxFrame {
+    pub foot_pressure: u16,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Payload {
+    Imu(ImuFrame),
+    Baro(BaroFrame),
+    Mag(MagFrame),
+    Aux(AuxFrame),
+}
+
+impl Payload {
+    pub fn frame_type(&self) -> FrameType {
+        match self {
+            Payload::Imu(_) => FrameType::Imu,
+            Payload::Baro(_) => FrameType::Baro,
+            Payload::Mag(_) => FrameType::Mag,
+            Payload::Aux(_) => FrameType::Aux,
+        }
+    }
+}
+
+/// A frame as it travels on the wire: 16-bit sequence (per frame type) and 32-bit device time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    pub seq: u16,
+    pub device_time_us: u32,
+    pub payload: Payload,
+}
+
+/// A frame handed out by the streaming decoder, with sequence and device time extended to 64 bits
+/// (they wrap on the wire).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DecodedFrame {
+    pub seq: u64,
+    pub device_time_us: u64,
+    pub payload: Payload,
+}

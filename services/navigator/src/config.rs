@@ -1,0 +1,213 @@
+//! Navigator settings as read from the TOML configuration.
+
+use serde::{Deserialize, Serialize};
+
+use crate::alignment::AlignConfig;
+use crate::baro_blend::BaroBlendConfig;
+use crate::earth::normal_gravity;
+use crate::mechanisation::StrapdownConfig;
+
+/// A configuration value outside its accepted range.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[error("navigator config: {field} = {value}: {reason}")]
+pub struct ConfigError {
+    /// Name of the field as written in the configuration.
+    pub field: &'static str,
+    /// The rejected value.
+    pub value: f64,
+    /// The accepted range.
+    pub reason: &'static str,
+}
+
+/// Navigator settings. Degrees only here, at the edge; everything inside is radians.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct NavigatorConfig {
+    /// Static alignment window, s of device time.
+    pub align_s: f64,
+    /// Magnetic declination, degrees, positive east.
+    pub declination_deg: f64,
+    /// Initial latitude, degrees.
+    pub initial_latitude_deg: f64,
+    /// Initial longitude, degrees.
+    pub initial_longitude_deg: f64,
+    /// Initial altitude, m; replaced by the first valid baro reading when there is one.
+    pub initial_altitude_m: f64,
+    /// Time constant τ of the baro blend, s.
+    pub baro_time_constant_s: f64,
+    /// Largest accepted |baro reading time − navigation time|, s.
+    pub baro_max_lag_s: f64,
+    /// Largest accepted IMU sample interval, s; longer gaps are skipped as device-time glitches.
+    pub max_dt_s: f64,
+    /// Two-sample coning correction in the attitude update.
+    pub coning_correction: bool,
+    /// An aiding source counts as used while its last reading is younger than this, s.
+    pub aiding_timeout_s: f64,
+    /// Alignment: largest accepted | |f̄| − g |, m/s².
+    pub align_specific_force_tolerance_mps2: f64,
+    /// Alignment: largest accepted norm of the mean rate, rad/s.
+    pub align_max_rate_rps: f64,
+    /// Alignment: largest accepted standard deviation of a specific-force axis, m/s².
+    pub align_max_specific_force_std_mps2: f64,
+    /// Alignment: largest accepted standard deviation of a rate axis, rad/s.
+    pub align_max_rate_std_rps: f64,
+}
+
+impl Default for NavigatorConfig {
+    fn default() -> Self {
+        let align = AlignConfig::default();
+        let strapdown = StrapdownConfig::default();
+        let baro = BaroBlendConfig::default();
+        Self {
+            align_s: align.window_s,
+            declination_deg: 0.0,
+            initial_latitude_deg: 0.0,
+            initial_longitude_deg: 0.0,
+            initial_altitude_m: 0.0,
+            baro_time_constant_s: baro.time_constant_s,
+            baro_max_lag_s: baro.max_lag_s,
+            max_dt_s: strapdown.max_dt_s,
+            coning_correction: strapdown.coning_correction,
+            aiding_timeout_s: 1.0,
+            align_specific_force_tolerance_mps2: align.specific_force_tolerance_mps2,
+            align_max_rate_rps: align.max_mean_rate_rps,
+            align_max_specific_force_std_mps2: align.max_specific_force_std_mps2,
+            align_max_rate_std_rps: align.max_rate_std_rps,
+        }
+    }
+}
+
+fn check(
+    field: &'static str,
+    value: f64,
+    ok: impl Fn(f64) -> bool,
+    reason: &'static str,
+) -> Result<(), ConfigError> {
+    // `is_finite` first so that NaN and infinities are always rejected whatever the range test says.
+    if value.is_finite() && ok(value) {
+        Ok(())
+    } else {
+        Err(ConfigError {
+            field,
+            value,
+            reason,
+        })
+    }
+}
+
+impl NavigatorConfig {
+    /// Checks every numeric field; the error names the first offending field and its value.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let positive = |x: f64| x > 0.0;
+        check(
+            "align_s",
+            self.align_s,
+            |x| x > 0.0 && x <= 600.0,
+            "must be in (0, 600] s",
+        )?;
+        check(
+            "declination_deg",
+            self.declination_deg,
+            |x| x.abs() <= 180.0,
+            "must be in [-180, 180] degrees",
+        )?;
+        check(
+            "initial_latitude_deg",
+            self.initial_latitude_deg,
+            |x| x.abs() <= 89.9,
+            "must be in [-89.9, 89.9] degrees (longitude is undefined at the poles)",
+        )?;
+        check(
+            "initial_longitude_deg",
+            self.initial_longitude_deg,
+            |x| x.abs() <= 180.0,
+            "must be in [-180, 180] degrees",
+        )?;
+        check(
+            "initial_altitude_m",
+            self.initial_altitude_m,
+            |x| (-1000.0..=50_000.0).contains(&x),
+            "must be in [-1000, 50000] m",
+        )?;
+        check(
+            "baro_time_constant_s",
+            self.baro_time_constant_s,
+            |x| x > 0.0 && x <= 1000.0,
+            "must be in (0, 1000] s",
+        )?;
+        check(
+            "baro_max_lag_s",
+            self.baro_max_lag_s,
+            |x| x >= 0.0,
+            "must be finite and >= 0 s",
+        )?;
+        check(
+            "max_dt_s",
+            self.max_dt_s,
+            |x| x > 0.0 && x <= 10.0,
+            "must be in (0, 10] s",
+        )?;
+        check(
+            "aiding_timeout_s",
+            self.aiding_timeout_s,
+            positive,
+            "must be finite and > 0 s",
+        )?;
+        check(
+            "align_specific_force_tolerance_mps2",
+            self.align_specific_force_tolerance_mps2,
+            positive,
+            "must be finite and > 0 m/s²",
+        )?;
+        check(
+            "align_max_rate_rps",
+            self.align_max_rate_rps,
+            positive,
+            "must be finite and > 0 rad/s",
+        )?;
+        check(
+            "align_max_specific_force_std_mps2",
+            self.align_max_specific_force_std_mps2,
+            positive,
+            "must be finite and > 0 m/s²",
+        )?;
+        check(
+            "align_max_rate_std_rps",
+            self.align_max_rate_std_rps,
+            positive,
+            "must be finite and > 0 rad/s",
+        )?;
+        Ok(())
+    }
+
+    /// Alignment limits, with the gravity expected at the initial position.
+    pub fn align_config(&self) -> AlignConfig {
+        AlignConfig {
+            window_s: self.align_s,
+            gravity_mps2: normal_gravity(
+                self.initial_latitude_deg.to_radians(),
+                self.initial_altitude_m,
+            ),
+            specific_force_tolerance_mps2: self.align_specific_force_tolerance_mps2,
+            max_mean_rate_rps: self.align_max_rate_rps,
+            max_specific_force_std_mps2: self.align_max_specific_force_std_mps2,
+            max_rate_std_rps: self.align_max_rate_std_rps,
+        }
+    }
+
+    /// Strapdown settings.
+    pub fn strapdown_config(&self) -> StrapdownConfig {
+        StrapdownConfig {
+            max_dt_s: self.max_dt_s,
+            coning_correction: self.coning_correction,
+        }
+    }
+
+    /// Baro blend settings.
+    pub fn baro_blend_config(&self) -> BaroBlendConfig {
+        BaroBlendConfig {
+            time_constant_s: self.baro_time_constant_s,
+            max_lag_s: self.baro_max_lag_s,
+        }
+    }
+}

@@ -1,0 +1,109 @@
+//! The per-sample path after alignment must not touch the heap.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+use rins_navigator::earth::normal_gravity;
+use rins_navigator::{Navigator, NavigatorConfig};
+
+/// Counts heap allocations made by the current thread while armed.
+struct CountingAllocator;
+
+thread_local! {
+    static ARMED: Cell<bool> = const { Cell::new(false) };
+    static COUNT: Cell<u64> = const { Cell::new(0) };
+}
+
+fn note_allocation() {
+    if ARMED.with(Cell::get) {
+        COUNT.with(|c| c.set(c.get() + 1));
+    }
+}
+
+// SAFETY: forwards to the system allocator unchanged; only bumps thread-local counters on the side.
+unsafe impl GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        note_allocation();
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc(layout) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as the caller's.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        note_allocation();
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc_zeroed(layout) }
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        note_allocation();
+        // SAFETY: same contract as the caller's.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: CountingAllocator = CountingAllocator;
+
+fn allocations_during(f: impl FnOnce()) -> u64 {
+    COUNT.with(|c| c.set(0));
+    ARMED.with(|a| a.set(true));
+    f();
+    ARMED.with(|a| a.set(false));
+    COUNT.with(Cell::get)
+}
+
+#[test]
+fn navigating_samples_do_not_allocate() {
+    let config = NavigatorConfig::default();
+    let g = normal_gravity(0.0, 0.0);
+    let mut nav = Navigator::new(config).unwrap();
+    let mut t = 0u64;
+    let mut aligned = false;
+    // Alignment itself is allocation-free too, but only the navigating path is required to be.
+    let aligning = allocations_during(|| {
+        while !aligned {
+            nav.on_mag(t, [20.0, 0.0, 40.0]);
+            nav.on_baro(t, 10.0, true);
+            aligned = nav.on_imu(t, [0.001, 0.0, 0.0], [0.0, 0.0, -g]).is_some();
+            t += 1000;
+        }
+    });
+    assert_eq!(aligning, 0);
+
+    let mut sink = 0.0;
+    let navigating = allocations_during(|| {
+        for k in 0..5000u64 {
+            let time = t + k * 1000;
+            if k.is_multiple_of(10) {
+                nav.on_mag(time, [20.0, 0.0, 40.0]);
+            }
+            if k.is_multiple_of(40) {
+                nav.on_baro(time, 10.5, k.is_multiple_of(80));
+            }
+            let out = nav
+                .on_imu(
+                    time,
+                    [0.001, 0.02 * (k as f64 * 0.01).sin(), 0.0],
+                    [0.1, 0.0, -g],
+                )
+                .unwrap();
+            sink += out.alt;
+        }
+        // A glitch and a non-finite sample take the rejection path.
+        let _ = nav.on_imu(0, [0.0; 3], [0.0, 0.0, -g]);
+        let _ = nav.on_imu(t + 6_000_000, [f64::NAN; 3], [0.0, 0.0, -g]);
+    });
+    assert_eq!(navigating, 0);
+    assert!(sink.is_finite());
+
+    // The counter does see allocations, so the zero above means something.
+    let boxed = allocations_during(|| {
+        std::hint::black_box(Box::new(1u64));
+    });
+    assert_eq!(boxed, 1);
+}

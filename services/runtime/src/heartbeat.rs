@@ -1,0 +1,46 @@
+//! Once-a-second heartbeat with the process's counters, on the `health` topic.
+
+use anyhow::Result;
+use ipc_types::{Health, PAYLOAD_VERSION, ServiceKind, names};
+
+use crate::clock::monotonic_ns;
+use crate::ipc::{IpcNode, TopicPublisher};
+
+const PERIOD_NS: u64 = 1_000_000_000;
+
+pub struct Heartbeat {
+    publisher: TopicPublisher<Health>,
+    template: Health,
+    next_due_ns: u64,
+}
+
+impl Heartbeat {
+    pub fn new(node: &IpcNode, service: ServiceKind) -> Result<Self> {
+        Ok(Self {
+            publisher: TopicPublisher::new(node, names::HEALTH)?,
+            template: Health {
+                version: PAYLOAD_VERSION,
+                service: service as u8,
+                pid: std::process::id(),
+                ..Health::default()
+            },
+            next_due_ns: 0,
+        })
+    }
+
+    /// Publishes `counters` (service, pid and time filled in here) if a second has passed since the last.
+    pub fn tick(&mut self, counters: &Health) -> Result<()> {
+        let now = monotonic_ns();
+        if now < self.next_due_ns {
+            return Ok(());
+        }
+        self.next_due_ns = now + PERIOD_NS;
+        self.publisher.publish(Health {
+            version: self.template.version,
+            service: self.template.service,
+            pid: self.template.pid,
+            now_ns: now,
+            ..*counters
+        })
+    }
+}

@@ -1,0 +1,199 @@
+//! iceoryx2 set-up shared by every process: an isolated prefix and root per deployment (and per test),
+//! and topics made of a publish-subscribe service plus an event service of the same name, so a consumer
+//! sleeps until data arrives instead of polling.
+
+use std::fmt::Debug;
+use std::time::Duration;
+
+use anyhow::{Result, anyhow};
+use iceoryx2::port::listener::{Listener, ListenerWaitError};
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+
+/// Environment variable naming the shared-memory prefix; every process of one deployment uses the same.
+pub const PREFIX_ENV: &str = "RINS_IPC_PREFIX";
+/// Environment variable naming the iceoryx2 root directory (node and service records).
+pub const ROOT_ENV: &str = "RINS_IPC_ROOT";
+pub const DEFAULT_PREFIX: &str = "rins_";
+pub const DEFAULT_ROOT: &str = "/tmp/rins/";
+
+/// Where this deployment's shared memory and iceoryx2 records live.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct IpcSettings {
+    pub prefix: String,
+    pub root: String,
+}
+
+impl IpcSettings {
+    /// From `RINS_IPC_PREFIX` / `RINS_IPC_ROOT`, with defaults. Children inherit the environment, so a
+    /// whole process tree shares one setting.
+    pub fn from_env() -> Self {
+        let prefix = std::env::var(PREFIX_ENV).unwrap_or_else(|_| DEFAULT_PREFIX.to_string());
+        let mut root = std::env::var(ROOT_ENV).unwrap_or_else(|_| DEFAULT_ROOT.to_string());
+        if !root.ends_with('/') {
+            root.push('/');
+        }
+        Self { prefix, root }
+    }
+
+    pub fn iceoryx_config(&self) -> Result<Config> {
+        let mut config = Config::default();
+        config.global.prefix = FileName::new(self.prefix.as_bytes()).map_err(|e| {
+            anyhow!(
+                "{PREFIX_ENV} = {:?}: not a valid file-name prefix ({e:?})",
+                self.prefix
+            )
+        })?;
+        let root = Path::new(self.root.as_bytes())
+            .map_err(|e| anyhow!("{ROOT_ENV} = {:?}: not a valid path ({e:?})", self.root))?;
+        config.global.set_root_path(&root);
+        Ok(config)
+    }
+}
+
+pub type IpcNode = Node<ipc::Service>;
+
+/// Creates this process's node. Signal handling is left to [`crate::shutdown::Shutdown`].
+pub fn create_node(name: &str, settings: &IpcSettings) -> Result<IpcNode> {
+    let config = settings.iceoryx_config()?;
+    let node_name = NodeName::new(name).map_err(|e| anyhow!("node name {name:?}: {e:?}"))?;
+    NodeBuilder::new()
+        .name(&node_name)
+        .config(&config)
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .map_err(|e| anyhow!("cannot create iceoryx2 node {name:?}: {e:?}"))
+}
+
+/// Queue depth of every subscriber: a consumer may sleep up to this many samples of a 1 kHz topic
+/// (plus margin at 8 kHz) before the oldest is overwritten.
+const SUBSCRIBER_BUFFER: usize = 512;
+/// Publishers per topic: restarted services leave a dead publisher until it is cleaned up.
+const MAX_PUBLISHERS: usize = 16;
+const MAX_SUBSCRIBERS: usize = 16;
+const MAX_NODES: usize = 64;
+
+fn service_name(name: &str) -> Result<ServiceName> {
+    ServiceName::new(name).map_err(|e| anyhow!("service name {name:?}: {e:?}"))
+}
+
+/// Every process opens a topic with the same settings, so whoever comes first creates it.
+fn open_pubsub<T: Debug + ZeroCopySend + 'static>(
+    node: &IpcNode,
+    name: &str,
+) -> Result<iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, T, ()>> {
+    node.service_builder(&service_name(name)?)
+        .publish_subscribe::<T>()
+        .max_publishers(MAX_PUBLISHERS)
+        .max_subscribers(MAX_SUBSCRIBERS)
+        .max_nodes(MAX_NODES)
+        .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
+        .history_size(0)
+        .enable_safe_overflow(true)
+        .open_or_create()
+        .map_err(|e| anyhow!("cannot open topic {name:?}: {e:?}"))
+}
+
+fn open_event(
+    node: &IpcNode,
+    name: &str,
+) -> Result<iceoryx2::service::port_factory::event::PortFactory<ipc::Service>> {
+    node.service_builder(&service_name(name)?)
+        .event()
+        .max_notifiers(MAX_PUBLISHERS)
+        .max_listeners(MAX_SUBSCRIBERS)
+        .max_nodes(MAX_NODES)
+        .open_or_create()
+        .map_err(|e| anyhow!("cannot open event service {name:?}: {e:?}"))
+}
+
+/// Publishing end of a topic: sends the sample, then wakes the topic's listeners.
+pub struct TopicPublisher<T: Debug + ZeroCopySend + 'static> {
+    publisher: Publisher<ipc::Service, T, ()>,
+    notifier: Notifier<ipc::Service>,
+    name: &'static str,
+}
+
+impl<T: Debug + ZeroCopySend + 'static> TopicPublisher<T> {
+    pub fn new(node: &IpcNode, name: &'static str) -> Result<Self> {
+        let publisher = open_pubsub::<T>(node, name)?
+            .publisher_builder()
+            .create()
+            .map_err(|e| anyhow!("cannot create publisher on {name:?}: {e:?}"))?;
+        let notifier = open_event(node, name)?
+            .notifier_builder()
+            .create()
+            .map_err(|e| anyhow!("cannot create notifier on {name:?}: {e:?}"))?;
+        Ok(Self {
+            publisher,
+            notifier,
+            name,
+        })
+    }
+
+    /// Writes `value` straight into shared memory and wakes the listeners.
+    pub fn publish(&self, value: T) -> Result<()> {
+        let sample = self
+            .publisher
+            .loan_uninit()
+            .map_err(|e| anyhow!("loan on {:?} failed: {e:?}", self.name))?;
+        sample
+            .write_payload(value)
+            .send()
+            .map_err(|e| anyhow!("send on {:?} failed: {e:?}", self.name))?;
+        self.notifier
+            .notify()
+            .map_err(|e| anyhow!("notify on {:?} failed: {e:?}", self.name))?;
+        Ok(())
+    }
+}
+
+/// Receiving end of a topic.
+pub struct TopicSubscriber<T: Debug + ZeroCopySend + 'static> {
+    subscriber: Subscriber<ipc::Service, T, ()>,
+    listener: Listener<ipc::Service>,
+    name: &'static str,
+}
+
+impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
+    pub fn new(node: &IpcNode, name: &'static str) -> Result<Self> {
+        let subscriber = open_pubsub::<T>(node, name)?
+            .subscriber_builder()
+            .create()
+            .map_err(|e| anyhow!("cannot create subscriber on {name:?}: {e:?}"))?;
+        let listener = open_event(node, name)?
+            .listener_builder()
+            .create()
+            .map_err(|e| anyhow!("cannot create listener on {name:?}: {e:?}"))?;
+        Ok(Self {
+            subscriber,
+            listener,
+            name,
+        })
+    }
+
+    /// Next queued sample, copied out of shared memory (payloads are small and `Copy`).
+    pub fn receive(&self) -> Result<Option<T>> {
+        let sample = self
+            .subscriber
+            .receive()
+            .map_err(|e| anyhow!("receive on {:?} failed: {e:?}", self.name))?;
+        Ok(sample.map(|s| *s.payload()))
+    }
+
+    /// Sleeps until a publisher signals new data or `timeout` passes. Returns whether a signal came.
+    pub fn wait(&self, timeout: Duration) -> Result<bool> {
+        match self.listener.timed_wait(|_| {}, timeout) {
+            Ok(woken) => Ok(woken > 0),
+            // A signal (the termination request the caller polls for) cut the wait short.
+            Err(ListenerWaitError::InterruptSignal) => Ok(false),
+            Err(e) => Err(anyhow!("wait on {:?} failed: {e:?}", self.name)),
+        }
+    }
+
+    pub fn name(&self) -> &'static str {
+        self.name
+    }
+}

@@ -1,0 +1,9 @@
+//! Runtime shared by every rins process: iceoryx2 node and topic set-up on an isolated prefix,
+//! the monotonic clock, termination signals, heartbeats and log set-up.
+
+pub mod clock;
+pub mod heartbeat;
+pub mod ipc;
+pub mod logging;
+pub mod shm_cleanup;
+pub mod shutdown;

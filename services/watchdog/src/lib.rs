@@ -1,0 +1,11 @@
+//! The watchdog: starts every rins process as a child, restarts the ones that exit, watches the
+//! topics, prints a status line per second and, at the end of a timed run, a summary.
+
+pub mod accuracy;
+pub mod config;
+pub mod monitor;
+pub mod restart_policy;
+pub mod seq_gaps;
+pub mod status;
+pub mod summary;
+pub mod supervisor;

@@ -1,0 +1,150 @@
+//! Watches every topic: per-topic rates, sequence gaps of the navigation output, device counters from
+//! the heartbeats, and — when a simulator publishes truth — the navigation error.
+
+use anyhow::Result;
+use ipc_types::{
+    Altitude, FusedImu, Health, NavMode, NavState, RawBaro, RawImu, RawMag, ServiceKind, Truth,
+    names,
+};
+use rins_runtime::ipc::{IpcNode, TopicSubscriber};
+
+use crate::accuracy::Accuracy;
+use crate::seq_gaps::SeqGaps;
+
+/// Truth is kept this many IMU frames back, to meet the navigation output that comes later.
+const TRUTH_RING: usize = 8192;
+
+/// Topics counted for the status line, in display order.
+pub const COUNTED: [&str; 6] = ["imu", "baro", "mag", "fused", "alt", "nav"];
+
+#[derive(Debug, Clone, Copy, Default)]
+pub struct DeviceCounters {
+    pub crc_errors: u64,
+    pub lost_frames: u64,
+    pub resync_bytes: u64,
+    pub reconnects: u64,
+}
+
+pub struct Monitor {
+    imu: TopicSubscriber<RawImu>,
+    baro: TopicSubscriber<RawBaro>,
+    mag: TopicSubscriber<RawMag>,
+    fused: TopicSubscriber<FusedImu>,
+    alt: TopicSubscriber<Altitude>,
+    nav: TopicSubscriber<NavState>,
+    truth: TopicSubscriber<Truth>,
+    health: TopicSubscriber<Health>,
+    /// Samples seen per topic of [`COUNTED`], since start.
+    pub totals: [u64; COUNTED.len()],
+    pub nav_gaps: SeqGaps,
+    pub last_nav: Option<NavState>,
+    pub accuracy: Accuracy,
+    truth_ring: Box<[Truth]>,
+    /// Latest acquisition counters per process id (a restarted acquisition starts from zero).
+    acquisition: Vec<(u32, DeviceCounters)>,
+}
+
+impl Monitor {
+    pub fn new(node: &IpcNode) -> Result<Self> {
+        Ok(Self {
+            imu: TopicSubscriber::new(node, names::RAW_IMU)?,
+            baro: TopicSubscriber::new(node, names::RAW_BARO)?,
+            mag: TopicSubscriber::new(node, names::RAW_MAG)?,
+            fused: TopicSubscriber::new(node, names::FUSED_IMU)?,
+            alt: TopicSubscriber::new(node, names::ALTITUDE)?,
+            nav: TopicSubscriber::new(node, names::NAV_STATE)?,
+            truth: TopicSubscriber::new(node, names::TRUTH)?,
+            health: TopicSubscriber::new(node, names::HEALTH)?,
+            totals: [0; COUNTED.len()],
+            nav_gaps: SeqGaps::default(),
+            last_nav: None,
+            accuracy: Accuracy::default(),
+            // version 0 marks an empty slot.
+            truth_ring: vec![
+                Truth {
+                    version: 0,
+                    ..Truth::default()
+                };
+                TRUTH_RING
+            ]
+            .into_boxed_slice(),
+            acquisition: Vec::new(),
+        })
+    }
+
+    /// Takes everything queued on every topic.
+    pub fn drain(&mut self) -> Result<()> {
+        self.totals[0] += drain_count(&self.imu)?;
+        self.totals[1] += drain_count(&self.baro)?;
+        self.totals[2] += drain_count(&self.mag)?;
+        self.totals[3] += drain_count(&self.fused)?;
+        self.totals[4] += drain_count(&self.alt)?;
+        // Truth first, so a navigation sample finds the truth of its own frame.
+        while let Some(t) = self.truth.receive()? {
+            self.truth_ring[(t.header.origin_seq as usize) % TRUTH_RING] = t;
+        }
+        while let Some(nav) = self.nav.receive()? {
+            self.totals[5] += 1;
+            self.on_nav(nav);
+        }
+        while let Some(h) = self.health.receive()? {
+            self.on_health(&h);
+        }
+        Ok(())
+    }
+
+    fn on_nav(&mut self, nav: NavState) {
+        let seq = nav.header.origin_seq;
+        self.nav_gaps.observe(seq);
+        if NavMode::from_u8(nav.mode) != NavMode::Aligning {
+            let truth = &self.truth_ring[(seq as usize) % TRUTH_RING];
+            if truth.header.origin_seq == seq && truth.version != 0 {
+                self.accuracy.push(
+                    truth.quaternion,
+                    truth.altitude_m,
+                    nav.quaternion,
+                    nav.altitude_m,
+                );
+            }
+        }
+        self.last_nav = Some(nav);
+    }
+
+    fn on_health(&mut self, h: &Health) {
+        if ServiceKind::from_u8(h.service) != Some(ServiceKind::Acquisition) {
+            return;
+        }
+        let counters = DeviceCounters {
+            crc_errors: h.crc_errors,
+            lost_frames: h.lost,
+            resync_bytes: h.resync_bytes,
+            reconnects: h.reconnects,
+        };
+        match self.acquisition.iter_mut().find(|(pid, _)| *pid == h.pid) {
+            Some(entry) => entry.1 = counters,
+            None => self.acquisition.push((h.pid, counters)),
+        }
+    }
+
+    /// Acquisition counters summed over every acquisition process seen.
+    pub fn device_counters(&self) -> DeviceCounters {
+        self.acquisition
+            .iter()
+            .fold(DeviceCounters::default(), |acc, (_, c)| DeviceCounters {
+                crc_errors: acc.crc_errors + c.crc_errors,
+                lost_frames: acc.lost_frames + c.lost_frames,
+                resync_bytes: acc.resync_bytes + c.resync_bytes,
+                reconnects: acc.reconnects + c.reconnects,
+            })
+    }
+}
+
+fn drain_count<T: std::fmt::Debug + Copy + iceoryx2::prelude::ZeroCopySend>(
+    sub: &TopicSubscriber<T>,
+) -> Result<u64> {
+    let mut n = 0;
+    while sub.receive()?.is_some() {
+        n += 1;
+    }
+    Ok(n)
+}

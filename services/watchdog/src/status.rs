@@ -1,0 +1,80 @@
+//! The once-a-second status line.
+
+use ipc_types::{NavMode, NavState};
+use nalgebra::{Quaternion, UnitQuaternion};
+
+use crate::monitor::{COUNTED, DeviceCounters};
+
+/// Roll, pitch, yaw in degrees (ZYX) of a body→NED quaternion [w, x, y, z].
+pub fn euler_deg(q: [f64; 4]) -> [f64; 3] {
+    let u = UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
+    let (r, p, y) = u.euler_angles();
+    [r.to_degrees(), p.to_degrees(), y.to_degrees()]
+}
+
+/// One status line: per-topic rates over the last period, losses, and the current solution.
+pub fn status_line(
+    elapsed_s: f64,
+    rates_hz: &[f64; COUNTED.len()],
+    dropped: u64,
+    device: &DeviceCounters,
+    nav: Option<&NavState>,
+) -> String {
+    let mut line = format!("t={elapsed_s:6.1}s");
+    for (name, rate) in COUNTED.iter().zip(rates_hz) {
+        line.push_str(&format!(" {name} {rate:4.0}/s"));
+    }
+    line.push_str(&format!(
+        " | dropped {dropped} crc {} lost {}",
+        device.crc_errors, device.lost_frames
+    ));
+    match nav {
+        Some(nav) => {
+            let [r, p, y] = euler_deg(nav.quaternion);
+            line.push_str(&format!(
+                " | {} roll {r:6.2} pitch {p:6.2} yaw {y:7.2} alt {:7.1} m",
+                NavMode::from_u8(nav.mode).name(),
+                nav.altitude_m
+            ));
+        }
+        None => line.push_str(" | no navigation output yet"),
+    }
+    line
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn euler_of_a_known_attitude() {
+        let u = UnitQuaternion::from_euler_angles(0.1, 0.2, -0.3);
+        let e = euler_deg([u.w, u.i, u.j, u.k]);
+        for (got, want) in e.iter().zip([0.1f64, 0.2, -0.3]) {
+            assert!((got - want.to_degrees()).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn line_names_every_topic_and_the_mode() {
+        let nav = NavState {
+            mode: NavMode::Navigating as u8,
+            altitude_m: 12.5,
+            ..NavState::default()
+        };
+        let line = status_line(
+            3.0,
+            &[1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0],
+            0,
+            &DeviceCounters::default(),
+            Some(&nav),
+        );
+        for name in COUNTED {
+            assert!(line.contains(name), "{line}");
+        }
+        assert!(
+            line.contains("navigating") && line.contains("12.5"),
+            "{line}"
+        );
+    }
+}

@@ -1,0 +1,32 @@
+//! The JSON object `rins up --json` prints on its last line.
+
+use serde::Serialize;
+
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Summary {
+    pub duration_s: f64,
+    /// IMU frames published by acquisition.
+    pub frames: u64,
+    pub baro_frames: u64,
+    pub mag_frames: u64,
+    /// IMU frames sent by the device for which no navigation output appeared (serial losses and
+    /// pipeline losses together), between the first and the last navigation output.
+    pub dropped: u64,
+    pub crc_errors: u64,
+    /// Frames missing from the device's sequence numbers, as counted by acquisition.
+    pub lost_frames: u64,
+    pub nav_samples: u64,
+    pub restarts: u64,
+    /// Attitude error against simulator truth after alignment, degrees (simulator mode only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub att_err_deg_rms: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub att_err_deg_max: Option<f64>,
+    /// Altitude error against simulator truth after alignment, metres (simulator mode only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alt_err_m_rms: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub alt_err_m_max: Option<f64>,
+    /// Shared-memory entries of this deployment left after shutdown.
+    pub shm_leaked: u64,
+}

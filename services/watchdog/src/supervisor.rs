@@ -1,0 +1,185 @@
+//! Child processes of the watchdog: start, notice exits, restart with backoff, stop cleanly.
+
+use std::os::unix::process::CommandExt;
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+
+use crate::restart_policy::RestartPolicy;
+
+/// How to start one child.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChildSpec {
+    pub name: String,
+    pub program: PathBuf,
+    pub args: Vec<String>,
+}
+
+struct Managed {
+    spec: ChildSpec,
+    child: Option<Child>,
+    started_at: Instant,
+    failures: u32,
+    restart_at: Option<Instant>,
+    restarts: u64,
+}
+
+pub struct Supervisor {
+    children: Vec<Managed>,
+    policy: RestartPolicy,
+}
+
+/// What happened to a child during [`Supervisor::poll`].
+#[derive(Debug, Clone, PartialEq)]
+pub enum ChildEvent {
+    Exited {
+        name: String,
+        status: String,
+        restart_in: Duration,
+    },
+    Restarted {
+        name: String,
+        pid: u32,
+    },
+}
+
+fn spawn(spec: &ChildSpec) -> Result<Child> {
+    let mut cmd = Command::new(&spec.program);
+    cmd.args(&spec.args).stdin(Stdio::null());
+    // Children never write to our stdout: it carries the status lines and the final JSON.
+    let stderr = std::io::stderr();
+    let err_fd = std::os::fd::AsFd::as_fd(&stderr).try_clone_to_owned()?;
+    cmd.stdout(Stdio::from(err_fd));
+    // SAFETY: prctl is async-signal-safe; it only asks the kernel to SIGTERM the child when the
+    // watchdog dies, so no orphan keeps running after a watchdog crash.
+    unsafe {
+        cmd.pre_exec(|| {
+            libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM);
+            Ok(())
+        });
+    }
+    cmd.spawn()
+        .with_context(|| format!("cannot start {} ({:?})", spec.name, spec.program))
+}
+
+impl Supervisor {
+    pub fn new(policy: RestartPolicy) -> Self {
+        Self {
+            children: Vec::new(),
+            policy,
+        }
+    }
+
+    /// Starts a child now and supervises it from then on.
+    pub fn start(&mut self, spec: ChildSpec) -> Result<u32> {
+        let child = spawn(&spec)?;
+        let pid = child.id();
+        tracing::info!(child = %spec.name, pid, "started");
+        self.children.push(Managed {
+            spec,
+            child: Some(child),
+            started_at: Instant::now(),
+            failures: 0,
+            restart_at: None,
+            restarts: 0,
+        });
+        Ok(pid)
+    }
+
+    /// Reaps exited children and restarts the ones whose backoff has passed.
+    pub fn poll(&mut self, events: &mut Vec<ChildEvent>) {
+        let now = Instant::now();
+        for m in &mut self.children {
+            if let Some(child) = &mut m.child {
+                match child.try_wait() {
+                    Ok(Some(status)) => {
+                        m.failures = self
+                            .policy
+                            .failures_after_exit(m.failures, now - m.started_at);
+                        let delay = self.policy.backoff(m.failures);
+                        m.child = None;
+                        m.restart_at = Some(now + delay);
+                        events.push(ChildEvent::Exited {
+                            name: m.spec.name.clone(),
+                            status: status.to_string(),
+                            restart_in: delay,
+                        });
+                    }
+                    Ok(None) => {}
+                    Err(e) => {
+                        tracing::error!(child = %m.spec.name, error = %e, "cannot query child")
+                    }
+                }
+            }
+            if m.child.is_none() && m.restart_at.is_some_and(|at| now >= at) {
+                match spawn(&m.spec) {
+                    Ok(child) => {
+                        events.push(ChildEvent::Restarted {
+                            name: m.spec.name.clone(),
+                            pid: child.id(),
+                        });
+                        m.child = Some(child);
+                        m.started_at = now;
+                        m.restart_at = None;
+                        m.restarts += 1;
+                    }
+                    Err(e) => {
+                        m.failures = m.failures.saturating_add(1);
+                        m.restart_at = Some(now + self.policy.backoff(m.failures));
+                        tracing::error!(child = %m.spec.name, error = %e, "restart failed");
+                    }
+                }
+            }
+        }
+    }
+
+    pub fn restarts(&self) -> u64 {
+        self.children.iter().map(|m| m.restarts).sum()
+    }
+
+    /// (name, pid) of every running child.
+    pub fn running(&self) -> Vec<(String, u32)> {
+        self.children
+            .iter()
+            .filter_map(|m| m.child.as_ref().map(|c| (m.spec.name.clone(), c.id())))
+            .collect()
+    }
+
+    /// SIGTERM to every child, in reverse start order; SIGKILL to those still running after `grace`.
+    pub fn stop_all(&mut self, grace: Duration) {
+        for m in self.children.iter().rev() {
+            if let Some(child) = &m.child {
+                // SAFETY: plain kill(2) on a pid we own and have not reaped yet.
+                unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) };
+            }
+        }
+        let deadline = Instant::now() + grace;
+        loop {
+            let mut running = 0;
+            for m in &mut self.children {
+                if let Some(child) = &mut m.child {
+                    match child.try_wait() {
+                        Ok(Some(_)) | Err(_) => m.child = None,
+                        Ok(None) => running += 1,
+                    }
+                }
+            }
+            if running == 0 {
+                return;
+            }
+            if Instant::now() >= deadline {
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        for m in &mut self.children {
+            if let Some(mut child) = m.child.take() {
+                tracing::warn!(child = %m.spec.name, "did not stop in time; killing");
+                let _ = child.kill();
+                let _ = child.wait();
+            }
+        }
+    }
+}

@@ -1,0 +1,109 @@
+//! `rins echo TOPIC`: print every sample of a topic, as JSON lines or CSV.
+
+use std::io::Write;
+use std::time::Duration;
+
+use anyhow::{Result, bail};
+use ipc_types::{
+    Altitude, FusedImu, Health, NavState, RawAux, RawBaro, RawImu, RawMag, Truth, names,
+};
+use rins_runtime::ipc::{IpcSettings, TopicSubscriber, create_node};
+use rins_runtime::shutdown::Shutdown;
+use serde::Serialize;
+use serde_json::Value;
+
+/// Flattens nested objects and arrays into `a.b.0`-style columns.
+fn flatten(prefix: &str, value: &Value, out: &mut Vec<(String, String)>) {
+    match value {
+        Value::Object(map) => {
+            for (k, v) in map {
+                let key = if prefix.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{prefix}.{k}")
+                };
+                flatten(&key, v, out);
+            }
+        }
+        Value::Array(items) => {
+            for (i, v) in items.iter().enumerate() {
+                flatten(&format!("{prefix}.{i}"), v, out);
+            }
+        }
+        other => out.push((prefix.to_string(), other.to_string())),
+    }
+}
+
+fn echo_topic<T>(name: &'static str, count: Option<u64>, csv: bool) -> Result<()>
+where
+    T: std::fmt::Debug + Copy + Serialize + iceoryx2::prelude::ZeroCopySend + 'static,
+{
+    let shutdown = Shutdown::install()?;
+    let settings = IpcSettings::from_env();
+    let node = create_node(&format!("echo-{}", std::process::id()), &settings)?;
+    let sub = TopicSubscriber::<T>::new(&node, name)?;
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    let mut printed = 0u64;
+    let mut columns = Vec::new();
+    while !shutdown.requested() && count.is_none_or(|c| printed < c) {
+        sub.wait(Duration::from_millis(100))?;
+        while let Some(sample) = sub.receive()? {
+            let value = serde_json::to_value(sample)?;
+            if csv {
+                columns.clear();
+                flatten("", &value, &mut columns);
+                if printed == 0 {
+                    let header: Vec<&str> = columns.iter().map(|(k, _)| k.as_str()).collect();
+                    writeln!(out, "{}", header.join(","))?;
+                }
+                let row: Vec<&str> = columns.iter().map(|(_, v)| v.as_str()).collect();
+                writeln!(out, "{}", row.join(","))?;
+            } else {
+                writeln!(out, "{value}")?;
+            }
+            printed += 1;
+            if count.is_some_and(|c| printed >= c) {
+                break;
+            }
+        }
+        out.flush()?;
+    }
+    Ok(())
+}
+
+pub fn run(topic: &str, count: Option<u64>, csv: bool) -> Result<()> {
+    let Some((_, service)) = names::TOPICS.iter().find(|(short, _)| *short == topic) else {
+        let known: Vec<&str> = names::TOPICS.iter().map(|(s, _)| *s).collect();
+        bail!(
+            "unknown topic {topic:?}: expected one of {}",
+            known.join(", ")
+        );
+    };
+    match *service {
+        names::RAW_IMU => echo_topic::<RawImu>(names::RAW_IMU, count, csv),
+        names::RAW_BARO => echo_topic::<RawBaro>(names::RAW_BARO, count, csv),
+        names::RAW_MAG => echo_topic::<RawMag>(names::RAW_MAG, count, csv),
+        names::RAW_AUX => echo_topic::<RawAux>(names::RAW_AUX, count, csv),
+        names::FUSED_IMU => echo_topic::<FusedImu>(names::FUSED_IMU, count, csv),
+        names::ALTITUDE => echo_topic::<Altitude>(names::ALTITUDE, count, csv),
+        names::NAV_STATE => echo_topic::<NavState>(names::NAV_STATE, count, csv),
+        names::TRUTH => echo_topic::<Truth>(names::TRUTH, count, csv),
+        _ => echo_topic::<Health>(names::HEALTH, count, csv),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flatten_names_nested_columns() {
+        let v = serde_json::json!({"a": 1, "b": {"c": [2, 3]}});
+        let mut out = Vec::new();
+        flatten("", &v, &mut out);
+        let keys: Vec<&str> = out.iter().map(|(k, _)| k.as_str()).collect();
+        assert_eq!(keys, ["a", "b.c.0", "b.c.1"]);
+        assert_eq!(out[2].1, "3");
+    }
+}

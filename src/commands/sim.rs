@@ -1,0 +1,45 @@
+//! `rins sim`: the device simulator on a pseudo-terminal.
+
+use anyhow::{Result, anyhow, bail};
+use rins_runtime::ipc::IpcSettings;
+use rins_runtime::shutdown::Shutdown;
+use rins_sim::Simulator;
+use rins_sim::service::SimOptions;
+
+use crate::cli::SimArgs;
+use crate::config;
+
+pub fn run(args: &SimArgs) -> Result<()> {
+    let mut cfg = config::load(args.config.as_deref())?;
+    if let Some(scenario) = args.scenario {
+        cfg.set_scenario(scenario);
+    }
+    if let Some(seed) = args.seed {
+        cfg.sim.seed = seed;
+    }
+    if let Some(d) = args.duration
+        && !(d.is_finite() && d > 0.0)
+    {
+        bail!("--duration {d}: must be a positive number of seconds");
+    }
+    // The simulated block carries the sensors the fusion geometry describes.
+    let gyro = cfg
+        .fusion
+        .geometry
+        .gyro
+        .build()
+        .map_err(|e| anyhow!("{}", e.within("fusion.geometry.gyro")))?;
+    let accel = cfg
+        .fusion
+        .geometry
+        .accel
+        .build()
+        .map_err(|e| anyhow!("{}", e.within("fusion.geometry.accel")))?;
+    let sim = Simulator::new(&cfg.sim, gyro.axes(), accel.axes(), cfg.sim.seed)?;
+    let shutdown = Shutdown::install()?;
+    let options = SimOptions {
+        link: args.link.clone(),
+        duration_s: args.duration,
+    };
+    rins_sim::service::run(sim, &options, &IpcSettings::from_env(), &shutdown)
+}

@@ -1,0 +1,278 @@
+//! `rins up`: the watchdog. Starts every service (and the simulator unless a real port is given) as
+//! child processes, restarts children that exit, prints a status line per second, and on shutdown
+//! stops everything and removes the deployment's shared memory.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail};
+use rins_runtime::ipc::{IpcSettings, create_node};
+use rins_runtime::shm_cleanup;
+use rins_runtime::shutdown::Shutdown;
+use rins_watchdog::monitor::{COUNTED, Monitor};
+use rins_watchdog::status::status_line;
+use rins_watchdog::summary::Summary;
+use rins_watchdog::supervisor::{ChildEvent, ChildSpec, Supervisor};
+
+use crate::cli::UpArgs;
+use crate::config::{self, RinsConfig};
+
+/// Services in start order: consumers first, so that no sample is published before its subscriber exists.
+const SERVICES: [&str; 4] = ["navigator", "altimeter", "fusion", "acquisition"];
+
+/// How long the simulator may take to create its pseudo-terminal.
+const SIM_START_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// Period of the supervision loop: topics drained and children checked this often.
+const LOOP_PERIOD: Duration = Duration::from_millis(1);
+
+fn ensure_no_live_deployment(settings: &IpcSettings) -> Result<()> {
+    let config = settings.iceoryx_config()?;
+    let mut alive = 0;
+    iceoryx2::prelude::Node::<iceoryx2::prelude::ipc::Service>::list(&config, |state| {
+        if let iceoryx2::prelude::NodeState::Alive(_) = state {
+            alive += 1;
+        }
+        iceoryx2::prelude::CallbackProgression::Continue
+    })
+    .map_err(|e| anyhow::anyhow!("cannot list iceoryx2 nodes: {e:?}"))?;
+    if alive > 0 {
+        bail!(
+            "another rins deployment is running on IPC prefix {:?} ({alive} live processes): stop it or set {} to another prefix",
+            settings.prefix,
+            rins_runtime::ipc::PREFIX_ENV
+        );
+    }
+    // Nothing alive: whatever is left belongs to a deployment that died; start clean.
+    let removed = shm_cleanup::remove_all(settings);
+    if removed > 0 {
+        tracing::info!(removed, "removed shared memory left by an earlier run");
+    }
+    Ok(())
+}
+
+fn wait_for_path(path: &Path, supervisor: &mut Supervisor, shutdown: &Shutdown) -> Result<()> {
+    let deadline = Instant::now() + SIM_START_TIMEOUT;
+    let mut events = Vec::new();
+    while !path.exists() {
+        supervisor.poll(&mut events);
+        if let Some(ChildEvent::Exited { name, status, .. }) = events.first() {
+            bail!(
+                "{name} exited ({status}) before creating {}",
+                path.display()
+            );
+        }
+        if Instant::now() >= deadline || shutdown.requested() {
+            bail!(
+                "simulator did not create {} in {:?}",
+                path.display(),
+                SIM_START_TIMEOUT
+            );
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    Ok(())
+}
+
+fn apply_overrides(cfg: &mut RinsConfig, args: &UpArgs) -> Result<()> {
+    if let Some(scenario) = args.scenario {
+        cfg.set_scenario(scenario);
+    }
+    if let Some(seed) = args.seed {
+        cfg.sim.seed = seed;
+    }
+    if let Some(duration) = args.duration
+        && !(duration.is_finite() && duration > 0.0)
+    {
+        bail!("--duration {duration}: must be a positive number of seconds");
+    }
+    if let Some(port) = &args.port {
+        if !port.exists() {
+            bail!(
+                "serial device {} does not exist: check the cable and the device path",
+                port.display()
+            );
+        }
+        cfg.acquisition.port = Some(port.to_string_lossy().into_owned());
+    }
+    Ok(())
+}
+
+pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
+    let mut cfg = config::load(args.config.as_deref())?;
+    apply_overrides(&mut cfg, args)?;
+    let shutdown = Shutdown::install()?;
+    let settings = IpcSettings::from_env();
+    ensure_no_live_deployment(&settings)?;
+
+    let run_dir = PathBuf::from(&settings.root).join(format!("{}run", settings.prefix));
+    std::fs::create_dir_all(&run_dir)
+        .with_context(|| format!("cannot create {}", run_dir.display()))?;
+    let simulate = cfg.acquisition.port.is_none();
+    let link = run_dir.join("sim-tty");
+    if simulate {
+        let _ = std::fs::remove_file(&link);
+        cfg.acquisition.port = Some(link.to_string_lossy().into_owned());
+    }
+    // Children read the same file (or the built-in configuration); command-line overrides travel as
+    // arguments.
+    let config_args: Vec<String> = match &args.config {
+        Some(path) => vec!["--config".into(), path.to_string_lossy().into_owned()],
+        None => Vec::new(),
+    };
+    let port = cfg.acquisition.port.clone().unwrap_or_default();
+
+    let exe = std::env::current_exe().context("cannot locate the rins executable")?;
+    let node = create_node("watchdog", &settings)?;
+    let mut monitor = Monitor::new(&node)?;
+    let mut supervisor = Supervisor::new(cfg.watchdog.restart_policy());
+    let started = Instant::now();
+    let outcome = (|| -> Result<()> {
+        for name in SERVICES {
+            let mut child_args = vec!["service".to_string(), name.to_string()];
+            child_args.extend(config_args.iter().cloned());
+            if name == "acquisition" {
+                child_args.extend(["--port".to_string(), port.clone()]);
+            }
+            supervisor.start(ChildSpec {
+                name: name.to_string(),
+                program: exe.clone(),
+                args: child_args,
+            })?;
+        }
+        if simulate {
+            supervisor.start(ChildSpec {
+                name: "sim".into(),
+                program: exe.clone(),
+                args: sim_args(&cfg, &config_args, &link),
+            })?;
+            wait_for_path(&link, &mut supervisor, &shutdown)?;
+        }
+        supervise(
+            &cfg,
+            args,
+            &shutdown,
+            &mut supervisor,
+            &mut monitor,
+            started,
+        )
+    })();
+
+    supervisor.stop_all(Duration::from_millis(cfg.watchdog.stop_grace_ms));
+    // Drain what the children published while stopping, then release our own ports.
+    let _ = monitor.drain();
+    let summary = summarise(&monitor, &supervisor, started.elapsed(), simulate);
+    drop(monitor);
+    drop(node);
+    shm_cleanup::remove_all(&settings);
+    let leaked = shm_cleanup::shm_entries(&settings).len() as u64;
+    outcome?;
+    if args.json {
+        let summary = Summary {
+            shm_leaked: leaked,
+            ..summary
+        };
+        println!("{}", serde_json::to_string(&summary)?);
+    }
+    Ok(std::process::ExitCode::SUCCESS)
+}
+
+fn sim_args(cfg: &RinsConfig, config_args: &[String], link: &Path) -> Vec<String> {
+    let mut args = vec!["sim".to_string()];
+    args.extend(config_args.iter().cloned());
+    args.extend([
+        "--scenario".to_string(),
+        cfg.scenario_name().to_string(),
+        "--seed".to_string(),
+        cfg.sim.seed.to_string(),
+        "--link".to_string(),
+        link.to_string_lossy().into_owned(),
+    ]);
+    args
+}
+
+fn supervise(
+    cfg: &RinsConfig,
+    args: &UpArgs,
+    shutdown: &Shutdown,
+    supervisor: &mut Supervisor,
+    monitor: &mut Monitor,
+    started: Instant,
+) -> Result<()> {
+    let end = args.duration.map(|d| started + Duration::from_secs_f64(d));
+    let period = (cfg.watchdog.status_period_s > 0.0)
+        .then(|| Duration::from_secs_f64(cfg.watchdog.status_period_s));
+    let mut next_status = period.map(|p| Instant::now() + p);
+    let mut last_totals = monitor.totals;
+    let mut last_status_at = Instant::now();
+    let mut events = Vec::new();
+    while !shutdown.requested() && end.is_none_or(|e| Instant::now() < e) {
+        monitor.drain()?;
+        supervisor.poll(&mut events);
+        for event in events.drain(..) {
+            match event {
+                ChildEvent::Exited {
+                    name,
+                    status,
+                    restart_in,
+                } => {
+                    tracing::warn!(child = %name, %status, restart_in_ms = restart_in.as_millis() as u64, "child exited")
+                }
+                ChildEvent::Restarted { name, pid } => {
+                    tracing::info!(child = %name, pid, "child restarted")
+                }
+            }
+        }
+        if let (Some(due), Some(period)) = (next_status, period)
+            && Instant::now() >= due
+        {
+            let dt = last_status_at.elapsed().as_secs_f64();
+            let mut rates = [0.0; COUNTED.len()];
+            for (i, rate) in rates.iter_mut().enumerate() {
+                *rate = (monitor.totals[i] - last_totals[i]) as f64 / dt;
+            }
+            last_totals = monitor.totals;
+            last_status_at = Instant::now();
+            println!(
+                "{}",
+                status_line(
+                    started.elapsed().as_secs_f64(),
+                    &rates,
+                    monitor.nav_gaps.missing,
+                    &monitor.device_counters(),
+                    monitor.last_nav.as_ref(),
+                )
+            );
+            next_status = Some(due + period);
+        }
+        std::thread::sleep(LOOP_PERIOD);
+    }
+    Ok(())
+}
+
+fn summarise(
+    monitor: &Monitor,
+    supervisor: &Supervisor,
+    elapsed: Duration,
+    simulate: bool,
+) -> Summary {
+    let device = monitor.device_counters();
+    let acc = &monitor.accuracy;
+    let sim = |v: Option<f64>| if simulate { v } else { None };
+    Summary {
+        duration_s: elapsed.as_secs_f64(),
+        frames: monitor.totals[0],
+        baro_frames: monitor.totals[1],
+        mag_frames: monitor.totals[2],
+        dropped: monitor.nav_gaps.missing,
+        crc_errors: device.crc_errors,
+        lost_frames: device.lost_frames,
+        nav_samples: monitor.totals[5],
+        restarts: supervisor.restarts(),
+        att_err_deg_rms: sim(acc.attitude_deg.rms()),
+        att_err_deg_max: sim(acc.attitude_deg.max()),
+        alt_err_m_rms: sim(acc.altitude_m.rms()),
+        alt_err_m_max: sim(acc.altitude_m.max()),
+        shm_leaked: 0,
+    }
+}

@@ -1,0 +1,178 @@
+//! The product configuration: one TOML file with a section per process. Unknown keys are rejected,
+//! and every value is range-checked with an error that names the field and the value.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, anyhow};
+use rins_acquisition::config::AcquisitionConfig;
+use rins_altimeter::AltimeterConfig;
+use rins_fusion::FusionConfig;
+use rins_navigator::config::NavigatorConfig;
+use rins_sim::SimConfig;
+use rins_watchdog::config::WatchdogConfig;
+use serde::Deserialize;
+
+use crate::cli::ScenarioArg;
+
+/// The configuration used when no file is given (also shipped as `config/rins.toml`).
+pub const BUILT_IN: &str = include_str!("../config/rins.toml");
+
+/// What the sensor block's datasheet says about its converters.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DeviceConfig {
+    /// Gyro full scale: ±this many °/s over the 12-bit range.
+    pub gyro_full_scale_dps: f64,
+    /// Accelerometer full scale: ±this many g over the 12-bit range.
+    pub accel_full_scale_g: f64,
+}
+
+impl Default for DeviceConfig {
+    fn default() -> Self {
+        Self {
+            gyro_full_scale_dps: 300.0,
+            accel_full_scale_g: 8.0,
+        }
+    }
+}
+
+/// Counts per half range of the signed 12-bit converter.
+const ADC_HALF_RANGE: f64 = 2048.0;
+const STANDARD_GRAVITY: f64 = 9.80665;
+
+impl DeviceConfig {
+    pub fn validate(&self) -> Result<(), String> {
+        for (field, value, max) in [
+            (
+                "device.gyro_full_scale_dps",
+                self.gyro_full_scale_dps,
+                10_000.0,
+            ),
+            (
+                "device.accel_full_scale_g",
+                self.accel_full_scale_g,
+                1_000.0,
+            ),
+        ] {
+            if !(value.is_finite() && value > 0.0 && value <= max) {
+                return Err(format!("{field} = {value}: must be > 0 and <= {max}"));
+            }
+        }
+        Ok(())
+    }
+
+    pub fn gyro_lsb_rps(&self) -> f64 {
+        self.gyro_full_scale_dps.to_radians() / ADC_HALF_RANGE
+    }
+
+    pub fn accel_lsb_mps2(&self) -> f64 {
+        self.accel_full_scale_g * STANDARD_GRAVITY / ADC_HALF_RANGE
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct RinsConfig {
+    pub device: DeviceConfig,
+    pub sim: SimConfig,
+    pub acquisition: AcquisitionConfig,
+    pub fusion: FusionConfig,
+    pub altimeter: AltimeterConfig,
+    pub navigator: NavigatorConfig,
+    pub watchdog: WatchdogConfig,
+}
+
+impl RinsConfig {
+    pub fn parse(text: &str, origin: &str) -> Result<Self> {
+        let mut cfg: RinsConfig =
+            toml::from_str(text).map_err(|e| anyhow!("{origin}: {}", e.to_string().trim_end()))?;
+        cfg.validate().map_err(|e| anyhow!("{origin}: {e}"))?;
+        // The simulator emulates the configured device: same converters.
+        cfg.sim.sensors.gyro_full_scale_dps = cfg.device.gyro_full_scale_dps;
+        cfg.sim.sensors.accel_full_scale_g = cfg.device.accel_full_scale_g;
+        Ok(cfg)
+    }
+
+    pub fn validate(&self) -> Result<(), String> {
+        self.device.validate()?;
+        self.sim.validate().map_err(|e| e.to_string())?;
+        self.acquisition.validate()?;
+        self.fusion
+            .validate()
+            .map_err(|e| e.within("fusion").to_string())?;
+        self.altimeter
+            .validate()
+            .map_err(|e| e.within("altimeter").to_string())?;
+        self.navigator.validate().map_err(|e| e.to_string())?;
+        self.watchdog.validate()?;
+        Ok(())
+    }
+
+    pub fn scenario_name(&self) -> &'static str {
+        match self.sim.scenario {
+            rins_sim::Scenario::Static => "static",
+            rins_sim::Scenario::Uav => "uav",
+        }
+    }
+
+    pub fn set_scenario(&mut self, scenario: ScenarioArg) {
+        self.sim.scenario = match scenario {
+            ScenarioArg::Static => rins_sim::Scenario::Static,
+            ScenarioArg::Uav => rins_sim::Scenario::Uav,
+        };
+    }
+}
+
+/// Reads `path`, or the built-in configuration when none is given.
+pub fn load(path: Option<&Path>) -> Result<RinsConfig> {
+    match path {
+        None => RinsConfig::parse(BUILT_IN, "built-in configuration"),
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("cannot read configuration file {}", path.display()))?;
+            RinsConfig::parse(&text, &path.display().to_string())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn built_in_configuration_is_valid() {
+        let cfg = load(None).unwrap();
+        assert_eq!(cfg, RinsConfig::parse(BUILT_IN, "x").unwrap());
+    }
+
+    #[test]
+    fn unknown_keys_are_rejected_by_name() {
+        let err = RinsConfig::parse("[fusion]\nspeed = 3\n", "test.toml").unwrap_err();
+        let msg = format!("{err:#}");
+        assert!(msg.contains("test.toml") && msg.contains("speed"), "{msg}");
+    }
+
+    #[test]
+    fn bad_values_name_field_and_value() {
+        let err = RinsConfig::parse("[device]\ngyro_full_scale_dps = -5\n", "t").unwrap_err();
+        assert!(
+            format!("{err}").contains("device.gyro_full_scale_dps = -5"),
+            "{err}"
+        );
+        let err = RinsConfig::parse(
+            "[fusion.geometry.gyro]\nkind = \"pyramid\"\nn = 4\nalpha_deg = 95\nbeta0_deg = 45\n",
+            "t",
+        )
+        .unwrap_err();
+        assert!(
+            format!("{err}").contains("fusion.geometry.gyro.alpha_deg = 95"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn wrong_types_are_reported_with_the_key() {
+        let err = RinsConfig::parse("[acquisition]\nbaud = \"fast\"\n", "t").unwrap_err();
+        assert!(format!("{err}").contains("baud"), "{err}");
+    }
+}
