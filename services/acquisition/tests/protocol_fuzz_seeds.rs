@@ -1,6 +1,7 @@
-//! Writes the seed corpus of the `decoder` fuzz target (fuzz/corpus/decoder) from real encoded
-//! frames. Run on purpose only:
-//! `cargo test -p rins-acquisition --test protocol_fuzz_seeds -- --ignored`.
+//! The seed corpus of the `decoder` fuzz target (fuzz/corpus/decoder) is made of real encoded
+//! frames. These tests check that the committed seeds are what the current encoder produces; after a
+//! protocol change, regenerate them with
+//! `RINS_WRITE_FUZZ_SEEDS=1 cargo test -p rins-acquisition --test protocol_fuzz_seeds`.
 
 mod common;
 
@@ -95,11 +96,19 @@ fn seeds_decode_to_the_frames_they_were_made_from() {
 }
 
 #[test]
-#[ignore = "writes fuzz/corpus/decoder"]
-fn write_fuzz_seeds() {
+fn committed_seeds_match_the_encoder() {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/corpus/decoder");
-    std::fs::create_dir_all(&dir).unwrap();
+    let write = std::env::var_os("RINS_WRITE_FUZZ_SEEDS").is_some();
+    if write {
+        std::fs::create_dir_all(&dir).unwrap();
+    }
     for (name, seed, _) in seeds() {
-        std::fs::write(dir.join(name), seed).unwrap();
+        let path = dir.join(name);
+        if write {
+            std::fs::write(&path, &seed).unwrap();
+        }
+        let committed = std::fs::read(&path)
+            .unwrap_or_else(|e| panic!("{}: {e}; regenerate the seeds", path.display()));
+        assert_eq!(committed, seed, "{name} is stale; regenerate the seeds");
     }
 }

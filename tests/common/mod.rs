@@ -1,0 +1,77 @@
+//! Helpers for end-to-end tests: each test runs `rins` as real processes on its own iceoryx2 prefix
+//! and root, and checks that nothing is left in /dev/shm afterwards.
+
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicU32, Ordering};
+
+pub const RINS: &str = env!("CARGO_BIN_EXE_rins");
+
+/// A private IPC namespace for one test.
+pub struct Isolated {
+    pub prefix: String,
+    pub root: PathBuf,
+}
+
+impl Isolated {
+    pub fn new(test: &str) -> Self {
+        static NEXT: AtomicU32 = AtomicU32::new(0);
+        let n = NEXT.fetch_add(1, Ordering::Relaxed);
+        let prefix = format!("rt{}_{}_{test}_", std::process::id(), n);
+        let root = std::env::temp_dir().join(format!("{prefix}root"));
+        Self { prefix, root }
+    }
+
+    pub fn command(&self) -> Command {
+        let mut cmd = Command::new(RINS);
+        cmd.env("RINS_IPC_PREFIX", &self.prefix)
+            .env("RINS_IPC_ROOT", &self.root)
+            .env("RINS_LOG", "warn");
+        cmd
+    }
+
+    pub fn run(&self, args: &[&str]) -> Output {
+        self.command().args(args).output().expect("cannot run rins")
+    }
+
+    /// Shared-memory entries of this namespace still present.
+    pub fn shm_entries(&self) -> Vec<String> {
+        std::fs::read_dir("/dev/shm")
+            .map(|d| {
+                d.filter_map(|e| e.ok())
+                    .map(|e| e.file_name().to_string_lossy().into_owned())
+                    .filter(|n| n.starts_with(&self.prefix))
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
+}
+
+impl Drop for Isolated {
+    fn drop(&mut self) {
+        for name in self.shm_entries() {
+            let _ = std::fs::remove_file(PathBuf::from("/dev/shm").join(name));
+        }
+        let _ = std::fs::remove_dir_all(&self.root);
+    }
+}
+
+/// The JSON object on the last line of stdout.
+pub fn last_json(output: &Output) -> serde_json::Value {
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let last = stdout.lines().last().unwrap_or_default();
+    serde_json::from_str(last).unwrap_or_else(|e| {
+        panic!(
+            "last line is not JSON ({e}): {last:?}\nstderr:\n{}",
+            String::from_utf8_lossy(&output.stderr)
+        )
+    })
+}
+
+pub fn num(v: &serde_json::Value, key: &str) -> f64 {
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("summary has no number {key:?}: {v}"))
+}

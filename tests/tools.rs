@@ -1,0 +1,80 @@
+//! `rins echo` and `rins latency` against a running pipeline.
+
+mod common;
+
+use std::process::Stdio;
+
+use common::{Isolated, last_json};
+
+#[test]
+fn echo_and_latency_read_a_running_pipeline() {
+    let ipc = Isolated::new("tools");
+    let mut up = ipc
+        .command()
+        .args(["up", "--scenario", "static", "--duration", "8", "--json"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("cannot start rins up");
+
+    // Blocks until the pipeline publishes: the navigator's first samples.
+    let echo = ipc.run(&["echo", "nav", "--count", "5", "--csv"]);
+    assert!(
+        echo.status.success(),
+        "{}",
+        String::from_utf8_lossy(&echo.stderr)
+    );
+    let text = String::from_utf8_lossy(&echo.stdout);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 6, "header + 5 rows:\n{text}");
+    let header: Vec<&str> = lines[0].split(',').collect();
+    assert!(
+        header.contains(&"quaternion.0") && header.contains(&"header.origin_seq"),
+        "{}",
+        lines[0]
+    );
+    // Consecutive navigation samples carry consecutive origin sequence numbers.
+    let seq_col = header
+        .iter()
+        .position(|h| *h == "header.origin_seq")
+        .unwrap();
+    let seqs: Vec<u64> = lines[1..]
+        .iter()
+        .map(|l| l.split(',').nth(seq_col).unwrap().parse().unwrap())
+        .collect();
+    for pair in seqs.windows(2) {
+        assert_eq!(pair[1], pair[0] + 1, "{seqs:?}");
+    }
+
+    let latency = ipc.run(&["latency", "--seconds", "2", "--json"]);
+    assert!(
+        latency.status.success(),
+        "{}",
+        String::from_utf8_lossy(&latency.stderr)
+    );
+    let hops = last_json(&latency);
+    let hops = hops
+        .as_array()
+        .expect("latency --json prints an array of hops");
+    let end_to_end = hops
+        .iter()
+        .find(|h| h["hop"] == "serial rx -> nav state published")
+        .expect("end-to-end hop");
+    // 2 s at 1 kHz.
+    assert!(
+        end_to_end["samples"].as_f64().unwrap() > 1_500.0,
+        "{end_to_end}"
+    );
+    let (p50, p99, max) = (
+        end_to_end["p50_us"].as_f64().unwrap(),
+        end_to_end["p99_us"].as_f64().unwrap(),
+        end_to_end["max_us"].as_f64().unwrap(),
+    );
+    assert!(p50 > 0.0 && p50 <= p99 && p99 <= max, "{end_to_end}");
+
+    let out = up.wait_with_output().expect("rins up did not finish");
+    assert!(out.status.success());
+    let summary = last_json(&out);
+    assert_eq!(summary["dropped"], 0, "{summary}");
+    assert_eq!(ipc.shm_entries(), Vec::<String>::new());
+}
