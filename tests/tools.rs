@@ -9,7 +9,7 @@ use common::{Isolated, last_json};
 #[test]
 fn echo_and_latency_read_a_running_pipeline() {
     let ipc = Isolated::new("tools");
-    let mut up = ipc
+    let up = ipc
         .command()
         .args(["up", "--scenario", "static", "--duration", "8", "--json"])
         .stdout(Stdio::piped())

@@ -11,12 +11,13 @@ pub const LAPSE_K_PER_M: f64 = 0.0065;
 pub const G0_MPS2: f64 = 9.80665;
 /// Molar mass of dry air, kg/mol.
 pub const MOLAR_MASS_KG_PER_MOL: f64 = 0.0289644;
-/// Universal gas constant, J/(mol·K).
-pub const GAS_CONSTANT: f64 = 8.31446;
+/// Universal gas constant as defined by the U.S. Standard Atmosphere 1976, J/(mol·K): with it the
+/// pressure law reproduces the standard-atmosphere tables that barometric altimeters are built to.
+pub const GAS_CONSTANT: f64 = 8.31432;
 /// Standard sea-level pressure, Pa.
 pub const P0_STANDARD_PA: f64 = 101_325.0;
 
-/// Exponent R·L/(g·M) ≈ 0.190266 (often quoted as 0.190263, from the older R = 8.31432).
+/// Exponent R·L/(g·M) ≈ 0.190263.
 pub const EXPONENT: f64 = GAS_CONSTANT * LAPSE_K_PER_M / (G0_MPS2 * MOLAR_MASS_KG_PER_MOL);
 
 /// Height scale T0/L ≈ 44 330.8 m: the altitude at which the ISA pressure would reach zero.
@@ -34,6 +35,11 @@ pub fn pressure_to_altitude(p_pa: f64, qnh_pa: f64) -> f64 {
 /// Static pressure in Pa at altitude `h_m` above the QNH reference; 0 at or above T0/L.
 pub fn altitude_to_pressure(h_m: f64, qnh_pa: f64) -> f64 {
     qnh_pa * (1.0 - h_m / HEIGHT_SCALE_M).max(0.0).powf(1.0 / EXPONENT)
+}
+
+/// ISA temperature at altitude `h_m`, K.
+pub fn temperature_k(h_m: f64) -> f64 {
+    T0_K - LAPSE_K_PER_M * h_m
 }
 
 /// dh/dp at `p_pa` in m/Pa (negative: height falls as pressure rises). Converts a pressure noise

@@ -7,17 +7,7 @@ use crate::baro_blend::BaroBlendConfig;
 use crate::earth::normal_gravity;
 use crate::mechanisation::StrapdownConfig;
 
-/// A configuration value outside its accepted range.
-#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-#[error("navigator config: {field} = {value}: {reason}")]
-pub struct ConfigError {
-    /// Name of the field as written in the configuration.
-    pub field: &'static str,
-    /// The rejected value.
-    pub value: f64,
-    /// The accepted range.
-    pub reason: &'static str,
-}
+pub use rins_runtime::config_error::ConfigError;
 
 /// Navigator settings. Degrees only here, at the edge; everything inside is radians.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -87,11 +77,7 @@ fn check(
     if value.is_finite() && ok(value) {
         Ok(())
     } else {
-        Err(ConfigError {
-            field,
-            value,
-            reason,
-        })
+        Err(ConfigError::new(field, value, reason).within("navigator"))
     }
 }
 

@@ -2,6 +2,7 @@
 //! the monotonic clock, termination signals, heartbeats and log set-up.
 
 pub mod clock;
+pub mod config_error;
 pub mod heartbeat;
 pub mod ipc;
 pub mod logging;
