@@ -55,9 +55,34 @@ impl IpcSettings {
 
 pub type IpcNode = Node<ipc::Service>;
 
+/// Makes this deployment's settings iceoryx2's process-wide configuration too. A few internal paths
+/// (cleaning up after a dead peer whose records are gone) fall back to the global configuration;
+/// without this they would look under the default root and prefix.
+fn install_global_config(settings: &IpcSettings, config: &Config) -> Result<()> {
+    let dir = std::path::Path::new(&settings.root);
+    std::fs::create_dir_all(dir).map_err(|e| anyhow!("cannot create {}: {e}", settings.root))?;
+    let text =
+        toml::to_string(config).map_err(|e| anyhow!("cannot encode iceoryx2 config: {e}"))?;
+    let file = dir.join(format!("{}iceoryx2.toml", settings.prefix));
+    // Write then rename: every process of the deployment does this, and none may read a half file.
+    let tmp = dir.join(format!(
+        "{}iceoryx2.toml.{}",
+        settings.prefix,
+        std::process::id()
+    ));
+    std::fs::write(&tmp, text).map_err(|e| anyhow!("cannot write {}: {e}", tmp.display()))?;
+    std::fs::rename(&tmp, &file).map_err(|e| anyhow!("cannot write {}: {e}", file.display()))?;
+    let path = FilePath::new(file.to_string_lossy().as_bytes())
+        .map_err(|e| anyhow!("{}: not a valid path ({e:?})", file.display()))?;
+    Config::setup_global_config_from_file(&path)
+        .map_err(|e| anyhow!("cannot load {}: {e:?}", file.display()))?;
+    Ok(())
+}
+
 /// Creates this process's node. Signal handling is left to [`crate::shutdown::Shutdown`].
 pub fn create_node(name: &str, settings: &IpcSettings) -> Result<IpcNode> {
     let config = settings.iceoryx_config()?;
+    install_global_config(settings, &config)?;
     let node_name = NodeName::new(name).map_err(|e| anyhow!("node name {name:?}: {e:?}"))?;
     NodeBuilder::new()
         .name(&node_name)
