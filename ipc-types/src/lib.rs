@@ -11,7 +11,7 @@ use serde::Serialize;
 pub mod names;
 
 /// Version of every payload layout in this crate. Bump it on any layout change.
-pub const PAYLOAD_VERSION: u16 = 1;
+pub const PAYLOAD_VERSION: u16 = 2;
 
 /// Up to this many single-axis channels per sensor type (gyro, accelerometer).
 pub const MAX_CHANNELS: usize = 16;
@@ -180,6 +180,65 @@ impl ChannelState {
     }
 }
 
+/// Why a channel is suspect or excluded ([`FusedImu::gyro_reason`], [`FusedImu::accel_reason`]).
+#[repr(u8)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FaultReason {
+    #[default]
+    None = 0,
+    /// The device flagged the channel invalid, or its samples stopped arriving.
+    Missing = 1,
+    /// The device reported an error for the channel's module.
+    DeviceError = 2,
+    /// The channel sits at the end of the converter range.
+    Saturated = 3,
+    /// The channel's value froze while the others varied.
+    Stuck = 4,
+    /// The channel's noise is far above its peers'.
+    Noisy = 5,
+    /// Isolated by the parity test (generalised likelihood test).
+    Parity = 6,
+    /// Isolated against the gravity / zero-rate reference while stationary.
+    StationaryReference = 7,
+    /// The module's temperature is outside the calibrated range.
+    Temperature = 8,
+}
+
+impl FaultReason {
+    pub const ALL: [FaultReason; 9] = [
+        FaultReason::None,
+        FaultReason::Missing,
+        FaultReason::DeviceError,
+        FaultReason::Saturated,
+        FaultReason::Stuck,
+        FaultReason::Noisy,
+        FaultReason::Parity,
+        FaultReason::StationaryReference,
+        FaultReason::Temperature,
+    ];
+
+    pub fn from_u8(v: u8) -> Self {
+        Self::ALL
+            .get(v as usize)
+            .copied()
+            .unwrap_or(FaultReason::None)
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            FaultReason::None => "none",
+            FaultReason::Missing => "missing",
+            FaultReason::DeviceError => "device-error",
+            FaultReason::Saturated => "saturated",
+            FaultReason::Stuck => "stuck",
+            FaultReason::Noisy => "noisy",
+            FaultReason::Parity => "parity",
+            FaultReason::StationaryReference => "stationary-reference",
+            FaultReason::Temperature => "temperature",
+        }
+    }
+}
+
 /// Body rate and specific force fused from the redundant channels.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, ZeroCopySend)]
@@ -201,6 +260,9 @@ pub struct FusedImu {
     /// Per-channel state, [`ChannelState`] as u8.
     pub gyro_state: [u8; MAX_CHANNELS],
     pub accel_state: [u8; MAX_CHANNELS],
+    /// Per-channel [`FaultReason`] as u8 (`None` for channels that are Ok).
+    pub gyro_reason: [u8; MAX_CHANNELS],
+    pub accel_reason: [u8; MAX_CHANNELS],
     /// Parity test statistic per sensor type (0 when no parity space).
     pub gyro_test_statistic: f32,
     pub accel_test_statistic: f32,
@@ -229,6 +291,8 @@ impl Default for FusedImu {
             specific_force_var: [0.0; 3],
             gyro_state: [ChannelState::Absent as u8; MAX_CHANNELS],
             accel_state: [ChannelState::Absent as u8; MAX_CHANNELS],
+            gyro_reason: [0; MAX_CHANNELS],
+            accel_reason: [0; MAX_CHANNELS],
             gyro_test_statistic: 0.0,
             accel_test_statistic: 0.0,
         }
@@ -362,6 +426,115 @@ impl Default for Truth {
             altitude_m: 0.0,
         }
     }
+}
+
+/// Which redundant sensor type a command addresses.
+#[repr(u8)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SensorType {
+    Gyro = 0,
+    Accel = 1,
+}
+
+impl SensorType {
+    pub fn from_u8(v: u8) -> Option<Self> {
+        match v {
+            0 => Some(SensorType::Gyro),
+            1 => Some(SensorType::Accel),
+            _ => None,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SensorType::Gyro => "gyro",
+            SensorType::Accel => "accel",
+        }
+    }
+}
+
+/// Fault the simulator applies to one channel ([`SimControl::fault`]).
+#[repr(u8)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SimFault {
+    /// Remove any fault from the channel.
+    Clear = 0,
+    /// The channel stops: flagged invalid.
+    Dead = 1,
+    /// The channel repeats its last value.
+    Stuck = 2,
+    /// A bias step of `param` (SI units: rad/s or m/s²).
+    BiasStep = 3,
+    /// A bias ramp of `param` per second.
+    Ramp = 4,
+    /// White noise multiplied by `param`.
+    Noise = 5,
+    /// The channel reads full scale.
+    Saturate = 6,
+    /// The channel drops out for the first half of every `param` seconds.
+    Intermittent = 7,
+}
+
+impl SimFault {
+    pub const ALL: [SimFault; 8] = [
+        SimFault::Clear,
+        SimFault::Dead,
+        SimFault::Stuck,
+        SimFault::BiasStep,
+        SimFault::Ramp,
+        SimFault::Noise,
+        SimFault::Saturate,
+        SimFault::Intermittent,
+    ];
+
+    pub fn from_u8(v: u8) -> Option<Self> {
+        Self::ALL.get(v as usize).copied()
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SimFault::Clear => "clear",
+            SimFault::Dead => "dead",
+            SimFault::Stuck => "stuck",
+            SimFault::BiasStep => "bias",
+            SimFault::Ramp => "ramp",
+            SimFault::Noise => "noise",
+            SimFault::Saturate => "saturate",
+            SimFault::Intermittent => "intermittent",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|f| f.name() == name)
+    }
+}
+
+/// Command to the simulator: apply a fault to one channel ("killing a sensor").
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::SimControl")]
+pub struct SimControl {
+    pub version: u16,
+    /// [`SensorType`] as u8.
+    pub sensor: u8,
+    pub channel: u8,
+    /// [`SimFault`] as u8.
+    pub fault: u8,
+    pub _pad: [u8; 3],
+    /// Fault parameter, see [`SimFault`].
+    pub param: f64,
+}
+
+/// Command to fusion: return an excluded channel to service (exclusions latch otherwise).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::FusionControl")]
+pub struct FusionControl {
+    pub version: u16,
+    /// [`SensorType`] as u8.
+    pub sensor: u8,
+    pub channel: u8,
+    pub _pad: [u8; 4],
 }
 
 /// Which process a [`Health`] message speaks for.

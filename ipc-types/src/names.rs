@@ -9,6 +9,10 @@ pub const ALTITUDE: &str = "rins/altitude";
 pub const NAV_STATE: &str = "rins/nav/state";
 pub const TRUTH: &str = "rins/sim/truth";
 pub const HEALTH: &str = "rins/health";
+/// Commands to the simulator (fault injection).
+pub const SIM_CONTROL: &str = "rins/control/sim";
+/// Commands to fusion (re-admission of excluded channels).
+pub const FUSION_CONTROL: &str = "rins/control/fusion";
 
 /// Every published topic, with the short name `rins echo` accepts.
 pub const TOPICS: [(&str, &str); 9] = [

@@ -53,6 +53,8 @@ pub fn fused_message(raw: &RawImu, fused: &Fused, n_gyro: usize, n_accel: usize)
         specific_force_var: fused.specific_force_var,
         gyro_state: channel_states(n_gyro, fused.gyro_mask),
         accel_state: channel_states(n_accel, fused.accel_mask),
+        gyro_reason: [0; ipc_types::MAX_CHANNELS],
+        accel_reason: [0; ipc_types::MAX_CHANNELS],
         gyro_test_statistic: 0.0,
         accel_test_statistic: 0.0,
     }
