@@ -36,9 +36,8 @@ impl Default for DeviceConfig {
     }
 }
 
-/// Counts per half range of the signed 12-bit converter.
-const ADC_HALF_RANGE: f64 = 2048.0;
-const STANDARD_GRAVITY: f64 = 9.80665;
+use rins_acquisition::protocol::layout::COUNTS_PER_FULL_SCALE;
+use rins_sim::GRAVITY_MPS2;
 
 impl DeviceConfig {
     pub fn validate(&self) -> Result<(), String> {
@@ -62,11 +61,11 @@ impl DeviceConfig {
     }
 
     pub fn gyro_lsb_rps(&self) -> f64 {
-        self.gyro_full_scale_dps.to_radians() / ADC_HALF_RANGE
+        self.gyro_full_scale_dps.to_radians() / COUNTS_PER_FULL_SCALE
     }
 
     pub fn accel_lsb_mps2(&self) -> f64 {
-        self.accel_full_scale_g * STANDARD_GRAVITY / ADC_HALF_RANGE
+        self.accel_full_scale_g * GRAVITY_MPS2 / COUNTS_PER_FULL_SCALE
     }
 }
 
@@ -87,7 +86,7 @@ impl RinsConfig {
         let mut cfg: RinsConfig =
             toml::from_str(text).map_err(|e| anyhow!("{origin}: {}", e.to_string().trim_end()))?;
         cfg.validate().map_err(|e| anyhow!("{origin}: {e}"))?;
-        // The simulator emulates the configured device: same converters.
+        // The simulated block has the configured device's converters.
         cfg.sim.sensors.gyro_full_scale_dps = cfg.device.gyro_full_scale_dps;
         cfg.sim.sensors.accel_full_scale_g = cfg.device.accel_full_scale_g;
         Ok(cfg)

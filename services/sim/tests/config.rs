@@ -23,6 +23,12 @@ fn defaults_are_the_documented_mems_block() {
 }
 
 #[test]
+fn converter_range_is_the_device_s_not_a_simulator_key() {
+    let err = toml::from_str::<SimConfig>("[sensors]\ngyro_full_scale_dps = 500.0\n").unwrap_err();
+    assert!(err.to_string().contains("gyro_full_scale_dps"), "{err}");
+}
+
+#[test]
 fn toml_section_parses_with_defaults_for_missing_fields() {
     let text = r#"
         scenario = "uav"
@@ -31,7 +37,6 @@ fn toml_section_parses_with_defaults_for_missing_fields() {
         [earth_field]
         declination_deg = -1.5
         [sensors]
-        gyro_full_scale_dps = 500.0
         mag_soft_iron = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.1]]
     "#;
     let c: SimConfig = toml::from_str(text).unwrap();
@@ -41,7 +46,7 @@ fn toml_section_parses_with_defaults_for_missing_fields() {
     assert_eq!(c.baro_rate_hz, 50.0);
     assert_eq!(c.earth_field.declination_deg, -1.5);
     assert_eq!(c.earth_field.intensity_ut, 50.0);
-    assert_eq!(c.sensors.gyro_full_scale_dps, 500.0);
+    assert_eq!(c.sensors.gyro_full_scale_dps, 300.0);
     assert_eq!(c.sensors.mag_soft_iron[2][2], 1.1);
     assert_eq!(
         c.sensors.accel_full_scale_g,

@@ -46,6 +46,8 @@ pub const AUX_PAYLOAD_LEN: usize = 2;
 /// Gyro and accelerometer channels are signed 12-bit ADC counts.
 pub const COUNT_MIN: i16 = -2048;
 pub const COUNT_MAX: i16 = 2047;
+/// Counts per converter full scale: full scale maps to ±2048 counts, so one count is full scale / 2048.
+pub const COUNTS_PER_FULL_SCALE: f64 = 2048.0;
 
 /// CRC-32C (Castagnoli), computed over the type byte through the end of the payload. A `const`
 /// so that the lookup table is built at compile time.

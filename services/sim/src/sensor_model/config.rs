@@ -5,12 +5,10 @@ use serde::Deserialize;
 use crate::GRAVITY_MPS2;
 use crate::error::{SimError, check_positive, check_range};
 
-/// Largest positive ADC count (12-bit signed).
-pub const ADC_MAX: i16 = 2047;
-/// Most negative ADC count (12-bit signed).
-pub const ADC_MIN: i16 = -2048;
-/// Counts per full scale (full scale maps to ±2048 counts).
-pub const ADC_HALF_RANGE: f64 = 2048.0;
+/// The converter is the protocol's: signed 12-bit counts.
+pub use rins_acquisition::protocol::layout::{
+    COUNTS_PER_FULL_SCALE as ADC_HALF_RANGE, COUNT_MAX as ADC_MAX, COUNT_MIN as ADC_MIN,
+};
 /// Module temperature sensors the frame can carry.
 pub const MAX_TEMPERATURE_SENSORS: u8 = ipc_types::MAX_TEMPERATURES as u8;
 
@@ -19,7 +17,9 @@ pub const MAX_TEMPERATURE_SENSORS: u8 = ipc_types::MAX_TEMPERATURES as u8;
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SensorModelConfig {
-    /// Gyro full scale: ±this maps to ±2048 counts, °/s.
+    /// Gyro full scale: ±this maps to ±2048 counts, °/s. Not a key of `[sim.sensors]`: the simulated
+    /// block has the converters of `[device]`, set by whoever builds the simulator.
+    #[serde(skip)]
     pub gyro_full_scale_dps: f64,
     /// Gyro white-noise density (angle random walk), °/s/√Hz.
     pub gyro_noise_density_dps_rthz: f64,
@@ -34,7 +34,9 @@ pub struct SensorModelConfig {
     /// σ of the per-channel bias temperature coefficient, °/s per °C.
     pub gyro_bias_temp_coeff_sigma_dps_per_c: f64,
 
-    /// Accelerometer full scale: ±this maps to ±2048 counts, g (9.80665 m/s²).
+    /// Accelerometer full scale: ±this maps to ±2048 counts, g (9.80665 m/s²). Set from `[device]`,
+    /// like `gyro_full_scale_dps`.
+    #[serde(skip)]
     pub accel_full_scale_g: f64,
     /// Accelerometer white-noise density (velocity random walk), µg/√Hz.
     pub accel_noise_density_ug_rthz: f64,
