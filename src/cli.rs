@@ -41,6 +41,13 @@ pub enum Command {
         #[arg(long)]
         csv: bool,
     },
+    /// Inject a fault into one channel of the running simulator ("kill a sensor").
+    Inject(InjectArgs),
+    /// Return a channel that fusion excluded to service (exclusions latch until then).
+    Readmit {
+        /// Channel: gyro or accel followed by its 0-based index, e.g. gyro2, accel0.
+        channel: String,
+    },
     /// Measure latency from serial receive through every stage to the navigation state.
     Latency {
         #[arg(long, default_value_t = 5.0)]
@@ -48,6 +55,65 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// What the configured gyro and accelerometer geometries can do: noise per axis, parity, FDI.
+    Geometry {
+        #[arg(long)]
+        config: Option<PathBuf>,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Offline evaluation on recorded data, in-process (no IPC).
+    Eval {
+        #[command(subcommand)]
+        what: EvalCommand,
+    },
+    /// Monte Carlo comparison of the redundant block with an orthogonal triad, with a gyro kill.
+    Mc(McArgs),
+}
+
+#[derive(Debug, Subcommand)]
+pub enum EvalCommand {
+    /// Fault detection and isolation on the four-IMU quadrotor recordings: false alarms without
+    /// faults, then detection and isolation of faults injected into the real data.
+    Fdi(EvalFdiArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct EvalFdiArgs {
+    /// Data set directory (holding `<group>/path_<N>/IMU_k.csv`).
+    pub dir: PathBuf,
+    /// One JSON object on stdout instead of tables.
+    #[arg(long)]
+    pub json: bool,
+    /// Configuration file (its `[fusion.fdi]` settings are used; geometry and noise are the
+    /// evaluation's).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Only trials whose name contains this text, e.g. `Horizontal/path_1`. Repeatable.
+    #[arg(long = "trial", value_name = "NAME")]
+    pub trials: Vec<String>,
+}
+
+#[derive(Debug, Args)]
+pub struct McArgs {
+    /// Number of runs (default: the comparison's default).
+    #[arg(long)]
+    pub runs: Option<usize>,
+    /// Flight time simulated, s (default: the whole UAV profile).
+    #[arg(long)]
+    pub duration: Option<f64>,
+    /// Time of the gyro kill, s (default 300 s, or half the flight when --duration is shorter).
+    #[arg(long)]
+    pub kill_at: Option<f64>,
+    /// Worker threads.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// One JSON object on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// Configuration file (its sim, navigator and altimeter settings are used).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -83,6 +149,38 @@ pub struct UpArgs {
     /// Simulator random seed (overrides sim.seed).
     #[arg(long)]
     pub seed: Option<u64>,
+    #[command(flatten)]
+    pub faults: FaultArgs,
+}
+
+/// Faults the simulator applies at given device times.
+#[derive(Debug, Args, Default)]
+pub struct FaultArgs {
+    /// Apply a fault at a device time (s since the simulator started): CHANNEL:KIND[=PARAM]@TIME,
+    /// e.g. gyro2:dead@5s, accel1:bias=0.5@3.2s, gyro0:noise=10@2s. Repeatable.
+    #[arg(long = "inject", value_name = "SPEC")]
+    pub inject: Vec<String>,
+    /// Scenario file of timed faults: [[fault]] tables with channel, kind, at_s and optional param.
+    #[arg(long, value_name = "FILE")]
+    pub faults: Option<PathBuf>,
+}
+
+impl FaultArgs {
+    pub fn is_empty(&self) -> bool {
+        self.inject.is_empty() && self.faults.is_none()
+    }
+}
+
+#[derive(Debug, Args)]
+pub struct InjectArgs {
+    /// Channel: gyro or accel followed by its 0-based index, e.g. gyro2, accel0.
+    pub channel: String,
+    /// dead | stuck | bias | ramp | noise | saturate | intermittent | clear.
+    pub fault: String,
+    /// bias: STEP (rad/s, m/s²); ramp: RATE (per s); noise: FACTOR (>= 1, times the configured
+    /// white noise); intermittent: PERIOD_S (default 0.2, dead for the first half).
+    #[arg(allow_negative_numbers = true)]
+    pub arg: Option<String>,
 }
 
 #[derive(Debug, Args)]
@@ -99,4 +197,6 @@ pub struct SimArgs {
     /// Stop after this many seconds.
     #[arg(long)]
     pub duration: Option<f64>,
+    #[command(flatten)]
+    pub faults: FaultArgs,
 }

@@ -78,3 +78,32 @@ fn echo_and_latency_read_a_running_pipeline() {
     assert_eq!(summary["dropped"], 0, "{summary}");
     assert_eq!(ipc.shm_entries(), Vec::<String>::new());
 }
+
+#[test]
+fn geometry_reports_the_seed_pyramid_and_its_z_axis_penalty() {
+    let ipc = Isolated::new("geometry");
+    let out = ipc.run(&["geometry", "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let reports = last_json(&out);
+    let gyro = &reports[0];
+    assert_eq!(gyro["sensor"], "gyro");
+    let c = &gyro["capability"];
+    // DESIGN §4.1: at α = 28.7° the x/y variance is 1/(2cos²α) = 0.65σ², z is 1/(4sin²α) = 1.084σ².
+    let v = |i: usize| c["variance_factors"][i].as_f64().unwrap();
+    assert!(
+        (v(0) - 0.650).abs() < 1e-3 && (v(2) - 1.084).abs() < 1e-3,
+        "{c}"
+    );
+    assert_eq!(c["parity_dimension"], 1);
+    assert_eq!(
+        (c["detect"].as_bool(), c["isolate_one"].as_bool()),
+        (Some(true), Some(false))
+    );
+    // At the optimal 35.26° every axis is 3/N = 0.75.
+    let opt = &gyro["optimal_pyramid"]["capability"]["variance_factors"];
+    assert!((opt[2].as_f64().unwrap() - 0.75).abs() < 1e-9, "{opt}");
+}

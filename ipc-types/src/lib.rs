@@ -275,6 +275,9 @@ pub mod fused_flags {
     /// Fewer than three usable channels of a type: the solution is not valid.
     pub const GYRO_INSUFFICIENT: u32 = 1 << 2;
     pub const ACCEL_INSUFFICIENT: u32 = 1 << 3;
+    /// Fusion is still measuring the per-channel gyro biases at rest: the rate is not yet
+    /// bias-corrected, so a navigator must not start its own static alignment on it.
+    pub const GYRO_REST_BIAS_PENDING: u32 = 1 << 4;
 }
 
 impl Default for FusedImu {
@@ -522,6 +525,64 @@ pub struct SimControl {
     pub fault: u8,
     pub _pad: [u8; 3],
     /// Fault parameter, see [`SimFault`].
+    pub param: f64,
+}
+
+/// What the simulator did with one [`SimControl`] command ([`FaultApplied::outcome`]).
+#[repr(u8)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FaultOutcome {
+    /// The fault (or its clearing) took effect at [`FaultApplied::device_time_us`].
+    Applied = 0,
+    /// The command named a sensor type or fault kind the simulator does not know.
+    UnknownCommand = 1,
+    /// The sensor block has no such channel.
+    NoSuchChannel = 2,
+    /// The fault parameter is out of range (e.g. a noise factor below 1).
+    InvalidParameter = 3,
+}
+
+impl FaultOutcome {
+    pub const ALL: [FaultOutcome; 4] = [
+        FaultOutcome::Applied,
+        FaultOutcome::UnknownCommand,
+        FaultOutcome::NoSuchChannel,
+        FaultOutcome::InvalidParameter,
+    ];
+
+    pub fn from_u8(v: u8) -> Option<Self> {
+        Self::ALL.get(v as usize).copied()
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            FaultOutcome::Applied => "applied",
+            FaultOutcome::UnknownCommand => "unknown-command",
+            FaultOutcome::NoSuchChannel => "no-such-channel",
+            FaultOutcome::InvalidParameter => "invalid-parameter",
+        }
+    }
+}
+
+/// Published by the simulator for every fault command it handled (scheduled or received on
+/// [`names::SIM_CONTROL`]), so that detection and isolation delays can be measured in device time.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::FaultApplied")]
+pub struct FaultApplied {
+    pub version: u16,
+    /// [`SensorType`] as u8, as given in the command.
+    pub sensor: u8,
+    pub channel: u8,
+    /// [`SimFault`] as u8, as given in the command.
+    pub fault: u8,
+    /// [`FaultOutcome`] as u8.
+    pub outcome: u8,
+    pub _pad: [u8; 2],
+    /// Device time of the first IMU sample the fault affects, µs since the simulator started (the
+    /// time base of [`Header::origin_device_time_us`]).
+    pub device_time_us: u64,
+    /// The command's parameter, see [`SimFault`].
     pub param: f64,
 }
 

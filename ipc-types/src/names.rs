@@ -11,6 +11,9 @@ pub const TRUTH: &str = "rins/sim/truth";
 pub const HEALTH: &str = "rins/health";
 /// Commands to the simulator (fault injection).
 pub const SIM_CONTROL: &str = "rins/control/sim";
+/// Fault commands the simulator handled, with the device time they took effect
+/// ([`crate::FaultApplied`]).
+pub const SIM_FAULT_APPLIED: &str = "rins/sim/fault";
 /// Commands to fusion (re-admission of excluded channels).
 pub const FUSION_CONTROL: &str = "rins/control/fusion";
 

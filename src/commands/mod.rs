@@ -1,7 +1,14 @@
 //! One module per subcommand.
 
+mod control;
 mod echo;
+mod eval;
+mod fault_args;
+mod geometry;
+mod inject;
 mod latency;
+mod mc;
+mod readmit;
 mod service;
 mod sim;
 mod up;
@@ -10,7 +17,7 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 
-use crate::cli::{Cli, Command};
+use crate::cli::{Cli, Command, EvalCommand};
 
 pub fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
@@ -28,8 +35,17 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Echo { topic, count, csv } => {
             echo::run(&topic, count, csv).map(|()| ExitCode::SUCCESS)
         }
+        Command::Inject(args) => inject::run(&args).map(|()| ExitCode::SUCCESS),
+        Command::Readmit { channel } => readmit::run(&channel).map(|()| ExitCode::SUCCESS),
         Command::Latency { seconds, json } => {
             latency::run(seconds, json).map(|()| ExitCode::SUCCESS)
         }
+        Command::Geometry { config, json } => {
+            geometry::run(config.as_deref(), json).map(|()| ExitCode::SUCCESS)
+        }
+        Command::Eval { what } => match what {
+            EvalCommand::Fdi(args) => eval::run_fdi(&args).map(|()| ExitCode::SUCCESS),
+        },
+        Command::Mc(args) => mc::run(&args).map(|()| ExitCode::SUCCESS),
     }
 }

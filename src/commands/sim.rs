@@ -4,9 +4,11 @@ use anyhow::{Result, anyhow, bail};
 use rins_runtime::ipc::IpcSettings;
 use rins_runtime::shutdown::Shutdown;
 use rins_sim::Simulator;
+use rins_sim::fault_command::WhiteNoise;
 use rins_sim::service::SimOptions;
 
 use crate::cli::SimArgs;
+use crate::commands::fault_args;
 use crate::config;
 
 pub fn run(args: &SimArgs) -> Result<()> {
@@ -35,11 +37,14 @@ pub fn run(args: &SimArgs) -> Result<()> {
         .accel
         .build()
         .map_err(|e| anyhow!("{}", e.within("fusion.geometry.accel")))?;
+    let faults = fault_args::schedule(&args.faults, gyro.n(), accel.n())?;
     let sim = Simulator::new(&cfg.sim, gyro.axes(), accel.axes(), cfg.sim.seed)?;
     let shutdown = Shutdown::install()?;
     let options = SimOptions {
         link: args.link.clone(),
         duration_s: args.duration,
+        faults,
+        noise: WhiteNoise::from_config(&cfg.sim),
     };
     rins_sim::service::run(sim, &options, &IpcSettings::from_env(), &shutdown)
 }

@@ -15,6 +15,7 @@ use rins_watchdog::summary::Summary;
 use rins_watchdog::supervisor::{ChildEvent, ChildSpec, Supervisor};
 
 use crate::cli::UpArgs;
+use crate::commands::fault_args;
 use crate::config::{self, RinsConfig};
 
 /// Services in start order: consumers first, so that no sample is published before its subscriber exists.
@@ -95,6 +96,14 @@ fn apply_overrides(cfg: &mut RinsConfig, args: &UpArgs) -> Result<()> {
         }
         cfg.acquisition.port = Some(port.to_string_lossy().into_owned());
     }
+    if !args.faults.is_empty() {
+        if args.port.is_some() {
+            bail!("--inject and --faults need the simulator: they cannot be used with --port");
+        }
+        // Checked here so that a bad fault stops the start-up before any child runs.
+        let (n_gyro, n_accel) = fault_args::channel_counts(cfg)?;
+        fault_args::schedule(&args.faults, n_gyro, n_accel)?;
+    }
     Ok(())
 }
 
@@ -144,7 +153,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
             supervisor.start(ChildSpec {
                 name: "sim".into(),
                 program: exe.clone(),
-                args: sim_args(&cfg, &config_args, &link),
+                args: sim_args(&cfg, &config_args, &link, args),
             })?;
             wait_for_path(&link, &mut supervisor, &shutdown)?;
         }
@@ -177,7 +186,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     Ok(std::process::ExitCode::SUCCESS)
 }
 
-fn sim_args(cfg: &RinsConfig, config_args: &[String], link: &Path) -> Vec<String> {
+fn sim_args(cfg: &RinsConfig, config_args: &[String], link: &Path, up: &UpArgs) -> Vec<String> {
     let mut args = vec!["sim".to_string()];
     args.extend(config_args.iter().cloned());
     args.extend([
@@ -188,6 +197,13 @@ fn sim_args(cfg: &RinsConfig, config_args: &[String], link: &Path) -> Vec<String
         "--link".to_string(),
         link.to_string_lossy().into_owned(),
     ]);
+    // The simulator applies timed faults itself, exactly at their tick.
+    for spec in &up.faults.inject {
+        args.extend(["--inject".to_string(), spec.clone()]);
+    }
+    if let Some(file) = &up.faults.faults {
+        args.extend(["--faults".to_string(), file.to_string_lossy().into_owned()]);
+    }
     args
 }
 
@@ -274,5 +290,7 @@ fn summarise(
         alt_err_m_rms: sim(acc.altitude_m.rms()),
         alt_err_m_max: sim(acc.altitude_m.max()),
         shm_leaked: 0,
+        faults: monitor.faults.records().to_vec(),
+        false_alarms: monitor.faults.false_alarms(),
     }
 }

@@ -3,9 +3,16 @@
 //! Sensor i measures `z_i = h_iᵀ x + ε_i`; the rows h_iᵀ form the N×3 matrix H. With equal noise σ
 //! the least-squares estimate has covariance σ²(HᵀH)⁻¹, so diag((HᵀH)⁻¹) are the per-axis variance
 //! factors of a layout and their square roots its noise amplification.
+//!
+//! Layouts (`kind` in the configuration): `pyramid` (n axes on a cone, the seed's layout), `axes`
+//! (any 3..=16 vectors), `triad` (orthogonal, no redundancy), `dodecahedron` (6 face normals,
+//! isotropic) and `stacked` (several triaxial IMUs, 3 rows each). What a layout allows for fault
+//! detection and isolation is reported by [`Geometry::capability`].
 
+use crate::capability::Capability;
 use crate::error::ConfigError;
 use crate::linalg::{normal_matrix, reciprocal_condition};
+use nalgebra::Rotation3;
 use serde::Deserialize;
 
 /// Most channels per sensor type (the IPC payloads are sized for this many).
@@ -30,6 +37,20 @@ pub enum GeometryConfig {
     },
     /// Explicit axes, one `[x, y, z]` per channel (normalised on construction).
     Axes { axes: Vec<[f64; 3]> },
+    /// Orthogonal triad: the body x, y and z axes (N = 3, no redundancy).
+    Triad {},
+    /// Six axes normal to the faces of a regular dodecahedron (see [`dodecahedron_axes`]):
+    /// every pair 63.43° apart, HᵀH = 2I, per-axis variance factor 3/N = 0.5.
+    Dodecahedron {},
+    /// `count` triaxial IMUs whose x, y, z axes become consecutive rows (IMU k: rows 3k..3k+3).
+    Stacked {
+        /// Number of triads, 1..=5 (at most 16 rows).
+        count: usize,
+        /// Mounting of each IMU relative to the body as `[roll, pitch, yaw]` degrees (Z-Y-X
+        /// Euler angles of the IMU→body rotation); empty = all aligned with the body.
+        #[serde(default)]
+        rotations_deg: Vec<[f64; 3]>,
+    },
 }
 
 impl GeometryConfig {
@@ -52,6 +73,12 @@ impl GeometryConfig {
                 beta0_deg,
             } => pyramid(*n, *alpha_deg, *beta0_deg),
             GeometryConfig::Axes { axes } => Geometry::from_axes(axes),
+            GeometryConfig::Triad {} => Geometry::from_axes(&TRIAD_AXES),
+            GeometryConfig::Dodecahedron {} => Geometry::from_axes(&dodecahedron_axes()),
+            GeometryConfig::Stacked {
+                count,
+                rotations_deg,
+            } => stacked(*count, rotations_deg),
         }
     }
 }
@@ -91,6 +118,74 @@ fn pyramid(n: usize, alpha_deg: f64, beta0_deg: f64) -> Result<Geometry, ConfigE
         // A flat pyramid is the only way a valid n/α/β0 can fail: blame α.
         ConfigError::new("alpha_deg", alpha_deg, e.reason)
     })
+}
+
+/// The orthogonal triad: body x (forward), y (right), z (down).
+pub const TRIAD_AXES: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+/// Most triads a stacked layout can hold (3 rows each, at most [`MAX_CHANNELS`] rows).
+pub const MAX_STACKED_TRIADS: usize = MAX_CHANNELS / 3;
+
+/// The six face normals of a regular dodecahedron (the vertex pairs of the dual icosahedron):
+/// `[±a, 0, b]`, `[0, b, ±a]`, `[b, ±a, 0]` with `a = 1/√(1+φ²)`, `b = φ/√(1+φ²)`, φ the golden
+/// ratio, in that order. Each axis lies in one body coordinate plane, tilted by atan(1/φ) =
+/// 31.72° from a body axis; every pair of axes (as lines) is 63.43° apart (|cos| = 1/√5).
+/// The pattern is symmetric under the cyclic permutation x→y→z, hence HᵀH = 2I.
+pub fn dodecahedron_axes() -> [[f64; 3]; 6] {
+    let phi = (1.0 + 5f64.sqrt()) / 2.0;
+    let norm = (1.0 + phi * phi).sqrt();
+    let (a, b) = (1.0 / norm, phi / norm);
+    [
+        [a, 0.0, b],
+        [-a, 0.0, b],
+        [0.0, b, a],
+        [0.0, b, -a],
+        [b, a, 0.0],
+        [b, -a, 0.0],
+    ]
+}
+
+fn stacked(count: usize, rotations_deg: &[[f64; 3]]) -> Result<Geometry, ConfigError> {
+    if !(1..=MAX_STACKED_TRIADS).contains(&count) {
+        return Err(ConfigError::new(
+            "count",
+            count,
+            format!(
+                "must be in 1..={MAX_STACKED_TRIADS} (3 rows per triad, at most {MAX_CHANNELS} rows)"
+            ),
+        ));
+    }
+    if !(rotations_deg.is_empty() || rotations_deg.len() == count) {
+        return Err(ConfigError::new(
+            "rotations_deg",
+            format!("{} entries", rotations_deg.len()),
+            format!("must have {count} entries (one per triad) or be empty"),
+        ));
+    }
+    if let Some((k, r)) = rotations_deg
+        .iter()
+        .enumerate()
+        .find(|(_, r)| !r.iter().all(|a| a.is_finite()))
+    {
+        return Err(ConfigError::new(
+            format!("rotations_deg[{k}]"),
+            format!("{r:?}"),
+            "must be finite [roll, pitch, yaw] degrees",
+        ));
+    }
+    let mut axes = [[0.0; 3]; MAX_CHANNELS];
+    for k in 0..count {
+        let [roll, pitch, yaw] = rotations_deg.get(k).copied().unwrap_or([0.0; 3]);
+        let rot =
+            Rotation3::from_euler_angles(roll.to_radians(), pitch.to_radians(), yaw.to_radians());
+        // IMU axis e_j seen in the body frame is column j of the IMU→body rotation.
+        for j in 0..3 {
+            let col = rot.matrix().column(j);
+            axes[3 * k + j] = [col[0], col[1], col[2]];
+        }
+    }
+    // Each triad alone spans 3-D, so a stacked layout is never rank deficient.
+    Geometry::from_axes(&axes[..3 * count])
 }
 
 /// N sensitive axes (unit vectors, rows of H) with their precomputed noise figures.
@@ -176,6 +271,11 @@ impl Geometry {
     /// λ_min/λ_max of HᵀH (1 for an isotropic layout such as the orthogonal triad).
     pub fn reciprocal_condition(&self) -> f64 {
         self.reciprocal_condition
+    }
+
+    /// Noise figures and fault detection/isolation abilities of this layout.
+    pub fn capability(&self) -> Capability {
+        Capability::of(self)
     }
 
     /// Bitmask with one bit set per channel.

@@ -4,18 +4,28 @@
 //! - [`geometry`]: sensitive-axis layouts (pyramid or explicit axes) and their noise figures.
 //! - [`calibration`]: ADC counts to SI units per channel.
 //! - [`wls`]: precomputed weighted least-squares solver for one active channel set.
-//! - [`fuser`]: the gyro and accelerometer sides together, driven by the channel-valid mask.
+//! - [`fdi`]: fault detection (parity, χ², channel health), isolation and reconfiguration.
+//! - [`kalman`]: the optional Kalman fusion method over the same channel sets.
+//! - [`rest_bias`]: per-channel gyro biases from a start-up window at rest.
+//! - [`fuser`]: the gyro and accelerometer sides together, with their fault monitors.
 
 pub mod calibration;
+pub mod capability;
 pub mod error;
+pub mod fdi;
 pub mod fuser;
 pub mod geometry;
+pub mod kalman;
 mod linalg;
+pub mod rest_bias;
 pub mod service;
 pub mod wls;
 
 pub use calibration::{Calibration, ChannelCalibration};
 pub use error::ConfigError;
-pub use fuser::{ChannelNoise, Fused, FusionConfig, ImuFuser, NoiseConfig, PerSensor};
+pub use fdi::{ChannelEvent, ChannelEvents, FdiConfig, ParityNoise, ParitySpace, SensorStatus};
+pub use fuser::{ChannelNoise, Fused, FusionConfig, ImuFuser, ImuSample, NoiseConfig, PerSensor};
 pub use geometry::{Geometry, GeometryConfig};
+pub use kalman::{FusionMethod, KalmanConfig};
+pub use rest_bias::RestBiasState;
 pub use wls::{WlsError, WlsSolver};

@@ -4,7 +4,8 @@ use std::time::Duration;
 
 use anyhow::Result;
 use ipc_types::{
-    ChannelState, FusedImu, Health, PAYLOAD_VERSION, RawImu, ServiceKind, Stage, fused_flags, names,
+    ChannelState, FusedImu, FusionControl, Health, PAYLOAD_VERSION, RawImu, SensorType,
+    ServiceKind, Stage, names,
 };
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::heartbeat::Heartbeat;
@@ -19,44 +20,65 @@ const _: () = assert!(ACCEL_MASK_SHIFT == 16);
 /// Longest sleep between looks at the shutdown flag and the heartbeat.
 const WAIT: Duration = Duration::from_millis(100);
 
-/// Per-channel states for the fused message: used channels Ok, fitted but unused Excluded.
-fn channel_states(n: usize, used_mask: u32) -> [u8; ipc_types::MAX_CHANNELS] {
-    let mut states = [ChannelState::Absent as u8; ipc_types::MAX_CHANNELS];
-    for (i, s) in states.iter_mut().enumerate().take(n) {
-        *s = if used_mask & (1 << i) != 0 {
-            ChannelState::Ok as u8
-        } else {
-            ChannelState::Excluded as u8
-        };
-    }
-    states
-}
-
-/// The fused message for one raw frame (header copied, fusion stamp left to the caller).
+/// The fused message for one raw frame: estimate, fault-detection fields and the raw frame's header
+/// (the fusion stamp is left to the caller).
 pub fn fused_message(raw: &RawImu, fused: &Fused, n_gyro: usize, n_accel: usize) -> FusedImu {
-    let mut flags = 0;
-    if !fused.gyro_ok {
-        flags |= fused_flags::GYRO_INSUFFICIENT;
-    }
-    if !fused.accel_ok {
-        flags |= fused_flags::ACCEL_INSUFFICIENT;
-    }
-    FusedImu {
+    let mut msg = FusedImu {
         version: PAYLOAD_VERSION,
         n_gyro: n_gyro as u8,
         n_accel: n_accel as u8,
-        flags,
         header: raw.header,
         rate_rps: fused.rate,
         specific_force_mps2: fused.specific_force,
         rate_var: fused.rate_var,
         specific_force_var: fused.specific_force_var,
-        gyro_state: channel_states(n_gyro, fused.gyro_mask),
-        accel_state: channel_states(n_accel, fused.accel_mask),
-        gyro_reason: [0; ipc_types::MAX_CHANNELS],
-        accel_reason: [0; ipc_types::MAX_CHANNELS],
-        gyro_test_statistic: 0.0,
-        accel_test_statistic: 0.0,
+        ..FusedImu::default()
+    };
+    fused.write_fdi(&mut msg);
+    msg
+}
+
+/// Every channel state change is a structured event (rare: faults, exclusions, re-admissions).
+fn log_events(fused: &Fused, device_time_us: u64) {
+    for e in fused.events.as_slice() {
+        let fields = (
+            e.sensor.name(),
+            e.channel,
+            format!("{:?}", e.old_state).to_lowercase(),
+            format!("{:?}", e.new_state).to_lowercase(),
+            e.reason.name(),
+        );
+        if e.new_state == ChannelState::Ok {
+            tracing::info!(sensor = fields.0, channel = fields.1, from = %fields.2, to = %fields.3, device_time_us, "channel state");
+        } else {
+            tracing::warn!(sensor = fields.0, channel = fields.1, from = %fields.2, to = %fields.3, reason = fields.4, device_time_us, "channel state");
+        }
+    }
+}
+
+/// Applies a re-admission command: the only way an excluded channel returns.
+fn readmit(fuser: &mut ImuFuser, cmd: &FusionControl) {
+    let Some(sensor) = SensorType::from_u8(cmd.sensor) else {
+        tracing::warn!(
+            sensor = cmd.sensor,
+            "re-admission for an unknown sensor type ignored"
+        );
+        return;
+    };
+    match fuser.readmit(sensor, usize::from(cmd.channel)) {
+        Ok(true) => tracing::warn!(
+            sensor = sensor.name(),
+            channel = cmd.channel,
+            "channel re-admitted by command"
+        ),
+        Ok(false) => tracing::info!(
+            sensor = sensor.name(),
+            channel = cmd.channel,
+            "re-admission: channel was not excluded"
+        ),
+        Err(e) => {
+            tracing::warn!(sensor = sensor.name(), channel = cmd.channel, error = %e, "re-admission refused")
+        }
     }
 }
 
@@ -64,6 +86,7 @@ pub fn run(mut fuser: ImuFuser, settings: &IpcSettings, shutdown: &Shutdown) -> 
     let node = create_node("fusion", settings)?;
     let input = TopicSubscriber::<RawImu>::new(&node, names::RAW_IMU)?;
     let output = TopicPublisher::<FusedImu>::new(&node, names::FUSED_IMU)?;
+    let control = TopicSubscriber::<FusionControl>::new(&node, names::FUSION_CONTROL)?;
     let mut heartbeat = Heartbeat::new(&node, ServiceKind::Fusion)?;
     let (n_gyro, n_accel) = (fuser.gyro_geometry().n(), fuser.accel_geometry().n());
     let mut counters = Health::default();
@@ -72,6 +95,13 @@ pub fn run(mut fuser: ImuFuser, settings: &IpcSettings, shutdown: &Shutdown) -> 
 
     while !shutdown.requested() {
         input.wait(WAIT)?;
+        while let Some(cmd) = control.receive()? {
+            if cmd.version == PAYLOAD_VERSION {
+                readmit(&mut fuser, &cmd);
+            } else {
+                counters.rejected += 1;
+            }
+        }
         while let Some(raw) = input.receive()? {
             counters.received += 1;
             if let Some(last) = last_seq
@@ -98,12 +128,10 @@ pub fn run(mut fuser: ImuFuser, settings: &IpcSettings, shutdown: &Shutdown) -> 
                 }
                 continue;
             }
-            // Invalid channels are dropped from the solution; the accel bits sit above the gyro bits.
-            let fused = fuser.fuse(
-                &raw.gyro_counts[..n_gyro],
-                &raw.accel_counts[..n_accel],
-                raw.valid_mask,
-            );
+            let fused = fuser.fuse_raw(&raw);
+            if !fused.events.is_empty() {
+                log_events(&fused, raw.header.origin_device_time_us);
+            }
             let mut msg = fused_message(&raw, &fused, n_gyro, n_accel);
             msg.header.stamp(Stage::Fusion, monotonic_ns());
             output.publish(msg)?;
@@ -112,24 +140,4 @@ pub fn run(mut fuser: ImuFuser, settings: &IpcSettings, shutdown: &Shutdown) -> 
         heartbeat.tick(&counters)?;
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn channel_states_mark_used_excluded_and_absent() {
-        let s = channel_states(4, 0b1011);
-        assert_eq!(
-            &s[..5],
-            &[
-                ChannelState::Ok as u8,
-                ChannelState::Ok as u8,
-                ChannelState::Excluded as u8,
-                ChannelState::Ok as u8,
-                ChannelState::Absent as u8
-            ]
-        );
-    }
 }

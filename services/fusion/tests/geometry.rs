@@ -189,3 +189,183 @@ fn errors_name_field_and_value() {
     let e = axes(vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 1e-5]]);
     assert!(e.reason.contains("coplanar"), "{e}");
 }
+
+fn stacked(count: usize, rotations_deg: Vec<[f64; 3]>) -> Geometry {
+    GeometryConfig::Stacked {
+        count,
+        rotations_deg,
+    }
+    .build()
+    .unwrap()
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// HᵀH of the geometry, row-major.
+fn normal_matrix(g: &Geometry) -> [[f64; 3]; 3] {
+    let mut m = [[0.0; 3]; 3];
+    for h in g.axes() {
+        for r in 0..3 {
+            for c in 0..3 {
+                m[r][c] += h[r] * h[c];
+            }
+        }
+    }
+    m
+}
+
+#[test]
+fn triad_kind_is_the_body_axes() {
+    let g = GeometryConfig::Triad {}.build().unwrap();
+    assert_eq!(
+        g.axes(),
+        &[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    );
+    assert_close(g.variance_factors(), [1.0; 3], 0.0);
+    assert_eq!(g.parity_dimension(), 0);
+}
+
+#[test]
+fn dodecahedron_kind_has_equal_angles_and_isotropic_noise() {
+    let g = GeometryConfig::Dodecahedron {}.build().unwrap();
+    assert_eq!(g.n(), 6);
+    let cos_63 = 1.0 / 5f64.sqrt();
+    assert!((cos_63.acos().to_degrees() - 63.43).abs() < 5e-3);
+    for (i, a) in g.axes().iter().enumerate() {
+        assert!((dot(*a, *a) - 1.0).abs() < 1e-15);
+        // Each axis lies in one body coordinate plane.
+        assert_eq!(
+            a.iter().filter(|c| **c == 0.0).count(),
+            1,
+            "axis {i}: {a:?}"
+        );
+        for b in &g.axes()[i + 1..] {
+            assert!((dot(*a, *b).abs() - cos_63).abs() < 1e-15, "{a:?} · {b:?}");
+        }
+    }
+    let m = normal_matrix(&g);
+    for (r, row) in m.iter().enumerate() {
+        for (c, v) in row.iter().enumerate() {
+            let expected = if r == c { 2.0 } else { 0.0 };
+            assert!((v - expected).abs() < 1e-15, "HᵀH[{r}][{c}] = {v}");
+        }
+    }
+    // 3/N per axis.
+    assert_close(g.variance_factors(), [0.5; 3], 1e-15);
+    assert_eq!(g.parity_dimension(), 3);
+}
+
+#[test]
+fn stacked_aligned_triads_repeat_the_body_axes() {
+    let g = stacked(4, vec![]);
+    assert_eq!(g.n(), 12);
+    for (i, h) in g.axes().iter().enumerate() {
+        let mut e = [0.0; 3];
+        e[i % 3] = 1.0;
+        assert_eq!(*h, e, "row {i}");
+    }
+    // HᵀH = 4I.
+    assert_close(g.variance_factors(), [0.25; 3], 1e-15);
+    assert_eq!(g.parity_dimension(), 9);
+    assert_eq!(g.full_mask(), 0xFFF);
+}
+
+#[test]
+fn stacked_rotations_are_imu_to_body_zyx_euler_angles() {
+    // Yaw 90°: the IMU's forward axis points to the body's right, its right axis to the back.
+    let g = stacked(2, vec![[0.0, 0.0, 0.0], [0.0, 0.0, 90.0]]);
+    assert_close(g.axes()[3], [0.0, 1.0, 0.0], 1e-15);
+    assert_close(g.axes()[4], [-1.0, 0.0, 0.0], 1e-15);
+    assert_close(g.axes()[5], [0.0, 0.0, 1.0], 1e-15);
+    // Pitch 90° (nose up): the IMU's forward axis points up, i.e. body −z in FRD.
+    let g = stacked(1, vec![[0.0, 90.0, 0.0]]);
+    assert_close(g.axes()[0], [0.0, 0.0, -1.0], 1e-15);
+
+    let angles = [
+        [10.0, -20.0, 30.0],
+        [-70.0, 45.0, 170.0],
+        [5.0, 80.0, -100.0],
+    ];
+    let g = stacked(3, angles.to_vec());
+    for (k, [r, p, y]) in angles.iter().enumerate() {
+        let rot = Rotation3::from_euler_angles(r.to_radians(), p.to_radians(), y.to_radians());
+        for (j, e) in [Vector3::x(), Vector3::y(), Vector3::z()]
+            .iter()
+            .enumerate()
+        {
+            let v = rot * e;
+            assert_close(g.axes()[3 * k + j], [v.x, v.y, v.z], 1e-15);
+        }
+    }
+    // Every triad is orthonormal, so HᵀH = count·I whatever the rotations.
+    assert_close(g.variance_factors(), [1.0 / 3.0; 3], 1e-14);
+}
+
+#[test]
+fn parses_the_new_kinds_from_toml() {
+    let parse = |s: &str| toml::from_str::<GeometryConfig>(s).unwrap();
+    assert_eq!(parse("kind = \"triad\""), GeometryConfig::Triad {});
+    assert_eq!(
+        parse("kind = \"dodecahedron\""),
+        GeometryConfig::Dodecahedron {}
+    );
+    assert_eq!(
+        parse("kind = \"stacked\"\ncount = 4"),
+        GeometryConfig::Stacked {
+            count: 4,
+            rotations_deg: vec![]
+        }
+    );
+    assert_eq!(
+        parse("kind = \"stacked\"\ncount = 2\nrotations_deg = [[0, 0, 0], [180, 0, 45.5]]"),
+        GeometryConfig::Stacked {
+            count: 2,
+            rotations_deg: vec![[0.0; 3], [180.0, 0.0, 45.5]]
+        }
+    );
+    for bad in [
+        "kind = \"triad\"\nn = 3",
+        "kind = \"dodecahedron\"\nalpha_deg = 30",
+        "kind = \"stacked\"\ncount = 2\nrotation_deg = []",
+        "kind = \"stacked\"",
+    ] {
+        assert!(toml::from_str::<GeometryConfig>(bad).is_err(), "{bad}");
+    }
+}
+
+#[test]
+fn stacked_errors_name_field_and_value() {
+    let bad = |count, rotations_deg| {
+        GeometryConfig::Stacked {
+            count,
+            rotations_deg,
+        }
+        .build()
+        .unwrap_err()
+    };
+    assert_eq!(
+        bad(0, vec![]).to_string(),
+        "count = 0: must be in 1..=5 (3 rows per triad, at most 16 rows)"
+    );
+    assert_eq!(bad(6, vec![]).field, "count");
+    assert_eq!(
+        bad(3, vec![[0.0; 3]; 2]).to_string(),
+        "rotations_deg = 2 entries: must have 3 entries (one per triad) or be empty"
+    );
+    let e = bad(2, vec![[0.0; 3], [1.0, f64::INFINITY, 0.0]]);
+    assert_eq!(
+        e.to_string(),
+        "rotations_deg[1] = [1.0, inf, 0.0]: must be finite [roll, pitch, yaw] degrees"
+    );
+    // The full path through the fusion configuration.
+    let cfg: FusionConfig = toml::from_str(
+        "[geometry.accel]\nkind = \"stacked\"\ncount = 2\nrotations_deg = [[0, 0, 0]]",
+    )
+    .unwrap();
+    assert_eq!(
+        cfg.validate().unwrap_err().field,
+        "geometry.accel.rotations_deg"
+    );
+}

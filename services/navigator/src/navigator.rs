@@ -275,3 +275,15 @@ impl Navigator {
         }
     }
 }
+
+/// Whether a fused IMU sample (its `FusedImu::flags`) may drive the navigator: both solutions valid,
+/// and fusion no longer measuring per-channel gyro biases — the rate before that correction carries
+/// the biases the alignment window would otherwise average into its own estimate.
+pub fn fused_sample_usable(flags: u32) -> bool {
+    use ipc_types::fused_flags;
+    flags
+        & (fused_flags::GYRO_INSUFFICIENT
+            | fused_flags::ACCEL_INSUFFICIENT
+            | fused_flags::GYRO_REST_BIAS_PENDING)
+        == 0
+}

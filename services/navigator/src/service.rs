@@ -6,8 +6,7 @@ use std::time::Duration;
 
 use anyhow::{Result, anyhow};
 use ipc_types::{
-    Altitude, FusedImu, Health, NavState, PAYLOAD_VERSION, RawMag, ServiceKind, Stage, fused_flags,
-    names,
+    Altitude, FusedImu, Health, NavState, PAYLOAD_VERSION, RawMag, ServiceKind, Stage, names,
 };
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::heartbeat::Heartbeat;
@@ -15,7 +14,7 @@ use rins_runtime::ipc::{IpcSettings, TopicPublisher, TopicSubscriber, create_nod
 use rins_runtime::shutdown::Shutdown;
 
 use crate::config::NavigatorConfig;
-use crate::navigator::Navigator;
+use crate::navigator::{Navigator, fused_sample_usable};
 
 const WAIT: Duration = Duration::from_millis(100);
 
@@ -26,9 +25,7 @@ pub fn step(nav: &mut Navigator, imu: &FusedImu, last: &NavState) -> NavState {
         header: imu.header,
         ..*last
     };
-    let usable =
-        imu.flags & (fused_flags::GYRO_INSUFFICIENT | fused_flags::ACCEL_INSUFFICIENT) == 0;
-    if usable
+    if fused_sample_usable(imu.flags)
         && let Some(solution) = nav.on_imu(
             imu.header.origin_device_time_us,
             imu.rate_rps,

@@ -92,7 +92,7 @@ impl Default for SimConfig {
             origin_longitude_deg: 8.545_594,
             origin_altitude_m: 488.0,
             initial_heading_deg: 0.0,
-            static_s: 2.0,
+            static_s: 3.0,
             qnh_pa: 101_325.0,
             earth_field: EarthFieldConfig::default(),
             sensors: SensorModelConfig::default(),

@@ -5,6 +5,8 @@
 
 pub mod config;
 pub mod error;
+pub mod fault_command;
+pub mod fault_schedule;
 pub mod sensor_model;
 pub mod service;
 pub mod simulator;

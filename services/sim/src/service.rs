@@ -6,14 +6,19 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::{Context, Result};
-use ipc_types::{Header, Health, PAYLOAD_VERSION, ServiceKind, Truth, names};
+use ipc_types::{
+    FaultApplied, FaultOutcome, Header, Health, PAYLOAD_VERSION, ServiceKind, SimControl, Truth,
+    names,
+};
 use rins_acquisition::protocol::{Frame, MAX_FRAME_LEN, encode};
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::heartbeat::Heartbeat;
-use rins_runtime::ipc::{IpcSettings, TopicPublisher, create_node};
+use rins_runtime::ipc::{IpcSettings, TopicPublisher, TopicSubscriber, create_node};
 use rins_runtime::shutdown::Shutdown;
 use serialport::{SerialPort, TTYPort};
 
+use crate::fault_command::{ControlError, FaultCommand, WhiteNoise};
+use crate::fault_schedule::{FaultSchedule, ScheduledFault};
 use crate::simulator::{Simulator, TickOutput, TruthSample};
 
 /// Frames of one tick at most: IMU, baro, mag, aux.
@@ -27,6 +32,10 @@ pub struct SimOptions {
     pub link: Option<PathBuf>,
     /// Stop after this many seconds of device time.
     pub duration_s: Option<f64>,
+    /// Faults to apply at given device times.
+    pub faults: Vec<ScheduledFault>,
+    /// Configured white noise, the unit of noise-factor faults.
+    pub noise: WhiteNoise,
 }
 
 pub fn truth_message(t: &TruthSample) -> Truth {
@@ -82,6 +91,83 @@ fn encode_tick(out: &TickOutput, buf: &mut [u8]) -> usize {
     len
 }
 
+/// Device time of the sample the next step produces, µs (as [`Simulator::step`] stamps it).
+fn next_sample_time_us(sim: &Simulator) -> u64 {
+    (sim.tick() as f64 * sim.imu_period_s() * 1e6).round() as u64
+}
+
+/// Applies one fault command before the next step, so it affects that step's sample, and
+/// describes what happened for [`names::SIM_FAULT_APPLIED`].
+fn apply_fault(sim: &mut Simulator, command: &FaultCommand, noise: &WhiteNoise) -> FaultApplied {
+    let channel = usize::from(command.channel.index);
+    let sensor = command.channel.inertial_sensor();
+    let result = match command.channel_fault(noise) {
+        Some(fault) => sim.inject_fault(sensor, channel, fault),
+        None => sim.clear_fault(sensor, channel),
+    };
+    let outcome = match result {
+        Ok(()) => {
+            tracing::info!(fault = %command, time_s = sim.time_s(), "fault applied");
+            FaultOutcome::Applied
+        }
+        Err(crate::SimError::NoSuchChannel { .. }) => {
+            tracing::warn!(fault = %command, "fault ignored: the sensor block has no such channel");
+            FaultOutcome::NoSuchChannel
+        }
+        Err(e) => {
+            tracing::warn!(fault = %command, error = %e, "fault ignored");
+            FaultOutcome::InvalidParameter
+        }
+    };
+    FaultApplied {
+        outcome: outcome as u8,
+        device_time_us: next_sample_time_us(sim),
+        ..fault_event(&command.to_control())
+    }
+}
+
+/// The event for a command as received, before its outcome is known.
+fn fault_event(control: &SimControl) -> FaultApplied {
+    FaultApplied {
+        version: PAYLOAD_VERSION,
+        sensor: control.sensor,
+        channel: control.channel,
+        fault: control.fault,
+        outcome: FaultOutcome::UnknownCommand as u8,
+        _pad: [0; 2],
+        device_time_us: 0,
+        param: control.param,
+    }
+}
+
+/// Applies a command received on [`names::SIM_CONTROL`]; malformed ones are logged and ignored.
+fn handle_control(sim: &mut Simulator, control: &SimControl, noise: &WhiteNoise) -> FaultApplied {
+    match FaultCommand::from_control(control) {
+        Ok(command) => apply_fault(sim, &command, noise),
+        Err(e) => {
+            let outcome = match e {
+                ControlError::Unknown => FaultOutcome::UnknownCommand,
+                ControlError::NoSuchChannel => FaultOutcome::NoSuchChannel,
+                ControlError::InvalidParameter => FaultOutcome::InvalidParameter,
+            };
+            tracing::warn!(
+                version = control.version,
+                sensor = control.sensor,
+                channel = control.channel,
+                fault = control.fault,
+                param = control.param,
+                outcome = outcome.name(),
+                "simulator control command ignored"
+            );
+            FaultApplied {
+                outcome: outcome as u8,
+                device_time_us: next_sample_time_us(sim),
+                ..fault_event(control)
+            }
+        }
+    }
+}
+
 pub fn run(
     mut sim: Simulator,
     options: &SimOptions,
@@ -108,6 +194,9 @@ pub fn run(
 
     let node = create_node("sim", settings)?;
     let truth = TopicPublisher::<Truth>::new(&node, names::TRUTH)?;
+    let fault_events = TopicPublisher::<FaultApplied>::new(&node, names::SIM_FAULT_APPLIED)?;
+    let control = TopicSubscriber::<SimControl>::new(&node, names::SIM_CONTROL)?;
+    let mut schedule = FaultSchedule::new(&options.faults, 1.0 / sim.imu_period_s());
     let mut heartbeat = Heartbeat::new(&node, ServiceKind::Simulator)?;
     let mut counters = Health::default();
     let mut out = TickOutput::default();
@@ -120,6 +209,14 @@ pub fn run(
 
     while !shutdown.requested() && end_tick.is_none_or(|end| sim.tick() < end) {
         sleep_until(start_ns + sim.tick() * period_ns);
+        // Faults first, announced before the frame leaves: whoever measures detection delays
+        // must know of a fault before any output derived from the faulty sample.
+        while let Some(command) = schedule.next_due(sim.tick()) {
+            fault_events.publish(apply_fault(&mut sim, &command, &options.noise))?;
+        }
+        while let Some(command) = control.receive()? {
+            fault_events.publish(handle_control(&mut sim, &command, &options.noise))?;
+        }
         sim.step(&mut out);
         // Truth first: whoever compares against it must find it before the frame's navigation output.
         truth.publish(truth_message(&out.truth))?;

@@ -3,6 +3,7 @@
 
 pub mod accuracy;
 pub mod config;
+pub mod fault_tracking;
 pub mod monitor;
 pub mod restart_policy;
 pub mod seq_gaps;

@@ -3,12 +3,13 @@
 
 use anyhow::Result;
 use ipc_types::{
-    Altitude, FusedImu, Health, NavMode, NavState, RawBaro, RawImu, RawMag, ServiceKind, Truth,
-    names,
+    Altitude, FaultApplied, FusedImu, Health, NavMode, NavState, RawBaro, RawImu, RawMag,
+    ServiceKind, Truth, names,
 };
 use rins_runtime::ipc::{IpcNode, TopicSubscriber};
 
 use crate::accuracy::Accuracy;
+use crate::fault_tracking::FaultTracker;
 use crate::seq_gaps::SeqGaps;
 
 /// Truth is kept this many IMU frames back, to meet the navigation output that comes later.
@@ -34,11 +35,14 @@ pub struct Monitor {
     nav: TopicSubscriber<NavState>,
     truth: TopicSubscriber<Truth>,
     health: TopicSubscriber<Health>,
+    fault_events: TopicSubscriber<FaultApplied>,
     /// Samples seen per topic of [`COUNTED`], since start.
     pub totals: [u64; COUNTED.len()],
     pub nav_gaps: SeqGaps,
     pub last_nav: Option<NavState>,
     pub accuracy: Accuracy,
+    /// Injected faults, their detection and isolation, and false alarms.
+    pub faults: FaultTracker,
     truth_ring: Box<[Truth]>,
     /// Latest acquisition counters per process id (a restarted acquisition starts from zero).
     acquisition: Vec<(u32, DeviceCounters)>,
@@ -55,10 +59,12 @@ impl Monitor {
             nav: TopicSubscriber::new(node, names::NAV_STATE)?,
             truth: TopicSubscriber::new(node, names::TRUTH)?,
             health: TopicSubscriber::new(node, names::HEALTH)?,
+            fault_events: TopicSubscriber::new(node, names::SIM_FAULT_APPLIED)?,
             totals: [0; COUNTED.len()],
             nav_gaps: SeqGaps::default(),
             last_nav: None,
             accuracy: Accuracy::default(),
+            faults: FaultTracker::new(),
             // version 0 marks an empty slot.
             truth_ring: vec![
                 Truth {
@@ -77,7 +83,15 @@ impl Monitor {
         self.totals[0] += drain_count(&self.imu)?;
         self.totals[1] += drain_count(&self.baro)?;
         self.totals[2] += drain_count(&self.mag)?;
-        self.totals[3] += drain_count(&self.fused)?;
+        // Fault events before fused outputs: the simulator announces a fault before the frame
+        // that carries it, so the fault is known when fusion's reaction arrives.
+        while let Some(e) = self.fault_events.receive()? {
+            self.faults.on_fault_applied(&e);
+        }
+        while let Some(f) = self.fused.receive()? {
+            self.totals[3] += 1;
+            self.faults.on_fused(&f);
+        }
         self.totals[4] += drain_count(&self.alt)?;
         // Truth first, so a navigation sample finds the truth of its own frame.
         while let Some(t) = self.truth.receive()? {

@@ -2,6 +2,8 @@
 
 use serde::Serialize;
 
+use crate::fault_tracking::FaultRecord;
+
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct Summary {
     pub duration_s: f64,
@@ -29,4 +31,9 @@ pub struct Summary {
     pub alt_err_m_max: Option<f64>,
     /// Shared-memory entries of this deployment left after shutdown.
     pub shm_leaked: u64,
+    /// Every fault injected (scheduled or at run time), with detection and isolation times.
+    pub faults: Vec<FaultRecord>,
+    /// Channels leaving Ok, or faults detected but not isolated, on a sensor type with no
+    /// injected fault active, counted as events.
+    pub false_alarms: u64,
 }

@@ -7,7 +7,7 @@ use crate::error::{SimError, check_positive, check_range};
 
 /// The converter is the protocol's: signed 12-bit counts.
 pub use rins_acquisition::protocol::layout::{
-    COUNTS_PER_FULL_SCALE as ADC_HALF_RANGE, COUNT_MAX as ADC_MAX, COUNT_MIN as ADC_MIN,
+    COUNT_MAX as ADC_MAX, COUNT_MIN as ADC_MIN, COUNTS_PER_FULL_SCALE as ADC_HALF_RANGE,
 };
 /// Module temperature sensors the frame can carry.
 pub const MAX_TEMPERATURE_SENSORS: u8 = ipc_types::MAX_TEMPERATURES as u8;

@@ -1,0 +1,7 @@
+//! Loaders of recorded data sets.
+
+mod csv;
+pub mod error;
+pub mod quadrotor;
+
+pub use error::DatasetError;

@@ -1,0 +1,13 @@
+//! Offline evaluation of the navigation chain, without IPC: the product's pure libraries run
+//! in-process.
+//!
+//! - [`mc`]: Monte Carlo comparison of the redundant skewed block with an orthogonal triad built
+//!   from the same sensors, with and without a dead gyro channel.
+//! - [`datasets`]: loaders of recorded data sets (the four-IMU quadrotor flights).
+//! - [`installation`]: relative rotation between IMUs from paired rate vectors (Wahba's problem).
+//! - [`stats`]: mean, 2σ and RMS helpers.
+
+pub mod datasets;
+pub mod installation;
+pub mod mc;
+pub mod stats;

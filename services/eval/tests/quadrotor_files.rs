@@ -1,0 +1,154 @@
+//! Quadrotor loader on small files written by the test: missing files, malformed lines, lags.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use rins_eval::datasets::DatasetError;
+use rins_eval::datasets::quadrotor::{list_trials, load_trial};
+
+/// A fresh directory under the system temp dir, removed on drop.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("rins-eval-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        Self(dir)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Rate about the sensor x axis, °/s, at row j of IMU `delay` rows late.
+fn rate(j: i64) -> f64 {
+    let t = j as f64 / 120.0;
+    30.0 * (2.0 * t).sin() + 10.0 * (5.3 * t).cos()
+}
+
+fn write_imu(dir: &Path, imu: usize, rows: usize, delay: i64) {
+    let mut s = String::from("time,Euler_X,Euler_Y,Euler_Z,Acc_X,Acc_Y,Acc_Z,Gyr_X,Gyr_Y,Gyr_Z\n");
+    for j in 0..rows as i64 {
+        let t = j as f64 / 120.0;
+        let _ = writeln!(
+            s,
+            "{t},1.0,-2.0,30.0,0.1,0.2,9.8,{},{},{}",
+            rate(j - delay),
+            0.5 * rate(j - delay + 40),
+            -2.0
+        );
+    }
+    std::fs::write(dir.join(format!("IMU_{imu}.csv")), s).unwrap();
+}
+
+fn write_truth(dir: &Path, rows: usize) {
+    let mut s = String::from(
+        "time,distance(meters),speed(m/s), compass_heading(degrees), pitch(degrees), roll(degrees),height_above_takeoff(meters),North,East,Down\n",
+    );
+    for k in 0..rows {
+        let t = k as f64 / 10.0;
+        let _ = writeln!(
+            s,
+            "{t},{},2.0,90.0,2.0,1.0,5.0,0.0,{},0.0",
+            2.0 * t,
+            2.0 * t
+        );
+    }
+    std::fs::write(dir.join("GT.csv"), s).unwrap();
+}
+
+#[test]
+fn missing_imu_files_are_skipped_with_a_note_and_lags_are_removed() {
+    let root = TempDir::new("missing");
+    let trial_dir = root.0.join("Vertical").join("path_2");
+    std::fs::create_dir_all(&trial_dir).unwrap();
+    write_imu(&trial_dir, 1, 600, 0);
+    write_imu(&trial_dir, 3, 600, 4);
+    write_truth(&trial_dir, 50);
+
+    let listed = list_trials(&root.0).unwrap();
+    assert_eq!(listed.len(), 1);
+    assert_eq!(listed[0].name, "Vertical/path_2");
+    assert_eq!(listed[0].imus, vec![1, 3]);
+    assert!(listed[0].has_truth);
+
+    let trial = load_trial(&trial_dir).unwrap();
+    assert_eq!(trial.imus.iter().map(|s| s.imu).collect::<Vec<_>>(), [1, 3]);
+    assert!(
+        trial.notes.iter().any(|n| n.contains("IMU_2.csv missing")),
+        "{:?}",
+        trial.notes
+    );
+    assert!(
+        trial.notes.iter().any(|n| n.contains("IMU_4.csv missing")),
+        "{:?}",
+        trial.notes
+    );
+    assert_eq!(trial.imus[1].lag_rows, 4);
+    // Aligned: the same instant in both series, so equal rates; 4 rows lost at the start.
+    assert_eq!(trial.len(), 596);
+    for (a, b) in trial.imus[0].samples.iter().zip(&trial.imus[1].samples) {
+        assert_eq!(a.t_s, b.t_s);
+        assert!((a.gyro_rps[0] - b.gyro_rps[0]).abs() < 1e-12);
+    }
+    // SI and FRD: −2 °/s about sensor z (up) is +2 °/s about FRD z (down); Acc_Z 9.8 → −9.8.
+    let s = trial.imus[0].samples[10];
+    assert!((s.gyro_rps[2] - 2f64.to_radians()).abs() < 1e-12);
+    assert_eq!(s.accel_mps2, [0.1, -0.2, -9.8]);
+    assert!(
+        (s.euler_rad[1] - 2f64.to_radians()).abs() < 1e-12,
+        "pitch = −Euler_Y"
+    );
+    assert!((trial.truth[3].heading_rad - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+}
+
+#[test]
+fn a_malformed_line_names_file_and_line() {
+    let root = TempDir::new("malformed");
+    write_imu(&root.0, 1, 300, 0);
+    write_truth(&root.0, 30);
+    let path = root.0.join("IMU_1.csv");
+    let mut text = std::fs::read_to_string(&path).unwrap();
+    text = text.replacen("0.1,0.2,9.8", "0.1,abc,9.8", 1);
+    std::fs::write(&path, text).unwrap();
+    let e = load_trial(&root.0).unwrap_err();
+    let message = e.to_string();
+    assert!(
+        message.contains("IMU_1.csv:2: Acc_Y = \"abc\""),
+        "{message}"
+    );
+    assert!(matches!(e, DatasetError::Malformed { line: 2, .. }));
+}
+
+#[test]
+fn a_trial_without_truth_or_without_imus_is_an_error() {
+    let root = TempDir::new("incomplete");
+    write_truth(&root.0, 30);
+    let e = load_trial(&root.0).unwrap_err();
+    assert!(matches!(e, DatasetError::MissingFile { .. }), "{e}");
+    write_imu(&root.0, 2, 300, 0);
+    std::fs::remove_file(root.0.join("GT.csv")).unwrap();
+    let e = load_trial(&root.0).unwrap_err();
+    assert!(e.to_string().contains("GT.csv: missing"), "{e}");
+}
+
+#[test]
+fn a_short_file_and_time_going_back_are_errors() {
+    let root = TempDir::new("short");
+    write_imu(&root.0, 1, 50, 0);
+    write_truth(&root.0, 30);
+    let e = load_trial(&root.0).unwrap_err();
+    assert!(matches!(e, DatasetError::TooShort { rows: 50, .. }), "{e}");
+    write_imu(&root.0, 1, 300, 0);
+    let path = root.0.join("IMU_1.csv");
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replacen("\n0.5,", "\n0.1,", 1);
+    std::fs::write(&path, text).unwrap();
+    let e = load_trial(&root.0).unwrap_err();
+    assert!(e.to_string().contains("goes back"), "{e}");
+}

@@ -1,0 +1,247 @@
+//! The `[fusion.fdi]` table: fault detection, isolation and reconfiguration settings.
+
+use super::MAX_PARITY;
+use super::channel_health::HealthSettings;
+use super::chi2::{chi2_upper_quantile, regularized_gamma_p};
+use super::persistence::{MAX_PERSISTENCE_WINDOW, exceedance_probability};
+use super::stationary::StationarySettings;
+use crate::error::ConfigError;
+use serde::Deserialize;
+
+/// Which parity noise covariance the detector whitens with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ParityNoise {
+    /// `V R Vᵀ` from the configured channel noise.
+    #[default]
+    Configured,
+    /// A slow estimate from fault-free samples, seeded from the configured one (see
+    /// [`super::noise_estimate`]).
+    Adaptive,
+}
+
+/// Fault detection and isolation settings. Sample counts are at the IMU rate.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FdiConfig {
+    /// Probability that a fault-free sample raises a (persistent, k-of-n) parity alarm. The
+    /// per-sample χ² threshold follows from it (see [`super::persistence`]): 1e-7 gives 0.36
+    /// false alarms per hour per sensor type at 1 kHz, the default 1e-10 gives 3.6e-4.
+    pub false_alarm_probability: f64,
+    /// Exceedances needed within the last `persistence_n` samples to declare a fault.
+    pub persistence_k: u32,
+    /// Length of the persistence window, 1..=16 samples.
+    pub persistence_n: u32,
+    /// GLT isolation margin: the winner's score must exceed every other signature's by this
+    /// much (twice the log-likelihood ratio; see [`super::isolation`]).
+    pub isolation_margin: f64,
+    /// `"configured"` or `"adaptive"` parity noise covariance.
+    pub parity_noise: ParityNoise,
+    /// Averaging length of the adaptive noise estimate, samples.
+    pub adaptive_window: u32,
+    /// Averaging length of the parity offset estimate, samples (0: no offset estimate; see
+    /// [`super::offset`]).
+    pub parity_offset_window: u32,
+    /// Learning phase at start, samples: the parity offset (and the adaptive noise) are learnt,
+    /// parity declarations are suspended. Ignored when neither estimate is in use.
+    pub learning_samples: u32,
+    /// Samples in a row at a converter rail before a channel counts as saturated.
+    pub saturation_samples: u32,
+    /// Identical counts in a row that make a channel stuck (see [`super::channel_health`]).
+    pub stuck_samples: u32,
+    /// Block length of the noise-outlier check, samples.
+    pub noise_window: u32,
+    /// A channel is noisy when its first-difference variance exceeds this multiple of the median
+    /// of the other channels'.
+    pub noise_ratio: f64,
+    /// Block length of the stationary detector, samples.
+    pub stationary_window: u32,
+    /// Largest per-axis standard deviation of the fused rate while stationary, rad/s.
+    pub stationary_rate_spread_rps: f64,
+    /// Largest per-axis standard deviation of the fused specific force while stationary, m/s².
+    pub stationary_force_spread_mps2: f64,
+    /// Largest mean fused rate while stationary, rad/s.
+    pub stationary_max_rate_rps: f64,
+    /// How much the departure of the isolated channel from the stationary reference must exceed
+    /// every other channel's (ratio of standard scores).
+    pub reference_ratio: f64,
+}
+
+impl Default for FdiConfig {
+    fn default() -> Self {
+        Self {
+            // 3.6e-4 persistent false alarms per hour per sensor type at 1 kHz; a 5σ step is still
+            // declared within 10 samples with probability 1 − 2e-5.
+            false_alarm_probability: 1e-10,
+            persistence_k: 3,
+            persistence_n: 5,
+            isolation_margin: 10.0,
+            parity_noise: ParityNoise::Configured,
+            adaptive_window: 10_000,
+            parity_offset_window: 60_000,
+            learning_samples: 1_000,
+            saturation_samples: 5,
+            stuck_samples: 20,
+            noise_window: 200,
+            noise_ratio: 25.0,
+            stationary_window: 200,
+            stationary_rate_spread_rps: 0.02,
+            stationary_force_spread_mps2: 0.2,
+            stationary_max_rate_rps: 0.05,
+            reference_ratio: 3.0,
+        }
+    }
+}
+
+/// Validated settings with the derived thresholds, ready for the per-sample path.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FdiSettings {
+    pub persistence_k: u32,
+    pub persistence_n: u32,
+    pub isolation_margin: f64,
+    pub parity_noise: ParityNoise,
+    pub adaptive_window: u32,
+    /// 0: no offset estimate.
+    pub parity_offset_window: u32,
+    /// Length of the learning phase (0 when neither the offset nor the adaptive noise is on).
+    pub learning_samples: u32,
+    pub health: HealthSettings,
+    pub stationary: StationarySettings,
+    pub reference_ratio: f64,
+    /// Per-sample exceedance probability α₁ behind the thresholds.
+    pub exceedance_probability: f64,
+    /// χ² threshold for each parity dimension (index m; entry 0 unused).
+    pub thresholds: [f64; MAX_PARITY + 1],
+    /// For each parity dimension m, E[T | T < threshold] / m for fault-free T ~ χ²(m): how much a
+    /// covariance estimate that skips the samples above the threshold falls short (index 0
+    /// unused). Equals P(m/2 + 1, x/2) / P(m/2, x/2) at the threshold x.
+    pub truncation: [f64; MAX_PARITY + 1],
+}
+
+fn positive(field: &str, v: f64) -> Result<(), ConfigError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(ConfigError::new(field, v, "must be finite and > 0"))
+    }
+}
+
+fn at_least(field: &str, v: u32, min: u32) -> Result<(), ConfigError> {
+    if v >= min {
+        Ok(())
+    } else {
+        Err(ConfigError::new(field, v, format!("must be >= {min}")))
+    }
+}
+
+impl FdiConfig {
+    /// Checks every field and derives the thresholds. Errors name the field relative to this
+    /// table (e.g. `persistence_k = 9: must be <= persistence_n (5)`).
+    pub fn settings(&self) -> Result<FdiSettings, ConfigError> {
+        let (k, n) = (self.persistence_k, self.persistence_n);
+        if !(1..=MAX_PERSISTENCE_WINDOW as u32).contains(&n) {
+            return Err(ConfigError::new(
+                "persistence_n",
+                n,
+                format!("must be in 1..={MAX_PERSISTENCE_WINDOW}"),
+            ));
+        }
+        at_least("persistence_k", k, 1)?;
+        if k > n {
+            return Err(ConfigError::new(
+                "persistence_k",
+                k,
+                format!("must be <= persistence_n ({n})"),
+            ));
+        }
+        let alpha = self.false_alarm_probability;
+        positive("false_alarm_probability", alpha)?;
+        let alpha1 = exceedance_probability(alpha, k, n).ok_or_else(|| {
+            ConfigError::new(
+                "false_alarm_probability",
+                alpha,
+                format!("must be below what {k}-of-{n} persistence can reach (use a value < 1e-3)"),
+            )
+        })?;
+        let mut thresholds = [f64::INFINITY; MAX_PARITY + 1];
+        for (m, t) in thresholds.iter_mut().enumerate().skip(1) {
+            *t = chi2_upper_quantile(m, alpha1)
+                .map_err(|e| ConfigError::new("false_alarm_probability", alpha, e.to_string()))?;
+        }
+        if !(self.isolation_margin.is_finite() && self.isolation_margin >= 0.0) {
+            return Err(ConfigError::new(
+                "isolation_margin",
+                self.isolation_margin,
+                "must be finite and >= 0",
+            ));
+        }
+        let mut truncation = [1.0; MAX_PARITY + 1];
+        for (m, k) in truncation.iter_mut().enumerate().skip(1) {
+            let half = thresholds[m] / 2.0;
+            let a = m as f64 / 2.0;
+            *k = regularized_gamma_p(a + 1.0, half) / regularized_gamma_p(a, half);
+        }
+        at_least("adaptive_window", self.adaptive_window, 10)?;
+        if self.parity_offset_window != 0 {
+            at_least("parity_offset_window", self.parity_offset_window, 10)?;
+        }
+        let learns = self.parity_offset_window != 0 || self.parity_noise == ParityNoise::Adaptive;
+        at_least("saturation_samples", self.saturation_samples, 1)?;
+        at_least("stuck_samples", self.stuck_samples, 2)?;
+        at_least("noise_window", self.noise_window, 10)?;
+        if !(self.noise_ratio.is_finite() && self.noise_ratio > 1.0) {
+            return Err(ConfigError::new(
+                "noise_ratio",
+                self.noise_ratio,
+                "must be finite and > 1",
+            ));
+        }
+        at_least("stationary_window", self.stationary_window, 10)?;
+        positive(
+            "stationary_rate_spread_rps",
+            self.stationary_rate_spread_rps,
+        )?;
+        positive(
+            "stationary_force_spread_mps2",
+            self.stationary_force_spread_mps2,
+        )?;
+        positive("stationary_max_rate_rps", self.stationary_max_rate_rps)?;
+        if !(self.reference_ratio.is_finite() && self.reference_ratio >= 1.0) {
+            return Err(ConfigError::new(
+                "reference_ratio",
+                self.reference_ratio,
+                "must be finite and >= 1",
+            ));
+        }
+        Ok(FdiSettings {
+            persistence_k: k,
+            persistence_n: n,
+            isolation_margin: self.isolation_margin,
+            parity_noise: self.parity_noise,
+            adaptive_window: self.adaptive_window,
+            parity_offset_window: self.parity_offset_window,
+            learning_samples: if learns { self.learning_samples } else { 0 },
+            health: HealthSettings {
+                saturation_samples: self.saturation_samples,
+                stuck_samples: self.stuck_samples,
+                noise_window: self.noise_window,
+                noise_ratio: self.noise_ratio,
+            },
+            stationary: StationarySettings {
+                window: self.stationary_window,
+                rate_spread: self.stationary_rate_spread_rps,
+                force_spread: self.stationary_force_spread_mps2,
+                max_rate: self.stationary_max_rate_rps,
+            },
+            reference_ratio: self.reference_ratio,
+            exceedance_probability: alpha1,
+            thresholds,
+            truncation,
+        })
+    }
+
+    /// Checks every field; errors name the field relative to this table.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        self.settings().map(|_| ())
+    }
+}

@@ -1,0 +1,363 @@
+//! Faults planned ahead: `gyro2:dead@5s` on the command line or `[[fault]]` entries of a scenario
+//! file, applied by the simulator at the first IMU tick at or after their device time.
+
+use serde::Deserialize;
+
+use crate::fault_command::{ChannelId, FaultCommand, FaultParseError, parse_kind, parse_number};
+
+/// A fault command and the device time (s since the simulator started) it takes effect.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScheduledFault {
+    pub at_s: f64,
+    pub command: FaultCommand,
+}
+
+fn check_time(token: impl FnOnce() -> String, at_s: f64) -> Result<f64, FaultParseError> {
+    if at_s.is_finite() && at_s >= 0.0 {
+        Ok(at_s)
+    } else {
+        Err(FaultParseError::new(
+            token(),
+            "must be a finite number of seconds >= 0",
+        ))
+    }
+}
+
+/// Parses a time like `5s`, `3.2s`, `250ms` or a bare number of seconds.
+pub fn parse_time_s(text: &str) -> Result<f64, FaultParseError> {
+    let token = || format!("time {text:?}");
+    let (number, scale) = if let Some(n) = text.strip_suffix("ms") {
+        (n, 1e-3)
+    } else if let Some(n) = text.strip_suffix('s') {
+        (n, 1.0)
+    } else {
+        (text, 1.0)
+    };
+    let value: f64 = number.parse().map_err(|_| {
+        FaultParseError::new(token(), "expected device seconds, e.g. 5s, 3.2s or 250ms")
+    })?;
+    check_time(token, value * scale)
+}
+
+impl ScheduledFault {
+    /// Parses `CHANNEL:KIND[=PARAM]@TIME`, e.g. `gyro2:dead@5s`, `accel1:bias=0.5@3.2s`.
+    pub fn parse(spec: &str) -> Result<Self, FaultParseError> {
+        Self::parse_inner(spec).map_err(|e| e.within(&format!("{spec:?}")))
+    }
+
+    fn parse_inner(spec: &str) -> Result<Self, FaultParseError> {
+        const FORM: &str =
+            "expected CHANNEL:KIND[=PARAM]@TIME, e.g. gyro2:dead@5s or accel1:bias=0.5@3.2s";
+        let Some((what, time)) = spec.rsplit_once('@') else {
+            return Err(FaultParseError::new("no \"@TIME\"", FORM));
+        };
+        let Some((channel, fault)) = what.split_once(':') else {
+            return Err(FaultParseError::new("no \"CHANNEL:\"", FORM));
+        };
+        let channel = ChannelId::parse(channel)?;
+        let (kind, param) = match fault.split_once('=') {
+            Some((k, p)) => (k, Some(p)),
+            None => (fault, None),
+        };
+        let kind = parse_kind(kind)?;
+        let param = param.map(|p| parse_number(kind, p)).transpose()?;
+        Ok(Self {
+            at_s: parse_time_s(time)?,
+            command: FaultCommand::new(channel, kind, param)?,
+        })
+    }
+}
+
+/// A scenario file: `[[fault]]` tables with `channel`, `kind`, `at_s` and optional `param`.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FaultFile {
+    #[serde(default)]
+    pub fault: Vec<FaultFileEntry>,
+}
+
+/// One `[[fault]]` table.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FaultFileEntry {
+    /// `gyro2`, `accel0`, ...
+    pub channel: String,
+    /// `dead`, `stuck`, `bias`, `ramp`, `noise`, `saturate`, `intermittent`, `clear`.
+    pub kind: String,
+    /// Device time, s since the simulator started.
+    pub at_s: f64,
+    /// Bias step, ramp rate, noise factor or intermittent period (SI units).
+    pub param: Option<f64>,
+}
+
+impl FaultFile {
+    /// Validates every entry; errors name the entry (`fault[i]`) and the offending field.
+    pub fn schedule(&self) -> Result<Vec<ScheduledFault>, FaultParseError> {
+        self.fault
+            .iter()
+            .enumerate()
+            .map(|(i, e)| {
+                let entry = || -> Result<ScheduledFault, FaultParseError> {
+                    let channel = ChannelId::parse(&e.channel)?;
+                    let kind = parse_kind(&e.kind)?;
+                    let at_s = check_time(|| format!("at_s = {}", e.at_s), e.at_s)?;
+                    Ok(ScheduledFault {
+                        at_s,
+                        command: FaultCommand::new(channel, kind, e.param)?,
+                    })
+                };
+                entry().map_err(|err| err.within(&format!("fault[{i}]")))
+            })
+            .collect()
+    }
+}
+
+/// Index of the first tick at or after `at_s` for ticks k/`imu_rate_hz` (a part per million of
+/// a tick of slack absorbs round-off, so `2.5` s at 1 kHz is tick 2500).
+pub fn tick_at(at_s: f64, imu_rate_hz: f64) -> u64 {
+    // Non-negative and finite after validation; the float-to-int cast saturates otherwise.
+    (at_s * imu_rate_hz - 1e-6).ceil().max(0.0) as u64
+}
+
+/// The planned faults in tick order, consumed as the simulator advances.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct FaultSchedule {
+    entries: Vec<(u64, FaultCommand)>,
+    next: usize,
+}
+
+impl FaultSchedule {
+    /// Orders `faults` by tick; faults due on the same tick keep their given order, so a later
+    /// entry for the same channel wins.
+    pub fn new(faults: &[ScheduledFault], imu_rate_hz: f64) -> Self {
+        let mut entries: Vec<(u64, FaultCommand)> = faults
+            .iter()
+            .map(|f| (tick_at(f.at_s, imu_rate_hz), f.command))
+            .collect();
+        entries.sort_by_key(|(tick, _)| *tick);
+        Self { entries, next: 0 }
+    }
+
+    /// The next command due at or before `tick`, if any; call until `None` each tick.
+    /// Allocation-free.
+    pub fn next_due(&mut self, tick: u64) -> Option<FaultCommand> {
+        let (due, command) = *self.entries.get(self.next)?;
+        if due > tick {
+            return None;
+        }
+        self.next += 1;
+        Some(command)
+    }
+
+    /// Commands not yet handed out.
+    pub fn remaining(&self) -> usize {
+        self.entries.len() - self.next
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use ipc_types::{SensorType, SimFault};
+    use proptest::prelude::*;
+
+    use super::*;
+
+    #[test]
+    fn specs_of_every_kind_parse() {
+        let cases: [(&str, SensorType, u8, SimFault, f64, f64); 7] = [
+            (
+                "gyro2:dead@5s",
+                SensorType::Gyro,
+                2,
+                SimFault::Dead,
+                0.0,
+                5.0,
+            ),
+            (
+                "accel1:bias=0.5@3.2s",
+                SensorType::Accel,
+                1,
+                SimFault::BiasStep,
+                0.5,
+                3.2,
+            ),
+            (
+                "gyro0:noise=10@2s",
+                SensorType::Gyro,
+                0,
+                SimFault::Noise,
+                10.0,
+                2.0,
+            ),
+            (
+                "gyro1:ramp=0.01@4s",
+                SensorType::Gyro,
+                1,
+                SimFault::Ramp,
+                0.01,
+                4.0,
+            ),
+            (
+                "accel3:intermittent=0.2@6s",
+                SensorType::Accel,
+                3,
+                SimFault::Intermittent,
+                0.2,
+                6.0,
+            ),
+            (
+                "gyro3:stuck@5",
+                SensorType::Gyro,
+                3,
+                SimFault::Stuck,
+                0.0,
+                5.0,
+            ),
+            (
+                "accel0:saturate@250ms",
+                SensorType::Accel,
+                0,
+                SimFault::Saturate,
+                0.0,
+                0.25,
+            ),
+        ];
+        for (spec, sensor, index, fault, param, at_s) in cases {
+            let s = ScheduledFault::parse(spec).unwrap_or_else(|e| panic!("{spec}: {e}"));
+            assert_eq!(s.command.channel, ChannelId { sensor, index }, "{spec}");
+            assert_eq!(s.command.fault, fault, "{spec}");
+            assert_eq!(s.command.param, param, "{spec}");
+            assert!((s.at_s - at_s).abs() < 1e-12, "{spec}");
+        }
+        let neg = ScheduledFault::parse("gyro1:bias=-0.02@1s").unwrap();
+        assert_eq!(neg.command.param, -0.02);
+    }
+
+    #[test]
+    fn bad_specs_name_the_offending_token() {
+        let cases = [
+            ("gyro2:dead", "no \"@TIME\""),
+            ("gyro2dead@5s", "no \"CHANNEL:\""),
+            ("gyro9x:dead@5s", "channel \"gyro9x\""),
+            ("gyro2:explode@5s", "fault \"explode\""),
+            ("gyro2:dead@xs", "time \"xs\""),
+            ("gyro2:dead@-1s", "time \"-1s\""),
+            ("gyro2:bias@5s", "bias"),
+            ("gyro2:bias=abc@5s", "bias STEP \"abc\""),
+            ("gyro2:noise=0.5@5s", "noise FACTOR = 0.5"),
+            ("gyro2:dead=1@5s", "dead \"1\""),
+        ];
+        for (spec, token) in cases {
+            let e = ScheduledFault::parse(spec).expect_err(spec);
+            assert!(e.token.starts_with(&format!("{spec:?}")), "{spec}: {e}");
+            assert!(e.token.contains(token), "{spec}: {e} lacks {token}");
+        }
+    }
+
+    #[test]
+    fn scenario_file_parses_and_errors_name_the_entry() {
+        let text = r#"
+            [[fault]]
+            channel = "gyro2"
+            kind = "dead"
+            at_s = 5.0
+
+            [[fault]]
+            channel = "accel1"
+            kind = "bias"
+            at_s = 3.2
+            param = 0.5
+        "#;
+        let file: FaultFile = toml::from_str(text).unwrap();
+        let s = file.schedule().unwrap();
+        assert_eq!(s.len(), 2);
+        assert_eq!(s[0].command.fault, SimFault::Dead);
+        assert_eq!(s[1].command.param, 0.5);
+        assert_eq!(s[1].at_s, 3.2);
+
+        let bad = FaultFile {
+            fault: vec![
+                file.fault[0].clone(),
+                FaultFileEntry {
+                    kind: "explode".into(),
+                    ..file.fault[0].clone()
+                },
+            ],
+        };
+        let e = bad.schedule().unwrap_err();
+        assert!(e.token.starts_with("fault[1]: fault \"explode\""), "{e}");
+        let bad = FaultFile {
+            fault: vec![FaultFileEntry {
+                at_s: f64::NAN,
+                ..file.fault[0].clone()
+            }],
+        };
+        assert!(bad.schedule().unwrap_err().token.contains("at_s = NaN"));
+        let bad = FaultFile {
+            fault: vec![FaultFileEntry {
+                param: None,
+                ..file.fault[1].clone()
+            }],
+        };
+        assert!(bad.schedule().unwrap_err().reason.contains("STEP"));
+
+        assert!(
+            toml::from_str::<FaultFile>(
+                "[[fault]]\nchannel = \"gyro0\"\nkind = \"dead\"\nat_s = 1\nwhen = 2\n"
+            )
+            .is_err()
+        );
+        assert!(
+            toml::from_str::<FaultFile>("")
+                .unwrap()
+                .schedule()
+                .unwrap()
+                .is_empty()
+        );
+    }
+
+    #[test]
+    fn fault_times_land_on_the_first_tick_at_or_after_them() {
+        assert_eq!(tick_at(2.5, 1000.0), 2500);
+        assert_eq!(tick_at(3.2, 1000.0), 3200);
+        assert_eq!(tick_at(0.0, 1000.0), 0);
+        assert_eq!(tick_at(2.5004, 1000.0), 2501);
+        assert_eq!(tick_at(0.1, 400.0), 40);
+        assert_eq!(tick_at(1.0 / 3.0, 300.0), 100);
+    }
+
+    proptest! {
+        #[test]
+        fn tick_at_is_the_first_sample_not_before_the_time(k in 0u64..10_000_000, rate in prop::sample::select(vec![100.0, 400.0, 1000.0, 2000.0, 8000.0])) {
+            // A time exactly on a sample maps to it; a time just after maps to the next one.
+            let t = k as f64 / rate;
+            prop_assert_eq!(tick_at(t, rate), k);
+            prop_assert_eq!(tick_at(t + 0.01 / rate, rate), k + 1);
+        }
+    }
+
+    #[test]
+    fn schedule_hands_out_commands_in_tick_order() {
+        let parse = |s: &str| ScheduledFault::parse(s).unwrap();
+        let faults = [
+            parse("gyro2:dead@5s"),
+            parse("gyro1:bias=0.1@1s"),
+            parse("gyro1:clear@1s"),
+            parse("accel0:stuck@2.0005s"),
+        ];
+        let mut s = FaultSchedule::new(&faults, 1000.0);
+        assert_eq!(s.remaining(), 4);
+        assert_eq!(s.next_due(999), None);
+        let a = s.next_due(1000).unwrap();
+        let b = s.next_due(1000).unwrap();
+        // Same tick: given order kept, so the clear comes last.
+        assert_eq!((a.fault, b.fault), (SimFault::BiasStep, SimFault::Clear));
+        assert_eq!(s.next_due(1000), None);
+        assert_eq!(s.next_due(2000), None);
+        assert_eq!(s.next_due(2001).unwrap().fault, SimFault::Stuck);
+        // A late call still delivers what is overdue.
+        assert_eq!(s.next_due(9000).unwrap().fault, SimFault::Dead);
+        assert_eq!(s.next_due(9000), None);
+        assert_eq!(s.remaining(), 0);
+    }
+}

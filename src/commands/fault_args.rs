@@ -1,0 +1,58 @@
+//! Timed faults from the command line (`--inject SPEC`, `--faults FILE`), checked against the
+//! configured sensor block.
+
+use anyhow::{Context, Result, anyhow};
+use rins_sim::fault_command::FaultParseError;
+use rins_sim::fault_schedule::{FaultFile, ScheduledFault};
+
+use crate::cli::FaultArgs;
+use crate::config::RinsConfig;
+
+/// Number of gyro and accelerometer channels of the configured sensor block.
+pub fn channel_counts(cfg: &RinsConfig) -> Result<(usize, usize)> {
+    let gyro = cfg
+        .fusion
+        .geometry
+        .gyro
+        .build()
+        .map_err(|e| anyhow!("{}", e.within("fusion.geometry.gyro")))?;
+    let accel = cfg
+        .fusion
+        .geometry
+        .accel
+        .build()
+        .map_err(|e| anyhow!("{}", e.within("fusion.geometry.accel")))?;
+    Ok((gyro.n(), accel.n()))
+}
+
+/// Every scheduled fault of `args`, each checked against a block of `n_gyro` gyros and
+/// `n_accel` accelerometers; errors name the option or file and the offending token.
+pub fn schedule(args: &FaultArgs, n_gyro: usize, n_accel: usize) -> Result<Vec<ScheduledFault>> {
+    let fitted = |f: &ScheduledFault| f.command.channel.check_fitted(n_gyro, n_accel);
+    let mut faults = Vec::new();
+    for spec in &args.inject {
+        let fault = ScheduledFault::parse(spec)
+            .and_then(|f| {
+                fitted(&f)
+                    .map_err(|e| e.within(&format!("{spec:?}")))
+                    .map(|()| f)
+            })
+            .map_err(|e: FaultParseError| anyhow!("--inject {e}"))?;
+        faults.push(fault);
+    }
+    if let Some(path) = &args.faults {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read fault file {}", path.display()))?;
+        let file: FaultFile = toml::from_str(&text)
+            .map_err(|e| anyhow!("{}: {}", path.display(), e.to_string().trim_end()))?;
+        let scheduled = file
+            .schedule()
+            .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        for (i, f) in scheduled.iter().enumerate() {
+            fitted(f)
+                .map_err(|e| anyhow!("{}: {}", path.display(), e.within(&format!("fault[{i}]"))))?;
+        }
+        faults.extend(scheduled);
+    }
+    Ok(faults)
+}
