@@ -107,6 +107,17 @@ impl RinsConfig {
         Ok(())
     }
 
+    /// The gyro and accelerometer geometries of the configured sensor block.
+    pub fn geometries(&self) -> Result<(rins_fusion::Geometry, rins_fusion::Geometry)> {
+        let build = |cfg: &rins_fusion::GeometryConfig, field: &str| {
+            cfg.build().map_err(|e| anyhow!("{}", e.within(field)))
+        };
+        Ok((
+            build(&self.fusion.geometry.gyro, "fusion.geometry.gyro")?,
+            build(&self.fusion.geometry.accel, "fusion.geometry.accel")?,
+        ))
+    }
+
     pub fn scenario_name(&self) -> &'static str {
         match self.sim.scenario {
             rins_sim::Scenario::Static => "static",

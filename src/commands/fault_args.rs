@@ -10,18 +10,7 @@ use crate::config::RinsConfig;
 
 /// Number of gyro and accelerometer channels of the configured sensor block.
 pub fn channel_counts(cfg: &RinsConfig) -> Result<(usize, usize)> {
-    let gyro = cfg
-        .fusion
-        .geometry
-        .gyro
-        .build()
-        .map_err(|e| anyhow!("{}", e.within("fusion.geometry.gyro")))?;
-    let accel = cfg
-        .fusion
-        .geometry
-        .accel
-        .build()
-        .map_err(|e| anyhow!("{}", e.within("fusion.geometry.accel")))?;
+    let (gyro, accel) = cfg.geometries()?;
     Ok((gyro.n(), accel.n()))
 }
 

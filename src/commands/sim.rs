@@ -1,6 +1,6 @@
 //! `rins sim`: the device simulator on a pseudo-terminal.
 
-use anyhow::{Result, anyhow, bail};
+use anyhow::{Result, bail};
 use rins_runtime::ipc::IpcSettings;
 use rins_runtime::shutdown::Shutdown;
 use rins_sim::Simulator;
@@ -25,18 +25,7 @@ pub fn run(args: &SimArgs) -> Result<()> {
         bail!("--duration {d}: must be a positive number of seconds");
     }
     // The simulated block carries the sensors the fusion geometry describes.
-    let gyro = cfg
-        .fusion
-        .geometry
-        .gyro
-        .build()
-        .map_err(|e| anyhow!("{}", e.within("fusion.geometry.gyro")))?;
-    let accel = cfg
-        .fusion
-        .geometry
-        .accel
-        .build()
-        .map_err(|e| anyhow!("{}", e.within("fusion.geometry.accel")))?;
+    let (gyro, accel) = cfg.geometries()?;
     let faults = fault_args::schedule(&args.faults, gyro.n(), accel.n())?;
     let sim = Simulator::new(&cfg.sim, gyro.axes(), accel.axes(), cfg.sim.seed)?;
     let shutdown = Shutdown::install()?;

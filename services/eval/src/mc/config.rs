@@ -94,11 +94,11 @@ pub struct McConfig {
     pub navigator: NavigatorConfig,
     /// Altimeter settings; `qnh_pa` is replaced by the simulator's (the altimeter is told QNH).
     pub altimeter: AltimeterConfig,
-    /// Calibrate each gyro channel's bias in the fuser from the navigator's static alignment
-    /// window (mean reading at rest) instead of leaving the whole bias to the navigator, which
-    /// estimates it on the fused body axes. The two are equivalent while every channel works;
-    /// after a reconfiguration the navigator's body-axis bias no longer matches the new channel
-    /// set, the per-channel one still does. Needs the vehicle parked for the window.
+    /// Measure each gyro channel's bias in the fuser at rest (its `rest_bias_s` window, as the
+    /// product does; default) instead of leaving the whole bias to the navigator, which estimates
+    /// it on the fused body axes. The two are equivalent while every channel works; after a
+    /// reconfiguration the navigator's body-axis bias no longer matches the new channel set, the
+    /// per-channel one still does. Needs the vehicle parked for the window.
     pub calibrate_gyro_channels_at_rest: bool,
 }
 
@@ -119,7 +119,7 @@ impl Default for McConfig {
             },
             navigator: NavigatorConfig::default(),
             altimeter: AltimeterConfig::default(),
-            calibrate_gyro_channels_at_rest: false,
+            calibrate_gyro_channels_at_rest: true,
         }
     }
 }
