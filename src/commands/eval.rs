@@ -25,9 +25,7 @@
 //! upper rail). The fault-free run is deterministic, so each faulted run starts from a copy of
 //! the fault-free fuser at the fault row.
 
-use std::io::Write;
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow};
 use ipc_types::ChannelState;
@@ -65,55 +63,6 @@ pub const BIAS_STEPS_SIGMA: [f64; 2] = [5.0, 20.0];
 pub struct NoiseFit {
     pub gyro_sigma_rps: f64,
     pub accel_sigma_mps2: f64,
-}
-
-/// A progress bar on stderr: `label [####....] done/total elapsed`, redrawn at most 10 times a
-/// second.
-pub struct Progress {
-    label: &'static str,
-    start: Instant,
-    last: Option<Instant>,
-}
-
-impl Progress {
-    pub fn new(label: &'static str) -> Self {
-        Self {
-            label,
-            start: Instant::now(),
-            last: None,
-        }
-    }
-
-    pub fn set(&mut self, done: usize, total: usize) {
-        let now = Instant::now();
-        if done < total
-            && self
-                .last
-                .is_some_and(|l| now - l < Duration::from_millis(100))
-        {
-            return;
-        }
-        self.last = Some(now);
-        let width = 30;
-        let filled = (done * width)
-            .checked_div(total)
-            .unwrap_or(width)
-            .min(width);
-        let mut err = std::io::stderr().lock();
-        let _ = write!(
-            err,
-            "\r{} [{}{}] {done}/{total} {:.1} s",
-            self.label,
-            "#".repeat(filled),
-            "-".repeat(width - filled),
-            self.start.elapsed().as_secs_f64()
-        );
-        let _ = err.flush();
-    }
-
-    pub fn finish(&mut self) {
-        let _ = writeln!(std::io::stderr());
-    }
 }
 
 /// The two redundant configurations.
@@ -681,7 +630,7 @@ fn evaluate(args: &EvalFdiArgs) -> Result<FdiReport> {
         .map(|(_, _, g)| 1 + 2 * g.n() * faults.len())
         .sum();
     let total_runs = runs_per_trial * entries.len();
-    let mut bar = Progress::new("eval fdi");
+    let mut bar = super::progress::Progress::new("eval fdi");
     bar.set(0, total_runs);
     let mut done = 0;
 

@@ -5,7 +5,7 @@ use anyhow::{Result, anyhow};
 use rins_eval::mc::config::DEFAULT_KILL_AT_S;
 use rins_eval::mc::{McConfig, run_monte_carlo};
 
-use super::eval::Progress;
+use super::progress::Progress;
 use crate::cli::McArgs;
 use crate::config;
 

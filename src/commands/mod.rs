@@ -8,6 +8,7 @@ mod geometry;
 mod inject;
 mod latency;
 mod mc;
+mod progress;
 mod readmit;
 mod service;
 mod sim;
