@@ -23,9 +23,11 @@ use crate::simulator::{Simulator, TickOutput, TruthSample};
 
 /// Frames of one tick at most: IMU, baro, mag, aux.
 const FRAMES_PER_TICK: usize = 4;
-/// How long a write may wait for the reader before the tick's bytes are dropped (a real line
-/// would overrun the receiver the same way).
-const WRITE_TIMEOUT: Duration = Duration::from_millis(2);
+/// How long a write may wait for the reader before the tick's bytes are dropped. The pty holds
+/// about 40 ms of frames; past that a real line would overrun the receiver. The simulator waits
+/// longer than a real device would, because it shares the processor with the pipeline it feeds: a
+/// stalled reader on a loaded machine delays frames (the sleeps catch up) instead of losing them.
+const WRITE_TIMEOUT: Duration = Duration::from_millis(100);
 
 pub struct SimOptions {
     /// Also expose the pseudo-terminal under this path (a stable name for acquisition).
