@@ -240,7 +240,9 @@ impl FusionConfig {
     }
 
     fn fdi_settings(&self) -> Result<FdiSettings, ConfigError> {
-        self.fdi.settings().map_err(|e| e.within("fdi"))
+        let mut settings = self.fdi.settings().map_err(|e| e.within("fdi"))?;
+        settings.timing_skew_samples = self.fdi.timing_skew_s * self.sample_rate_hz;
+        Ok(settings)
     }
 
     fn side_parts(

@@ -83,7 +83,8 @@ pub struct WindowResult {
     /// Time inside the window without a valid solution (fuser short of channels), s.
     pub unsolved_s: f64,
     /// Time inside the window with some channel left out of the solution (dead, or excluded by
-    /// the fuser's fault detection), s. In a fault-free flight this is false exclusion time.
+    /// the fuser's fault detection) or flagged (Suspect, detected-not-isolated), s. In a
+    /// fault-free flight this is false-alarm time.
     pub degraded_s: f64,
 }
 

@@ -1,7 +1,7 @@
 //! One simulated sensor block and the processing chain of the product run in-process on it:
 //! simulator → fuser → navigator, barometer → altimeter → navigator, magnetometer → navigator.
 
-use ipc_types::{MAX_CHANNELS, MAX_TEMPERATURES, NavMode};
+use ipc_types::{ChannelState, MAX_CHANNELS, MAX_TEMPERATURES, NavMode};
 use rins_acquisition::protocol::{ImuFrame, Payload};
 use rins_altimeter::AltitudeEstimator;
 use rins_fusion::{ImuFuser, ImuSample};
@@ -17,12 +17,19 @@ pub(crate) struct FusedSample {
     pub specific_force_mps2: [f64; 3],
     /// Enough healthy channels of both kinds.
     pub usable: bool,
-    /// Some channel of the frame did not enter the solution (dead, or excluded by the fuser).
+    /// Some channel of the frame did not enter the solution (dead, or excluded by the fuser), or
+    /// the fuser flags a channel Suspect or a detected-but-unisolated fault: in a fault-free
+    /// flight, a false alarm.
     pub degraded: bool,
 }
 
 fn full_mask(n: usize) -> u32 {
     if n >= 32 { u32::MAX } else { (1u32 << n) - 1 }
+}
+
+/// A channel not Ok, or a detected-but-unisolated fault.
+fn flagged(s: &rins_fusion::SensorStatus) -> bool {
+    s.detected_not_isolated || s.states[..s.n].iter().any(|&st| st != ChannelState::Ok)
 }
 
 /// The one call into the fuser, so that a change of its interface touches only this function.
@@ -47,7 +54,10 @@ pub(crate) fn fuse_frame(fuser: &mut ImuFuser, imu: &ImuFrame) -> FusedSample {
         rate_rps: fused.rate,
         specific_force_mps2: fused.specific_force,
         usable: rins_navigator::navigator::fused_sample_usable(fused.flags()),
-        degraded: fused.gyro_mask != full_mask(n_gyro) || fused.accel_mask != full_mask(n_accel),
+        degraded: fused.gyro_mask != full_mask(n_gyro)
+            || fused.accel_mask != full_mask(n_accel)
+            || flagged(&fused.gyro_status)
+            || flagged(&fused.accel_status),
     }
 }
 
@@ -133,7 +143,7 @@ impl Pipeline {
         self.solution.as_ref()
     }
 
-    /// Some channel of the last frame was left out of the solution.
+    /// Some channel of the last frame was left out of the solution or flagged.
     pub fn degraded(&self) -> bool {
         self.degraded
     }

@@ -69,6 +69,9 @@ pub struct KillStats {
     pub faulted: WindowStats,
     /// Runs whose faulted flight had no solution at the end: navigation lost.
     pub lost_runs: usize,
+    /// Attitude difference to the no-fault flight over the first second after the kill, ° (over
+    /// the runs that had both solutions).
+    pub reconfiguration_jump_deg: Stat,
 }
 
 /// One system over all runs.
@@ -225,6 +228,12 @@ fn system_report(
             nominal: window_stats(&kills.iter().map(|k| k.nominal).collect::<Vec<_>>()),
             faulted: window_stats(&faulted),
             lost_runs: faulted.iter().filter(|w| w.final_errors.is_none()).count(),
+            reconfiguration_jump_deg: Stat::of(
+                &kills
+                    .iter()
+                    .filter_map(|k| k.reconfiguration_jump_deg)
+                    .collect::<Vec<_>>(),
+            ),
         }
     });
     SystemReport {
@@ -296,7 +305,7 @@ impl McReport {
         );
         let _ = writeln!(
             s,
-            "Gyro bias: {}. Fault-free flights with a channel left out of the solution (false exclusion): \
+            "Gyro bias: {}. Fault-free flights with a channel flagged or left out of the solution (false alarm): \
              {} for {} s on average, {} for {} s.\n",
             if self.gyro_channels_calibrated_at_rest {
                 "per channel in the fuser, from the static alignment window"
@@ -460,6 +469,24 @@ impl McReport {
         row(s, "RMS horizontal after the kill, m", &|w| {
             lost_or(w, w.rms.horizontal_m)
         });
+        let jump = |k: &KillStats| {
+            let j = k.reconfiguration_jump_deg;
+            if j.n == 0 {
+                "no solution".to_string()
+            } else {
+                format!("{} (max {})", num(j.mean), num(j.max))
+            }
+        };
+        let _ = writeln!(
+            s,
+            "\nReconfiguration: attitude difference to the no-fault flight over the first {} s after \
+             the kill, ° (mean, max over runs): {} {}; {} {}.",
+            num(super::run::JUMP_WINDOW_S),
+            r.label,
+            jump(rk),
+            o.label,
+            jump(ok),
+        );
         let _ = writeln!(
             s,
             "\n\"lost\": the fuser reports too few gyro channels, the navigator cannot integrate and \

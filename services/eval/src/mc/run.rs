@@ -14,6 +14,27 @@ pub struct KillRun {
     pub nominal: WindowResult,
     /// The same flight, same seed, with the channel dead from the kill time on.
     pub faulted: WindowResult,
+    /// Largest attitude difference between the two flights over the first
+    /// [`JUMP_WINDOW_S`] after the kill, °: what the reconfiguration itself does to the solution
+    /// (`None` when either flight had no solution then).
+    pub reconfiguration_jump_deg: Option<f64>,
+}
+
+/// Span after the kill over which the reconfiguration jump is measured, s: long enough for a
+/// step in the fused rate to show in the attitude, short enough that the two flights' different
+/// noise has not yet drifted apart (the angle random walk of the difference is ~0.01° per √s).
+pub const JUMP_WINDOW_S: f64 = 1.0;
+
+/// Angle between two attitudes given as `[w, x, y, z]` unit quaternions, °.
+fn attitude_difference_deg(a: &[f64; 4], b: &[f64; 4]) -> f64 {
+    let dot = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| x * y)
+        .sum::<f64>()
+        .abs()
+        .min(1.0);
+    (2.0 * dot.acos()).to_degrees()
 }
 
 /// One system in one run.
@@ -52,6 +73,8 @@ pub(crate) fn run_system(
     let mut nominal: Option<Window> = None;
     let mut aligned_at_s = None;
     let mut fork: Option<(Pipeline, Window, Window)> = None;
+    let jump_ticks = (JUMP_WINDOW_S / tick_s).round() as u64;
+    let mut jump: Option<f64> = None;
 
     for k in 0..prepared.ticks {
         if Some(k) == kill_tick && aligned_at_s.is_some() {
@@ -82,6 +105,13 @@ pub(crate) fn run_system(
         }
         if let Some((faulted, nominal_after, faulted_window)) = fork.as_mut() {
             faulted.step();
+            if let (Some(kill), Some(a), Some(b)) =
+                (kill_tick, pipeline.solution(), faulted.solution())
+                && k < kill + jump_ticks
+            {
+                let d = attitude_difference_deg(&a.quaternion, &b.quaternion);
+                jump = Some(jump.map_or(d, |j: f64| j.max(d)));
+            }
             nominal_after.push(
                 pipeline.solution(),
                 pipeline.degraded(),
@@ -104,6 +134,7 @@ pub(crate) fn run_system(
         kill: fork.map(|(_, n, f)| KillRun {
             nominal: n.result(),
             faulted: f.result(),
+            reconfiguration_jump_deg: jump,
         }),
     })
 }
@@ -116,4 +147,20 @@ pub(crate) fn run_pair(prepared: &Prepared, seed: u64) -> Result<RunRecord, McEr
         redundant: run_system(prepared, redundant, seed)?,
         orthogonal: run_system(prepared, orthogonal, seed)?,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::attitude_difference_deg;
+
+    #[test]
+    fn attitude_difference_of_a_small_rotation() {
+        let h = 0.1f64.to_radians() / 2.0;
+        let a = [1.0, 0.0, 0.0, 0.0];
+        let b = [h.cos(), 0.0, 0.0, h.sin()];
+        assert!((attitude_difference_deg(&a, &b) - 0.1).abs() < 1e-9);
+        // q and −q are the same attitude.
+        let minus_b = b.map(|c| -c);
+        assert!((attitude_difference_deg(&a, &minus_b) - 0.1).abs() < 1e-9);
+    }
 }

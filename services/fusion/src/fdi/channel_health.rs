@@ -9,7 +9,9 @@
 //!   window — a frozen converter on a moving or noisy signal.
 //! - **Noisy**: over blocks of `noise_window` samples, the mean of (Δz_i/σ_i)² (first differences,
 //!   so a steady signal or bias does not count) more than `noise_ratio` times the median of the
-//!   other channels'. A verdict is available at each block end, so a noise fault is isolated
+//!   other channels' — of the channels along nearly the same axis (within [`PEER_ANGLE_DEG`]) when
+//!   there are at least two, since airframe vibration is not isotropic (a quadrotor's is strongest
+//!   along the thrust axis) and a channel must not be blamed for the axis it measures. A verdict is available at each block end, so a noise fault is isolated
 //!   within two windows.
 //!
 //! **Stuck false-alarm arithmetic.** A fault-free channel repeats its count L times in a row with
@@ -63,12 +65,33 @@ pub struct HealthFindings {
     pub noise_verdict: bool,
 }
 
+/// Channels whose axes are at most this far apart (either sense) are compared with each other in
+/// the noise-outlier check, °.
+pub const PEER_ANGLE_DEG: f64 = 30.0;
+
+/// For every channel, the mask of the other channels within [`PEER_ANGLE_DEG`] of its axis.
+fn peer_masks(axes: &[[f64; 3]]) -> [u32; MAX_CHANNELS] {
+    let cos_limit = PEER_ANGLE_DEG.to_radians().cos();
+    let mut peers = [0u32; MAX_CHANNELS];
+    for (i, a) in axes.iter().enumerate().take(MAX_CHANNELS) {
+        for (j, b) in axes.iter().enumerate().take(MAX_CHANNELS) {
+            let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+            if i != j && dot.abs() >= cos_limit {
+                peers[i] |= 1 << j;
+            }
+        }
+    }
+    peers
+}
+
 /// Run lengths and noise accumulators of the channels of one sensor type.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ChannelHealth {
     n: usize,
     settings: HealthSettings,
     inv_variance: [f64; MAX_CHANNELS],
+    /// Channels along nearly the same axis, per channel (see [`PEER_ANGLE_DEG`]).
+    peers: [u32; MAX_CHANNELS],
     last_counts: [i16; MAX_CHANNELS],
     /// Identical counts in a row ending now (0 = no history).
     same_run: [u32; MAX_CHANNELS],
@@ -83,12 +106,18 @@ pub struct ChannelHealth {
 }
 
 impl ChannelHealth {
-    /// Health state of `n` channels with configured noise variances `variances` (SI²).
-    pub fn new(n: usize, variances: &[f64; MAX_CHANNELS], settings: HealthSettings) -> Self {
+    /// Health state of the channels along `axes` (unit vectors, one per channel) with configured
+    /// noise variances `variances` (SI²).
+    pub fn new(
+        axes: &[[f64; 3]],
+        variances: &[f64; MAX_CHANNELS],
+        settings: HealthSettings,
+    ) -> Self {
         Self {
-            n: n.min(MAX_CHANNELS),
+            n: axes.len().min(MAX_CHANNELS),
             settings,
             inv_variance: variances.map(|v| if v > 0.0 { 1.0 / v } else { 0.0 }),
+            peers: peer_masks(axes),
             last_counts: [0; MAX_CHANNELS],
             same_run: [0; MAX_CHANNELS],
             rail_run: [0; MAX_CHANNELS],
@@ -168,7 +197,8 @@ impl ChannelHealth {
     }
 
     /// Channels whose mean normalised squared difference over the block exceeds `noise_ratio`
-    /// times the median of the other eligible channels' (at least two others needed).
+    /// times the median of the other eligible channels' (at least two others needed): its peers
+    /// along the same axis when two or more are eligible, otherwise all.
     fn noise_outliers(&self, usable: u32) -> u32 {
         let min_count = (self.settings.noise_window / 2).max(1);
         let mut level = [0.0; MAX_CHANNELS];
@@ -184,9 +214,15 @@ impl ChannelHealth {
             if eligible & (1 << i) == 0 {
                 continue;
             }
+            let peers = self.peers[i] & eligible;
+            let compared = if peers.count_ones() >= 2 {
+                peers
+            } else {
+                eligible & !(1 << i)
+            };
             let mut others = [0.0; MAX_CHANNELS];
             let mut k = 0;
-            for j in (0..self.n).filter(|&j| j != i && eligible & (1 << j) != 0) {
+            for j in (0..self.n).filter(|&j| compared & (1 << j) != 0) {
                 others[k] = level[j];
                 k += 1;
             }
@@ -216,5 +252,78 @@ impl ChannelHealth {
             self.diff_sum[channel] = 0.0;
             self.diff_count[channel] = 0;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+    use rand_distr::{Distribution, StandardNormal};
+
+    const SETTINGS: HealthSettings = HealthSettings {
+        saturation_samples: 5,
+        stuck_samples: 20,
+        noise_window: 200,
+        noise_ratio: 25.0,
+    };
+
+    /// Noise verdict after one window of white noise with per-channel σ `sigma` (configured σ 1).
+    fn noisy_after_a_window(axes: &[[f64; 3]], sigma: &[f64]) -> u32 {
+        let mut health = ChannelHealth::new(axes, &[1.0; MAX_CHANNELS], SETTINGS);
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let usable = (1u32 << axes.len()) - 1;
+        for _ in 0..SETTINGS.noise_window {
+            let mut z = [0.0; MAX_CHANNELS];
+            let mut counts = [0i16; MAX_CHANNELS];
+            for i in 0..axes.len() {
+                let e: f64 = StandardNormal.sample(&mut rng);
+                z[i] = sigma[i] * e;
+                counts[i] = (z[i] * 100.0).round() as i16;
+            }
+            let found = health.check(&counts[..axes.len()], &z, usable);
+            if found.noise_verdict {
+                return found.noisy;
+            }
+        }
+        panic!("no verdict within one window");
+    }
+
+    fn three_triads() -> Vec<[f64; 3]> {
+        (0..3)
+            .flat_map(|_| [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+            .collect()
+    }
+
+    #[test]
+    fn vibration_along_one_axis_is_not_blamed_on_its_channels() {
+        // Every z channel sees 6× the noise of the x/y channels (variance 36 > 25 × the median
+        // of all others): compared with their z peers they are alike.
+        let sigma = [1.0, 1.0, 6.0, 1.0, 1.0, 6.0, 1.0, 1.0, 6.0];
+        assert_eq!(noisy_after_a_window(&three_triads(), &sigma), 0);
+    }
+
+    #[test]
+    fn a_noisy_channel_stands_out_among_its_peers() {
+        let mut sigma = [1.0, 1.0, 6.0, 1.0, 1.0, 6.0, 1.0, 1.0, 6.0];
+        sigma[5] = 60.0;
+        assert_eq!(noisy_after_a_window(&three_triads(), &sigma), 1 << 5);
+    }
+
+    #[test]
+    fn without_peers_every_other_channel_is_the_reference() {
+        // Seed pyramid: no two axes within 30°, so each channel is compared with all others.
+        let a = 28.7f64.to_radians();
+        let axes: Vec<[f64; 3]> = (0..4)
+            .map(|i| {
+                let b = (45.0 + 90.0 * i as f64).to_radians();
+                [a.cos() * b.cos(), a.cos() * b.sin(), a.sin()]
+            })
+            .collect();
+        assert_eq!(peer_masks(&axes)[..4], [0; 4]);
+        assert_eq!(noisy_after_a_window(&axes, &[1.0, 1.0, 10.0, 1.0]), 1 << 2);
+        let peers = peer_masks(&three_triads());
+        assert_eq!(peers[2], (1 << 5) | (1 << 8));
     }
 }

@@ -65,6 +65,13 @@ pub struct FdiConfig {
     /// How much the departure of the isolated channel from the stationary reference must exceed
     /// every other channel's (ratio of standard scores).
     pub reference_ratio: f64,
+    /// Channel error proportional to the measured quantity (scale factor and misalignment
+    /// uncertainty between channels), as a fraction of |fused value|: adds (f·|x|)² to every
+    /// channel's variance in the parity test, so fast manoeuvres do not read as faults.
+    pub motion_noise_fraction: f64,
+    /// Uncertainty of the sampling instants between channels, s: adds (τ·|dx/dt|)² to every
+    /// channel's variance in the parity test (units on separate clocks; 0 for one converter).
+    pub timing_skew_s: f64,
 }
 
 impl Default for FdiConfig {
@@ -89,6 +96,8 @@ impl Default for FdiConfig {
             stationary_force_spread_mps2: 0.2,
             stationary_max_rate_rps: 0.05,
             reference_ratio: 3.0,
+            motion_noise_fraction: 0.0,
+            timing_skew_s: 0.0,
         }
     }
 }
@@ -108,6 +117,11 @@ pub struct FdiSettings {
     pub health: HealthSettings,
     pub stationary: StationarySettings,
     pub reference_ratio: f64,
+    /// See [`FdiConfig::motion_noise_fraction`].
+    pub motion_noise_fraction: f64,
+    /// [`FdiConfig::timing_skew_s`] in samples; set by the fuser, which knows the sample rate
+    /// (0 from [`FdiConfig::settings`]).
+    pub timing_skew_samples: f64,
     /// Per-sample exceedance probability α₁ behind the thresholds.
     pub exceedance_probability: f64,
     /// χ² threshold for each parity dimension (index m; entry 0 unused).
@@ -213,7 +227,25 @@ impl FdiConfig {
                 "must be finite and >= 1",
             ));
         }
+        if !(self.motion_noise_fraction.is_finite()
+            && (0.0..1.0).contains(&self.motion_noise_fraction))
+        {
+            return Err(ConfigError::new(
+                "motion_noise_fraction",
+                self.motion_noise_fraction,
+                "must be in [0, 1)",
+            ));
+        }
+        if !(self.timing_skew_s.is_finite() && (0.0..=1.0).contains(&self.timing_skew_s)) {
+            return Err(ConfigError::new(
+                "timing_skew_s",
+                self.timing_skew_s,
+                "must be in [0, 1] s",
+            ));
+        }
         Ok(FdiSettings {
+            motion_noise_fraction: self.motion_noise_fraction,
+            timing_skew_samples: 0.0,
             persistence_k: k,
             persistence_n: n,
             isolation_margin: self.isolation_margin,

@@ -120,6 +120,10 @@ pub struct SensorMonitor {
     seen: u64,
     reference: ChannelReference,
     status: SensorStatus,
+    /// The previous solution, for the rate of change in [`Self::motion_variance`].
+    last_x: [f64; 3],
+    /// Channel variance the motion adds now (see [`FdiSettings::motion_noise_fraction`]).
+    motion_variance: f64,
 }
 
 impl SensorMonitor {
@@ -141,6 +145,7 @@ impl SensorMonitor {
             .then(|| AdaptiveParityNoise::new(settings.adaptive_window));
         let offset = (settings.parity_offset_window > 0)
             .then(|| ParityOffset::new(settings.parity_offset_window));
+        let health = ChannelHealth::new(geometry.axes(), &variances, settings.health);
         let mut monitor = Self {
             sensor,
             geometry,
@@ -155,7 +160,7 @@ impl SensorMonitor {
             persistence: Persistence::new(settings.persistence_k, settings.persistence_n),
             window: ParityWindow::default(),
             episode: 0,
-            health: ChannelHealth::new(n, &variances, settings.health),
+            health,
             noisy_suspect: 0,
             adaptive,
             offset,
@@ -166,6 +171,8 @@ impl SensorMonitor {
                 sensor == SensorType::Gyro,
             ),
             status,
+            last_x: [0.0; 3],
+            motion_variance: 0.0,
         };
         monitor.reconfigure();
         monitor
@@ -192,11 +199,20 @@ impl SensorMonitor {
             self.reconfigure();
         }
 
+        // The solution before the test sets the motion's share of the noise for this sample.
+        let before_test = self.solver.as_ref().map(|s| (s.mask(), s.solve(z)));
+        if let Some((_, (x, _))) = &before_test {
+            self.motion_variance = motion_variance(&self.settings, x, &self.last_x);
+        }
         let (t, candidates, learning) = self.parity_test(z, stationary);
 
         let estimate = match &self.solver {
             Some(solver) => {
-                let (x, var) = solver.solve(z);
+                let (x, var) = match before_test {
+                    Some((mask, solution)) if mask == solver.mask() => solution,
+                    _ => solver.solve(z),
+                };
+                self.last_x = x;
                 SensorEstimate {
                     x,
                     var,
@@ -297,6 +313,17 @@ impl SensorMonitor {
                 *v -= m;
             }
         }
+        // The motion's share of the channel noise inflates the parity noise uniformly (V has
+        // orthonormal rows); the test and the estimates see the parity scaled back to the
+        // motion-free noise, so the adaptive estimate does not learn the manoeuvres.
+        let base = space.mean_noise_variance();
+        let inflation = if base > 0.0 {
+            1.0 + self.motion_variance / base
+        } else {
+            1.0
+        };
+        let scale = inflation.sqrt().recip();
+        p.iter_mut().take(dim).for_each(|v| *v *= scale);
         let mut pw = [0.0; MAX_PARITY];
         let t = space.whiten(&p, &mut pw);
         let exceeded = t > self.threshold;
@@ -540,4 +567,16 @@ impl SensorMonitor {
     pub fn sensor(&self) -> SensorType {
         self.sensor
     }
+}
+
+/// Channel variance added by the motion: `(f·|x|)² + (τ·|x − x_prev|)²`, τ in samples.
+fn motion_variance(settings: &FdiSettings, x: &[f64; 3], last: &[f64; 3]) -> f64 {
+    let norm2 = |v: [f64; 3]| v.iter().map(|c| c * c).sum::<f64>();
+    let f = settings.motion_noise_fraction;
+    let tau = settings.timing_skew_samples;
+    if f == 0.0 && tau == 0.0 {
+        return 0.0;
+    }
+    let change = [x[0] - last[0], x[1] - last[1], x[2] - last[2]];
+    f * f * norm2(*x) + tau * tau * norm2(change)
 }

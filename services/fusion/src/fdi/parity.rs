@@ -187,6 +187,19 @@ impl ParitySpace {
         true
     }
 
+    /// Mean variance of the parity noise in use, `tr(L Lᵀ) / m` (0 without parity). V has
+    /// orthonormal rows, so a variance v added to every channel adds v to this.
+    pub fn mean_noise_variance(&self) -> f64 {
+        if self.dim == 0 {
+            return 0.0;
+        }
+        let trace: f64 = self.factor[..self.dim]
+            .iter()
+            .map(|row| row[..self.dim].iter().map(|v| v * v).sum::<f64>())
+            .sum();
+        trace / self.dim as f64
+    }
+
     /// Raw parity `p = V z` into `p[..m]` (z indexed by channel; inactive entries never read).
     pub fn parity(&self, z: &[f64; MAX_CHANNELS], p: &mut [f64; MAX_PARITY]) {
         for (pr, row) in p.iter_mut().zip(&self.basis).take(self.dim) {

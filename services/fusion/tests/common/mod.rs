@@ -36,6 +36,8 @@ pub enum Fault {
     Noise(f64),
     /// Flagged invalid.
     Dead,
+    /// Scale-factor error: reads (1 + k) times the true projection.
+    Scale(f64),
 }
 
 pub struct Rig {
@@ -137,6 +139,7 @@ impl Rig {
             match self.faults[i] {
                 Fault::Bias(b) => value += b,
                 Fault::Noise(k) => sigma *= k,
+                Fault::Scale(k) => value *= 1.0 + k,
                 _ => {}
             }
             value += sigma * noise;

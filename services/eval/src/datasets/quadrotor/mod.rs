@@ -13,7 +13,9 @@
 
 pub mod align;
 pub mod frame;
+pub mod lever_arm;
 pub mod projection;
+pub mod subrow;
 
 use std::path::{Path, PathBuf};
 
@@ -69,6 +71,9 @@ pub struct ImuSeries {
     /// Rows this unit's data lags the reference IMU (positive: it records the same motion later);
     /// sample j of every series in the trial is the same instant.
     pub lag_rows: i64,
+    /// Smallest and largest residual lag (rows, fractional) removed by resampling after the
+    /// whole-row alignment (see [`subrow`]); zero for the reference.
+    pub residual_lag_rows: [f64; 2],
     /// Rows of the file whose timestamp step is not one period (repeated or skipped timestamps).
     pub timestamp_glitches: usize,
     /// The aligned samples; every series of a trial has the same length and times.
@@ -381,11 +386,25 @@ pub fn load_trial(path: &Path) -> Result<Trial, DatasetError> {
             ImuSeries {
                 imu: series.imu,
                 lag_rows: lag,
+                residual_lag_rows: [0.0; 2],
                 timestamp_glitches: series.glitches,
                 samples,
             }
         })
         .collect();
+    let mut imus = imus;
+    let reference_rate = rate_magnitude(&imus[0].samples);
+    for series in imus.iter_mut().skip(1) {
+        let lag = subrow::residual_lag(&reference_rate, &rate_magnitude(&series.samples));
+        let lo = lag.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = lag.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        series.samples = subrow::resample(&series.samples, &lag);
+        series.residual_lag_rows = [lo, hi];
+        notes.push(format!(
+            "IMU_{}: residual lag {lo:+.2}..{hi:+.2} rows removed by resampling",
+            series.imu
+        ));
+    }
     let trimmed = reference.samples.len() - times.len();
     if trimmed > 0 {
         notes.push(format!(

@@ -266,6 +266,7 @@ mod tests {
             .map(|(k, r)| ImuSeries {
                 imu: k + 1,
                 lag_rows: 0,
+                residual_lag_rows: [0.0; 2],
                 timestamp_glitches: 0,
                 samples: reference
                     .iter()
