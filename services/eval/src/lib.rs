@@ -3,11 +3,14 @@
 //!
 //! - [`mc`]: Monte Carlo comparison of the redundant skewed block with an orthogonal triad built
 //!   from the same sensors, with and without a dead gyro channel.
+//! - [`fdi`]: fault detection and isolation on the real quadrotor recordings (false alarms, and
+//!   faults injected into the data).
 //! - [`datasets`]: loaders of recorded data sets (the four-IMU quadrotor flights).
 //! - [`installation`]: relative rotation between IMUs from paired rate vectors (Wahba's problem).
 //! - [`stats`]: mean, 2σ and RMS helpers.
 
 pub mod datasets;
+pub mod fdi;
 pub mod installation;
 pub mod mc;
 pub mod stats;

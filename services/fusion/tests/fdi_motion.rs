@@ -8,18 +8,23 @@ use common::{Fault, GYRO_LSB, GYRO_SIGMA, Rig, pyramid4};
 use ipc_types::SensorType;
 use rins_fusion::fdi::FdiConfig;
 
-/// Alarmed samples over 2 s of a rate of magnitude `rate` rad/s whose direction sweeps (a
-/// constant one would be learnt as a parity offset), channel 0 reading 2 % high.
-fn alarms_in_a_fast_turn(config: &FdiConfig, rate: f64) -> usize {
-    let mut rig = Rig::new(
+/// The seed pyramid's gyros with exact (unquantised) values.
+fn pyramid_gyros(config: &FdiConfig, seed: u64) -> Rig {
+    Rig::new(
         SensorType::Gyro,
         pyramid4(),
         GYRO_SIGMA,
         GYRO_LSB,
         false,
         config,
-        7,
-    );
+        seed,
+    )
+}
+
+/// Alarmed samples over 2 s of a rate of magnitude `rate` rad/s whose direction sweeps (a
+/// constant one would be learnt as a parity offset), channel 0 reading 2 % high.
+fn alarms_in_a_fast_turn(config: &FdiConfig, rate: f64) -> usize {
+    let mut rig = pyramid_gyros(config, 7);
     rig.learn([0.0; 3], false);
     rig.inject(0, Fault::Scale(0.05));
     (0..2000)
@@ -58,15 +63,7 @@ fn declared_disagreement_still_leaves_a_bias_visible_at_rest() {
         timing_skew_s: 0.006,
         ..FdiConfig::default()
     };
-    let mut rig = Rig::new(
-        SensorType::Gyro,
-        pyramid4(),
-        GYRO_SIGMA,
-        GYRO_LSB,
-        false,
-        &declared,
-        3,
-    );
+    let mut rig = pyramid_gyros(&declared, 3);
     rig.learn([0.0; 3], false);
     rig.inject(1, Fault::Bias(9.0 * GYRO_SIGMA));
     let detected = (1..=10).any(|_| rig.step([0.0; 3], false).1.detected_not_isolated);

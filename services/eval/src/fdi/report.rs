@@ -1,0 +1,270 @@
+//! The evaluation's report: tallies, per-trial rows, and the text tables.
+
+use std::path::PathBuf;
+
+use serde::Serialize;
+
+use super::NoiseFit;
+use super::runs::Outcome;
+use crate::datasets::quadrotor::IMU_RATE_HZ;
+
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct Tally {
+    pub faults_injected: usize,
+    pub detected: usize,
+    pub isolated: usize,
+    pub correctly_isolated: usize,
+    #[serde(skip)]
+    pub detection_delays: Vec<usize>,
+    #[serde(skip)]
+    pub isolation_delays: Vec<usize>,
+    pub detection_delay_samples_p50: Option<f64>,
+    pub detection_delay_samples_max: Option<usize>,
+    pub detection_delay_ms_p50: Option<f64>,
+    pub detection_delay_ms_max: Option<f64>,
+    pub isolation_delay_samples_p50: Option<f64>,
+    pub isolation_delay_samples_max: Option<usize>,
+    pub isolation_delay_ms_p50: Option<f64>,
+    pub isolation_delay_ms_max: Option<f64>,
+}
+
+fn median(v: &[usize]) -> Option<f64> {
+    let mut s = v.to_vec();
+    s.sort_unstable();
+    let n = s.len();
+    match n {
+        0 => None,
+        _ if n % 2 == 1 => Some(s[n / 2] as f64),
+        _ => Some((s[n / 2 - 1] + s[n / 2]) as f64 / 2.0),
+    }
+}
+
+fn ms(samples: f64) -> f64 {
+    samples * 1000.0 / IMU_RATE_HZ
+}
+
+impl Tally {
+    pub fn add(&mut self, o: &Outcome, channel: usize) {
+        self.faults_injected += 1;
+        if let Some(d) = o.detected {
+            self.detected += 1;
+            self.detection_delays.push(d);
+        }
+        if let Some((d, x)) = o.isolated {
+            self.isolated += 1;
+            self.isolation_delays.push(d);
+            self.correctly_isolated += usize::from(x == channel);
+        }
+    }
+
+    pub fn merge(&mut self, other: &Tally) {
+        self.faults_injected += other.faults_injected;
+        self.detected += other.detected;
+        self.isolated += other.isolated;
+        self.correctly_isolated += other.correctly_isolated;
+        self.detection_delays.extend(&other.detection_delays);
+        self.isolation_delays.extend(&other.isolation_delays);
+    }
+
+    pub fn finish(&mut self) {
+        self.detection_delay_samples_p50 = median(&self.detection_delays);
+        self.detection_delay_samples_max = self.detection_delays.iter().copied().max();
+        self.detection_delay_ms_p50 = self.detection_delay_samples_p50.map(ms);
+        self.detection_delay_ms_max = self.detection_delay_samples_max.map(|d| ms(d as f64));
+        self.isolation_delay_samples_p50 = median(&self.isolation_delays);
+        self.isolation_delay_samples_max = self.isolation_delays.iter().copied().max();
+        self.isolation_delay_ms_p50 = self.isolation_delay_samples_p50.map(ms);
+        self.isolation_delay_ms_max = self.isolation_delay_samples_max.map(|d| ms(d as f64));
+    }
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct FaultBreakdown {
+    pub configuration: &'static str,
+    pub sensor: &'static str,
+    pub fault: String,
+    #[serde(flatten)]
+    pub tally: Tally,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct TrialReport {
+    pub trial: String,
+    pub rows: usize,
+    pub seconds: f64,
+    pub configuration: &'static str,
+    /// Alarm episodes without any fault, gyro and accel.
+    pub false_alarms: [usize; 2],
+    /// Episodes of genuine over-range (channels Suspect, saturated), gyro and accel.
+    pub over_range: [usize; 2],
+    pub false_alarm_samples: [usize; 2],
+    /// Why the false alarms were raised, `type:reason` → episodes.
+    pub false_alarm_reasons: std::collections::BTreeMap<String, usize>,
+    /// Largest parity T / threshold after learning, gyro and accel.
+    pub max_t_over_threshold: [f64; 2],
+    /// Per-trial parity estimate of the channel σ, gyro rad/s and accel m/s².
+    pub sigma_hat: [f64; 2],
+    /// Largest relative bias removed, gyro rad/s and accel m/s².
+    pub max_relative_bias: [f64; 2],
+    /// Channel samples at a converter rail in the data.
+    pub clipped_samples: usize,
+    pub fault_row: usize,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct ConfigurationSummary {
+    pub configuration: &'static str,
+    pub channels: usize,
+    pub noise: NoiseFit,
+    pub false_alarms: usize,
+    #[serde(flatten)]
+    pub tally: Tally,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct FdiReport {
+    pub dir: PathBuf,
+    pub trials: usize,
+    pub imu_rate_hz: f64,
+    pub gyro_lsb_rps: f64,
+    pub accel_lsb_mps2: f64,
+    pub persistence: [u32; 2],
+    pub learning_samples: u32,
+    pub false_alarms: usize,
+    pub false_alarm_samples: usize,
+    /// Episodes of genuine over-range (not false alarms).
+    pub over_range: usize,
+    pub motion_noise_fraction: f64,
+    pub timing_skew_s: f64,
+    #[serde(flatten)]
+    pub total: Tally,
+    pub configurations: Vec<ConfigurationSummary>,
+    pub breakdown: Vec<FaultBreakdown>,
+    pub per_trial: Vec<TrialReport>,
+}
+
+fn opt(v: Option<f64>) -> String {
+    v.map_or("-".into(), |x| format!("{x:.0}"))
+}
+
+fn rate(a: usize, b: usize) -> String {
+    if b == 0 {
+        "-".into()
+    } else {
+        format!("{a}/{b} ({:.0} %)", 100.0 * a as f64 / b as f64)
+    }
+}
+
+/// The report as text tables.
+pub fn to_table(r: &FdiReport) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "FDI on {} ({} trials, {} Hz; persistence {}-of-{} samples; learning {} samples; lsb gyro {:.3e} rad/s, accel {:.3e} m/s²; motion noise {} of |x|, timing skew {} ms)\n",
+        r.dir.display(),
+        r.trials,
+        r.imu_rate_hz,
+        r.persistence[0],
+        r.persistence[1],
+        r.learning_samples,
+        r.gyro_lsb_rps,
+        r.accel_lsb_mps2,
+        r.motion_noise_fraction,
+        r.timing_skew_s * 1e3
+    );
+    let _ = writeln!(
+        s,
+        "{:22} {:9} {:>6} {:>10} {:>10} {:>11} {:>11} {:>11} {:>11} {:>7}",
+        "trial",
+        "config",
+        "s",
+        "FA gyro",
+        "FA accel",
+        "T/thr gyro",
+        "T/thr acc",
+        "σ̂ gyro °/s",
+        "σ̂ acc m/s²",
+        "clipped"
+    );
+    for t in &r.per_trial {
+        let _ = writeln!(
+            s,
+            "{:22} {:9} {:>6.1} {:>10} {:>10} {:>11.2} {:>11.2} {:>11.3} {:>11.3} {:>7}",
+            t.trial,
+            t.configuration,
+            t.seconds,
+            t.false_alarms[0],
+            t.false_alarms[1],
+            t.max_t_over_threshold[0],
+            t.max_t_over_threshold[1],
+            t.sigma_hat[0].to_degrees(),
+            t.sigma_hat[1],
+            t.clipped_samples
+        );
+        if !t.false_alarm_reasons.is_empty() {
+            let _ = writeln!(s, "    false alarms: {:?}", t.false_alarm_reasons);
+        }
+    }
+    let _ = writeln!(
+        s,
+        "\nfalse alarms (episodes without a fault): {} ({} samples); genuine over-range episodes (Suspect, not alarms): {}\n",
+        r.false_alarms, r.false_alarm_samples, r.over_range
+    );
+    let _ = writeln!(
+        s,
+        "{:9} {:5} {:10} {:>15} {:>15} {:>15} {:>17} {:>17}",
+        "config",
+        "type",
+        "fault",
+        "detected",
+        "isolated",
+        "correct",
+        "det p50/max smp",
+        "iso p50/max ms"
+    );
+    for b in &r.breakdown {
+        let t = &b.tally;
+        let _ = writeln!(
+            s,
+            "{:9} {:5} {:10} {:>15} {:>15} {:>15} {:>17} {:>17}",
+            b.configuration,
+            b.sensor,
+            b.fault,
+            rate(t.detected, t.faults_injected),
+            rate(t.isolated, t.faults_injected),
+            rate(t.correctly_isolated, t.faults_injected),
+            format!(
+                "{}/{}",
+                opt(t.detection_delay_samples_p50),
+                opt(t.detection_delay_samples_max.map(|d| d as f64))
+            ),
+            format!(
+                "{}/{}",
+                opt(t.isolation_delay_ms_p50),
+                opt(t.isolation_delay_ms_max)
+            ),
+        );
+    }
+    let _ = writeln!(s);
+    for c in r
+        .configurations
+        .iter()
+        .map(|c| (c.configuration, &c.tally))
+        .chain([("total", &r.total)])
+    {
+        let (name, t) = c;
+        let _ = writeln!(
+            s,
+            "{name:9}: detected {}, isolated {}, correctly {}; detection delay p50 {} ms max {} ms; isolation delay p50 {} ms max {} ms",
+            rate(t.detected, t.faults_injected),
+            rate(t.isolated, t.faults_injected),
+            rate(t.correctly_isolated, t.faults_injected),
+            opt(t.detection_delay_ms_p50),
+            opt(t.detection_delay_ms_max),
+            opt(t.isolation_delay_ms_p50),
+            opt(t.isolation_delay_ms_max),
+        );
+    }
+    s
+}
