@@ -40,6 +40,9 @@ pub enum Command {
         /// Comma-separated values with a header line, instead of one JSON object per line.
         #[arg(long)]
         csv: bool,
+        /// Fail when no sample arrives for this many seconds (0: wait for ever).
+        #[arg(long, default_value_t = 10.0)]
+        timeout: f64,
     },
     /// Inject a fault into one channel of the running simulator ("kill a sensor").
     Inject(InjectArgs),

@@ -93,3 +93,12 @@ fn missing_config_file_and_missing_device_are_reported() {
 fn unknown_topic_is_rejected() {
     fails_with(&["echo", "speed"], &["unknown topic \"speed\"", "nav"]);
 }
+
+#[test]
+fn echo_without_a_pipeline_times_out_naming_the_topic() {
+    fails_with(
+        &["echo", "nav", "--count", "1", "--timeout", "0.3"],
+        &["no sample on topic", "rins up"],
+    );
+    fails_with(&["echo", "nav", "--timeout=-1"], &["--timeout -1"]);
+}

@@ -11,14 +11,15 @@ fn echo_and_latency_read_a_running_pipeline() {
     let ipc = Isolated::new("tools");
     let up = ipc
         .command()
-        .args(["up", "--scenario", "static", "--duration", "8", "--json"])
+        // Long enough for any machine load; the test stops it itself below.
+        .args(["up", "--scenario", "static", "--duration", "300", "--json"])
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .spawn()
         .expect("cannot start rins up");
 
-    // Blocks until the pipeline publishes: the navigator's first samples.
-    let echo = ipc.run(&["echo", "nav", "--count", "5", "--csv"]);
+    // Waits until the pipeline publishes: the navigator's first samples.
+    let echo = ipc.run(&["echo", "nav", "--count", "5", "--csv", "--timeout", "120"]);
     assert!(
         echo.status.success(),
         "{}",
@@ -72,6 +73,10 @@ fn echo_and_latency_read_a_running_pipeline() {
     );
     assert!(p50 > 0.0 && p50 <= p99 && p99 <= max, "{end_to_end}");
 
+    // SIGTERM is how an operator stops the pipeline: it must shut down cleanly and still report.
+    let pid = libc::pid_t::try_from(up.id()).expect("pid fits pid_t");
+    // SAFETY: sends a signal to our own child process, which has not been reaped yet.
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGTERM) }, 0);
     let out = up.wait_with_output().expect("rins up did not finish");
     assert!(out.status.success());
     let summary = last_json(&out);

@@ -1,7 +1,7 @@
 //! `rins echo TOPIC`: print every sample of a topic, as JSON lines or CSV.
 
 use std::io::Write;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use anyhow::{Result, bail};
 use ipc_types::{
@@ -34,7 +34,16 @@ fn flatten(prefix: &str, value: &Value, out: &mut Vec<(String, String)>) {
     }
 }
 
-fn echo_topic<T>(name: &'static str, count: Option<u64>, csv: bool) -> Result<()>
+/// What to print and when to give up.
+#[derive(Clone, Copy)]
+struct EchoOptions {
+    count: Option<u64>,
+    csv: bool,
+    /// Longest wait for the next sample; `None` waits for ever.
+    timeout: Option<Duration>,
+}
+
+fn echo_topic<T>(name: &'static str, opts: EchoOptions) -> Result<()>
 where
     T: std::fmt::Debug + Copy + Serialize + iceoryx2::prelude::ZeroCopySend + 'static,
 {
@@ -46,9 +55,25 @@ where
     let mut out = stdout.lock();
     let mut printed = 0u64;
     let mut columns = Vec::new();
+    let EchoOptions {
+        count,
+        csv,
+        timeout,
+    } = opts;
+    let mut last_sample = Instant::now();
     while !shutdown.requested() && count.is_none_or(|c| printed < c) {
+        if let Some(limit) = timeout
+            && last_sample.elapsed() > limit
+        {
+            bail!(
+                "no sample on topic {name:?} for {:.1} s after {printed} printed: \
+                 is the pipeline running (`rins up`) with the same RINS_IPC_PREFIX?",
+                limit.as_secs_f64()
+            );
+        }
         sub.wait(Duration::from_millis(100))?;
         while let Some(sample) = sub.receive()? {
+            last_sample = Instant::now();
             let value = serde_json::to_value(sample)?;
             if csv {
                 columns.clear();
@@ -72,7 +97,17 @@ where
     Ok(())
 }
 
-pub fn run(topic: &str, count: Option<u64>, csv: bool) -> Result<()> {
+pub fn run(topic: &str, count: Option<u64>, csv: bool, timeout_s: f64) -> Result<()> {
+    if !(timeout_s.is_finite() && timeout_s >= 0.0) {
+        bail!(
+            "--timeout {timeout_s}: must be zero (wait for ever) or a positive number of seconds"
+        );
+    }
+    let opts = EchoOptions {
+        count,
+        csv,
+        timeout: (timeout_s > 0.0).then(|| Duration::from_secs_f64(timeout_s)),
+    };
     let Some((_, service)) = names::TOPICS.iter().find(|(short, _)| *short == topic) else {
         let known: Vec<&str> = names::TOPICS.iter().map(|(s, _)| *s).collect();
         bail!(
@@ -81,15 +116,15 @@ pub fn run(topic: &str, count: Option<u64>, csv: bool) -> Result<()> {
         );
     };
     match *service {
-        names::RAW_IMU => echo_topic::<RawImu>(names::RAW_IMU, count, csv),
-        names::RAW_BARO => echo_topic::<RawBaro>(names::RAW_BARO, count, csv),
-        names::RAW_MAG => echo_topic::<RawMag>(names::RAW_MAG, count, csv),
-        names::RAW_AUX => echo_topic::<RawAux>(names::RAW_AUX, count, csv),
-        names::FUSED_IMU => echo_topic::<FusedImu>(names::FUSED_IMU, count, csv),
-        names::ALTITUDE => echo_topic::<Altitude>(names::ALTITUDE, count, csv),
-        names::NAV_STATE => echo_topic::<NavState>(names::NAV_STATE, count, csv),
-        names::TRUTH => echo_topic::<Truth>(names::TRUTH, count, csv),
-        _ => echo_topic::<Health>(names::HEALTH, count, csv),
+        names::RAW_IMU => echo_topic::<RawImu>(names::RAW_IMU, opts),
+        names::RAW_BARO => echo_topic::<RawBaro>(names::RAW_BARO, opts),
+        names::RAW_MAG => echo_topic::<RawMag>(names::RAW_MAG, opts),
+        names::RAW_AUX => echo_topic::<RawAux>(names::RAW_AUX, opts),
+        names::FUSED_IMU => echo_topic::<FusedImu>(names::FUSED_IMU, opts),
+        names::ALTITUDE => echo_topic::<Altitude>(names::ALTITUDE, opts),
+        names::NAV_STATE => echo_topic::<NavState>(names::NAV_STATE, opts),
+        names::TRUTH => echo_topic::<Truth>(names::TRUTH, opts),
+        _ => echo_topic::<Health>(names::HEALTH, opts),
     }
 }
 

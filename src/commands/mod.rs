@@ -33,9 +33,12 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             rins_runtime::logging::init("sim");
             sim::run(&args).map(|()| ExitCode::SUCCESS)
         }
-        Command::Echo { topic, count, csv } => {
-            echo::run(&topic, count, csv).map(|()| ExitCode::SUCCESS)
-        }
+        Command::Echo {
+            topic,
+            count,
+            csv,
+            timeout,
+        } => echo::run(&topic, count, csv, timeout).map(|()| ExitCode::SUCCESS),
         Command::Inject(args) => inject::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Readmit { channel } => readmit::run(&channel).map(|()| ExitCode::SUCCESS),
         Command::Latency { seconds, json } => {
