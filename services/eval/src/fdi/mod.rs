@@ -37,10 +37,12 @@ use serde::Serialize;
 use crate::datasets::quadrotor::projection::stacked_axes;
 use crate::datasets::quadrotor::{IMU_RATE_HZ, list_trials, load_trial};
 
+mod episodes;
 mod prepare;
 mod report;
 mod runs;
 
+pub use episodes::AlarmEpisode;
 use prepare::prepare;
 pub use report::{ConfigurationSummary, FaultBreakdown, FdiReport, Tally, TrialReport, to_table};
 use runs::{run_clean, run_fault};
@@ -276,6 +278,23 @@ pub fn evaluate(request: &FdiRequest, progress: &mut dyn FnMut(usize, usize)) ->
                 .with_context(|| format!("eval fdi: trial {}", entry.name))?;
             let t0 = p.gyro.len() / 2;
             let clean = run_clean(fusion, lsb, &p, t0)?;
+            let half_window = (episodes::EVIDENCE_HALF_WINDOW_S * IMU_RATE_HZ) as usize;
+            let alarm_episodes = clean
+                .starts
+                .iter()
+                .map(|&(sensor, row, reason)| {
+                    let (ch, ratio) =
+                        episodes::loudest_channel(&p, geometry, sensor, row, half_window);
+                    AlarmEpisode {
+                        sensor: sensor.name(),
+                        at_s: row as f64 / IMU_RATE_HZ,
+                        reason,
+                        loudest_channel: ch,
+                        loudest_imu: layout.unit_of(ch) + 1,
+                        noise_ratio: ratio,
+                    }
+                })
+                .collect();
             done += 1;
             progress(done, total_runs);
             per_trial.push(TrialReport {
@@ -286,7 +305,7 @@ pub fn evaluate(request: &FdiRequest, progress: &mut dyn FnMut(usize, usize)) ->
                 false_alarms: clean.episodes,
                 over_range: clean.over_range,
                 false_alarm_samples: clean.samples,
-                false_alarm_reasons: clean.reasons.clone(),
+                alarm_episodes,
                 max_t_over_threshold: clean.max_t_ratio,
                 sigma_hat: p.sigma_hat,
                 max_relative_bias: p.max_bias_removed,

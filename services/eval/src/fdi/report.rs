@@ -98,8 +98,8 @@ pub struct TrialReport {
     /// Episodes of genuine over-range (channels Suspect, saturated), gyro and accel.
     pub over_range: [usize; 2],
     pub false_alarm_samples: [usize; 2],
-    /// Why the false alarms were raised, `type:reason` → episodes.
-    pub false_alarm_reasons: std::collections::BTreeMap<String, usize>,
+    /// Each false alarm: when, why, and which unit's channel stood out in noise.
+    pub alarm_episodes: Vec<super::AlarmEpisode>,
     /// Largest parity T / threshold after learning, gyro and accel.
     pub max_t_over_threshold: [f64; 2],
     /// Per-trial parity estimate of the channel σ, gyro rad/s and accel m/s².
@@ -202,8 +202,12 @@ pub fn to_table(r: &FdiReport) -> String {
             t.sigma_hat[1],
             t.clipped_samples
         );
-        if !t.false_alarm_reasons.is_empty() {
-            let _ = writeln!(s, "    false alarms: {:?}", t.false_alarm_reasons);
+        for e in &t.alarm_episodes {
+            let _ = writeln!(
+                s,
+                "    false alarm: {} {} at {:.1} s; loudest channel {} (IMU_{}) at {:.1}x its peers' noise",
+                e.sensor, e.reason, e.at_s, e.loudest_channel, e.loudest_imu, e.noise_ratio
+            );
         }
     }
     let _ = writeln!(

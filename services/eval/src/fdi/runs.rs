@@ -125,8 +125,8 @@ pub(crate) struct CleanRun {
     pub samples: [usize; 2],
     /// Largest T / threshold after learning, per type.
     pub max_t_ratio: [f64; 2],
-    /// Reasons seen at the start of each alarm episode, `type:reason` (e.g. `gyro:noisy`).
-    pub reasons: std::collections::BTreeMap<String, usize>,
+    /// Each alarm episode's sensor, first row and reason.
+    pub starts: Vec<(Sensor, usize, &'static str)>,
     pub snapshot: Option<ImuFuser>,
 }
 
@@ -143,7 +143,7 @@ pub(crate) fn run_clean(
         episodes: [0; 2],
         samples: [0; 2],
         max_t_ratio: [0.0; 2],
-        reasons: Default::default(),
+        starts: Vec::new(),
         snapshot: None,
     };
     let mut was = [false; 2];
@@ -172,9 +172,7 @@ pub(crate) fn run_clean(
                         .find(|r| **r != ipc_types::FaultReason::None)
                         .map_or("?", |r| r.name())
                 };
-                *run.reasons
-                    .entry(format!("{}:{why}", Sensor::ALL[j].name()))
-                    .or_default() += 1;
+                run.starts.push((Sensor::ALL[j], k, why));
             }
             was[j] = a;
             if !s.learning && s.threshold.is_finite() {
