@@ -74,11 +74,44 @@ pub enum Command {
     Mc(McArgs),
 }
 
+
 #[derive(Debug, Subcommand)]
 pub enum EvalCommand {
     /// Fault detection and isolation on the four-IMU quadrotor recordings: false alarms without
     /// faults, then detection and isolation of faults injected into the real data.
     Fdi(EvalFdiArgs),
+    /// Foot-mounted walks with Vicon truth: 2-D position RMSE per trial, pedestrian profile.
+    Pyshoe(EvalPyshoeArgs),
+    /// Foot-mounted closed-loop walks: end-point error, m and % of distance, pedestrian profile.
+    Xio(EvalXioArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct EvalPyshoeArgs {
+    /// Directory of trials (`*.csv`, with the peer's figures in a `.json` beside each).
+    pub dir: PathBuf,
+    #[command(flatten)]
+    pub common: EvalProfileArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct EvalXioArgs {
+    /// Walk files (`Time (s),Gyroscope X (deg/s),…` CSV).
+    #[arg(required = true)]
+    pub files: Vec<PathBuf>,
+    #[command(flatten)]
+    pub common: EvalProfileArgs,
+}
+
+#[derive(Debug, Args)]
+pub struct EvalProfileArgs {
+    /// One JSON object on stdout instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Profile configuration file (its `[navigator]` settings are used; default: the built-in
+    /// pedestrian profile, config/pedestrian.toml).
+    #[arg(long)]
+    pub profile: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]

@@ -16,6 +16,8 @@ use crate::cli::ScenarioArg;
 
 /// The configuration used when no file is given (also shipped as `config/rins.toml`).
 pub const BUILT_IN: &str = include_str!("../config/rins.toml");
+/// The pedestrian profile (foot-mounted unit): navigator settings only.
+pub const PEDESTRIAN: &str = include_str!("../config/pedestrian.toml");
 
 /// What the sensor block's datasheet says about its converters.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -134,6 +136,14 @@ impl RinsConfig {
 }
 
 /// Reads `path`, or the built-in configuration when none is given.
+/// The pedestrian profile, built in or from `path`.
+pub fn load_pedestrian(path: Option<&Path>) -> Result<RinsConfig> {
+    match path {
+        None => RinsConfig::parse(PEDESTRIAN, "built-in pedestrian profile"),
+        Some(path) => load(Some(path)),
+    }
+}
+
 pub fn load(path: Option<&Path>) -> Result<RinsConfig> {
     match path {
         None => RinsConfig::parse(BUILT_IN, "built-in configuration"),
@@ -148,6 +158,12 @@ pub fn load(path: Option<&Path>) -> Result<RinsConfig> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn built_in_pedestrian_profile_is_valid() {
+        let cfg = load_pedestrian(None).unwrap();
+        assert!(cfg.navigator.zupt.enabled);
+    }
 
     #[test]
     fn built_in_configuration_is_valid() {

@@ -1,10 +1,10 @@
-//! `rins eval fdi DIR`: loads the configuration, runs [`rins_eval::fdi::evaluate`] with a
-//! progress bar and prints the report.
+//! `rins eval fdi|pyshoe|xio`: loads the configuration, runs the evaluation from `rins-eval`
+//! with a progress bar and prints the report.
 
 use anyhow::Result;
 use rins_eval::fdi::{FdiRequest, evaluate, to_table};
 
-use crate::cli::EvalFdiArgs;
+use crate::cli::{EvalFdiArgs, EvalProfileArgs, EvalPyshoeArgs, EvalXioArgs};
 use crate::config;
 
 pub fn run_fdi(args: &EvalFdiArgs) -> Result<()> {
@@ -24,4 +24,43 @@ pub fn run_fdi(args: &EvalFdiArgs) -> Result<()> {
         print!("{}", to_table(&report));
     }
     Ok(())
+}
+
+fn pedestrian(args: &EvalProfileArgs) -> Result<rins_navigator::aided::AidedConfig> {
+    Ok(config::load_pedestrian(args.profile.as_deref())?
+        .navigator
+        .aided_config())
+}
+
+fn print<T: serde::Serialize>(json: bool, report: &T, table: impl Fn(&T) -> String) -> Result<()> {
+    if json {
+        println!("{}", serde_json::to_string(report)?);
+    } else {
+        print!("{}", table(report));
+    }
+    Ok(())
+}
+
+pub fn run_pyshoe(args: &EvalPyshoeArgs) -> Result<()> {
+    let aided = pedestrian(&args.common)?;
+    let mut bar = super::progress::Progress::new("eval pyshoe");
+    let report = rins_eval::foot::evaluate_pyshoe(&args.dir, &aided, &mut |d, t| bar.set(d, t))?;
+    bar.finish();
+    print(
+        args.common.json,
+        &report,
+        rins_eval::foot::report::pyshoe_table,
+    )
+}
+
+pub fn run_xio(args: &EvalXioArgs) -> Result<()> {
+    let aided = pedestrian(&args.common)?;
+    let mut bar = super::progress::Progress::new("eval xio");
+    let report = rins_eval::foot::evaluate_xio(&args.files, &aided, &mut |d, t| bar.set(d, t))?;
+    bar.finish();
+    print(
+        args.common.json,
+        &report,
+        rins_eval::foot::report::xio_table,
+    )
 }

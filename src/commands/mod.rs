@@ -49,6 +49,8 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         }
         Command::Eval { what } => match what {
             EvalCommand::Fdi(args) => eval::run_fdi(&args).map(|()| ExitCode::SUCCESS),
+            EvalCommand::Pyshoe(args) => eval::run_pyshoe(&args).map(|()| ExitCode::SUCCESS),
+            EvalCommand::Xio(args) => eval::run_xio(&args).map(|()| ExitCode::SUCCESS),
         },
         Command::Mc(args) => mc::run(&args).map(|()| ExitCode::SUCCESS),
     }

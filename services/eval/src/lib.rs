@@ -11,6 +11,7 @@
 
 pub mod datasets;
 pub mod fdi;
+pub mod foot;
 pub mod installation;
 pub mod mc;
 pub mod stats;

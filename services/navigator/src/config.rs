@@ -2,10 +2,13 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::aided::{AidedConfig, ZuptConfig};
 use crate::alignment::AlignConfig;
 use crate::baro_blend::BaroBlendConfig;
 use crate::earth::normal_gravity;
+use crate::ekf::EkfNoise;
 use crate::mechanisation::StrapdownConfig;
+use crate::stance::StanceConfig;
 
 pub use rins_runtime::config_error::ConfigError;
 
@@ -41,6 +44,12 @@ pub struct NavigatorConfig {
     pub align_max_specific_force_std_mps2: f64,
     /// Alignment: largest accepted standard deviation of a rate axis, rad/s.
     pub align_max_rate_std_rps: f64,
+    /// Error-state filter noise (`[navigator.ekf]`).
+    pub ekf: EkfNoise,
+    /// Zero-velocity updates (`[navigator.zupt]`).
+    pub zupt: ZuptConfig,
+    /// Stance detector (`[navigator.stance]`).
+    pub stance: StanceConfig,
 }
 
 impl Default for NavigatorConfig {
@@ -63,6 +72,9 @@ impl Default for NavigatorConfig {
             align_max_rate_rps: align.max_mean_rate_rps,
             align_max_specific_force_std_mps2: align.max_specific_force_std_mps2,
             align_max_rate_std_rps: align.max_rate_std_rps,
+            ekf: EkfNoise::default(),
+            zupt: ZuptConfig::default(),
+            stance: StanceConfig::default(),
         }
     }
 }
@@ -163,7 +175,49 @@ impl NavigatorConfig {
             positive,
             "must be finite and > 0 rad/s",
         )?;
+        if let Err((field, value)) = self.ekf.check() {
+            return Err(
+                ConfigError::new(field, value, "must be finite and > 0").within("navigator.ekf")
+            );
+        }
+        check(
+            "zupt.sigma_mps",
+            self.zupt.sigma_mps,
+            positive,
+            "must be finite and > 0 m/s",
+        )?;
+        check(
+            "zupt.gate",
+            self.zupt.gate,
+            positive,
+            "must be finite and > 0",
+        )?;
+        if let Err((field, value)) = self.stance.check() {
+            return Err(ConfigError::new(
+                field,
+                value,
+                "out of range (window 1..=64, others finite and > 0)",
+            )
+            .within("navigator.stance"));
+        }
         Ok(())
+    }
+
+    /// Settings of the aided inertial core.
+    pub fn aided_config(&self) -> AidedConfig {
+        AidedConfig {
+            align: self.align_config(),
+            strapdown: self.strapdown_config(),
+            noise: self.ekf,
+            zupt: self.zupt,
+            stance: self.stance,
+            declination_rad: self.declination_deg.to_radians(),
+            origin: [
+                self.initial_latitude_deg.to_radians(),
+                self.initial_longitude_deg.to_radians(),
+                self.initial_altitude_m,
+            ],
+        }
     }
 
     /// Alignment limits, with the gravity expected at the initial position.

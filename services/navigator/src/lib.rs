@@ -3,14 +3,17 @@
 //! Pure functions and small structs, no I/O. Frames: NED navigation, FRD body; quaternions rotate
 //! body → NED (Hamilton, scalar first); SI units inside, degrees only in [`NavigatorConfig`].
 
+pub mod aided;
 pub mod alignment;
 pub mod attitude;
 pub mod baro_blend;
 pub mod config;
 pub mod earth;
+pub mod ekf;
 pub mod mechanisation;
 pub mod navigator;
 pub mod service;
+pub mod stance;
 
 pub use alignment::{AlignConfig, AlignError, Alignment, StaticAligner};
 pub use baro_blend::{BaroBlend, BaroBlendConfig, BaroOutcome};

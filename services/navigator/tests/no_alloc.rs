@@ -107,3 +107,43 @@ fn navigating_samples_do_not_allocate() {
     });
     assert_eq!(boxed, 1);
 }
+
+#[test]
+fn the_error_state_filter_and_stance_detector_do_not_allocate_per_sample() {
+    use rins_navigator::aided::{AidedNavigator, ZuptConfig};
+    use rins_navigator::ekf::AidingSource;
+
+    let mut config = NavigatorConfig::default();
+    config.zupt = ZuptConfig {
+        enabled: true,
+        ..ZuptConfig::default()
+    };
+    let g = normal_gravity(0.0, 0.0);
+    let mut nav = AidedNavigator::new(config.aided_config());
+    let mut t = 0u64;
+    // Alignment and the start of the filter (one boxed filter) happen before counting.
+    while nav.ekf().is_none() {
+        let _ = nav.on_imu(t, [0.0; 3], [0.0, 0.0, -g], None);
+        t += 1000;
+    }
+    let mut stances = 0;
+    let navigating = allocations_during(|| {
+        for k in 0..5000u64 {
+            // Alternating swing and stance every 0.5 s.
+            let swing = (k / 500) % 2 == 1;
+            let rate = if swing { [0.0, 2.0, 0.0] } else { [0.0; 3] };
+            let step = nav.on_imu(t + k * 1000, rate, [0.0, 0.0, -g], None);
+            stances += usize::from(step.stance);
+        }
+    });
+    assert_eq!(navigating, 0);
+    assert!(stances > 2000, "{stances}");
+    let ekf = nav.ekf().expect("aligned");
+    assert!(ekf.counts(AidingSource::Zupt).accepted > 2000);
+    let mut ekf = ekf.clone();
+    let updates = allocations_during(|| {
+        let _ = ekf.height(1.0, 1.0, 5.0);
+        let _ = ekf.heading(AidingSource::Mag, 0.1, 0.05, 5.0);
+    });
+    assert_eq!(updates, 0);
+}

@@ -2,6 +2,10 @@
 
 mod csv;
 pub mod error;
+pub mod foot;
+pub mod pyshoe;
 pub mod quadrotor;
+pub mod xio;
 
 pub use error::DatasetError;
+pub use foot::{FootSample, FootTrial, PeerResult};

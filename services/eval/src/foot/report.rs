@@ -1,0 +1,63 @@
+//! Text tables of the foot-mounted evaluations.
+
+use std::fmt::Write;
+
+use super::{PyshoeReport, XioReport};
+
+fn opt(v: Option<f64>, scale: f64) -> String {
+    v.map_or_else(|| "-".into(), |x| format!("{:.3}", x * scale))
+}
+
+pub fn pyshoe_table(r: &PyshoeReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{:<22} {:>7} {:>10} {:>14} {:>9} {:>8} {:>9}",
+        "trial", "s", "rmse2d m", "peer(tuned) m", "heading°", "stance", "zupt rej"
+    );
+    for t in &r.trials {
+        let _ = writeln!(
+            s,
+            "{:<22} {:>7.1} {:>10.3} {:>14} {:>9.1} {:>7.0}% {:>9}",
+            t.trial,
+            t.seconds,
+            t.rmse_2d_m,
+            opt(t.peer_rmse_2d_m, 1.0),
+            t.heading_fit_deg,
+            100.0 * t.stance_fraction,
+            t.zupt_rejected
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\nmean 2-D RMSE: {:.3} m over {} trials (peer, threshold tuned per trial: {})",
+        r.mean_rmse_m,
+        r.trials.len(),
+        opt(r.peer_mean_rmse_m, 1.0)
+    );
+    s
+}
+
+pub fn xio_table(r: &XioReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{:<14} {:>7} {:>10} {:>11} {:>10} {:>9} {:>8} {:>8}",
+        "walk", "s", "end err m", "distance m", "% dist", "peer m", "stance", "dup rows"
+    );
+    for t in &r.trials {
+        let _ = writeln!(
+            s,
+            "{:<14} {:>7.1} {:>10.3} {:>11.1} {:>9.2}% {:>9} {:>7.0}% {:>8}",
+            t.trial,
+            t.seconds,
+            t.end_error_m,
+            t.distance_m,
+            t.pct_distance,
+            opt(t.peer_end_error_m, 1.0),
+            100.0 * t.stance_fraction,
+            t.dropped_duplicate_rows
+        );
+    }
+    s
+}

@@ -1,0 +1,245 @@
+//! The filter: covariance prediction on each IMU sample, gated Joseph-form updates, injection.
+
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+
+use super::noise::EkfNoise;
+use super::{ATT, BA, BG, Covariance, POS, STATES, VEL};
+use crate::attitude::{rotation_vector_to_quaternion, wrap_pi};
+use crate::earth::{meridian_radius, prime_vertical_radius};
+use crate::mechanisation::{ImuBias, NominalState, StepOutcome, Strapdown, StrapdownConfig};
+
+/// Smallest `cos φ` used when turning an east error into longitude.
+const MIN_COS_LATITUDE: f64 = 1e-6;
+
+/// Where a measurement comes from, for the accepted/rejected counts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AidingSource {
+    Baro = 0,
+    Mag = 1,
+    Zupt = 2,
+    Hupt = 3,
+}
+
+impl AidingSource {
+    pub const COUNT: usize = 4;
+    pub const ALL: [AidingSource; Self::COUNT] = [
+        AidingSource::Baro,
+        AidingSource::Mag,
+        AidingSource::Zupt,
+        AidingSource::Hupt,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            AidingSource::Baro => "baro",
+            AidingSource::Mag => "mag",
+            AidingSource::Zupt => "zupt",
+            AidingSource::Hupt => "hupt",
+        }
+    }
+}
+
+/// Measurements of one source that passed and failed the innovation gate.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct AidingCounts {
+    pub accepted: u64,
+    pub rejected: u64,
+}
+
+/// What became of one measurement.
+#[must_use]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum UpdateOutcome {
+    /// Applied; `d2` is the innovation's squared Mahalanobis distance.
+    Accepted { d2: f64 },
+    /// Outside the gate (or not finite): not applied.
+    Rejected { d2: f64 },
+    /// The innovation covariance was not positive definite: not applied.
+    Singular,
+}
+
+impl UpdateOutcome {
+    pub fn is_accepted(self) -> bool {
+        matches!(self, UpdateOutcome::Accepted { .. })
+    }
+}
+
+/// Error-state EKF around a [`Strapdown`] mechanisation. Allocation-free.
+#[derive(Debug, Clone)]
+pub struct ErrorStateEkf {
+    strapdown: Strapdown,
+    p: Covariance,
+    noise: EkfNoise,
+    counts: [AidingCounts; AidingSource::COUNT],
+}
+
+/// `[v×]`, the matrix of `x ↦ v × x`.
+fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
+}
+
+/// `F · m` for the error dynamics of the module docs, using only its non-zero blocks:
+/// rows δθ = −C·m[δb_g], rows δv = −[fⁿ×]·m[δθ] − C·m[δb_a], rows δp = m[δv].
+fn f_times(m: &Covariance, c: &Matrix3<f64>, f_skew: &Matrix3<f64>) -> Covariance {
+    let mut out = Covariance::zeros();
+    out.fixed_rows_mut::<3>(ATT)
+        .copy_from(&(-c * m.fixed_rows::<3>(BG)));
+    out.fixed_rows_mut::<3>(VEL)
+        .copy_from(&(-f_skew * m.fixed_rows::<3>(ATT) - c * m.fixed_rows::<3>(BA)));
+    out.fixed_rows_mut::<3>(POS)
+        .copy_from(&m.fixed_rows::<3>(VEL));
+    out
+}
+
+impl ErrorStateEkf {
+    /// Starts from `state` and `bias` with the initial uncertainty of `noise`.
+    pub fn new(
+        state: NominalState,
+        bias: ImuBias,
+        strapdown: StrapdownConfig,
+        noise: EkfNoise,
+    ) -> Self {
+        let mut diagonal = SVector::<f64, STATES>::zeros();
+        let blocks = [
+            (ATT, noise.initial_tilt_sigma),
+            (VEL, noise.initial_velocity_sigma),
+            (POS, noise.initial_position_sigma),
+            (BG, noise.initial_gyro_bias_sigma),
+            (BA, noise.initial_accel_bias_sigma),
+        ];
+        for (start, sigma) in blocks {
+            for i in start..start + 3 {
+                diagonal[i] = sigma * sigma;
+            }
+        }
+        diagonal[ATT + 2] = noise.initial_heading_sigma.powi(2);
+        Self {
+            strapdown: Strapdown::new(state, bias, strapdown),
+            p: Covariance::from_diagonal(&diagonal),
+            noise,
+            counts: [AidingCounts::default(); AidingSource::COUNT],
+        }
+    }
+
+    pub fn state(&self) -> &NominalState {
+        self.strapdown.state()
+    }
+
+    /// The nominal state, to initialise it from a reference (e.g. the truth at the start of a
+    /// recording); the covariance is left as it is.
+    pub fn state_mut(&mut self) -> &mut NominalState {
+        self.strapdown.state_mut()
+    }
+
+    pub fn bias(&self) -> &ImuBias {
+        self.strapdown.bias()
+    }
+
+    pub fn strapdown(&self) -> &Strapdown {
+        &self.strapdown
+    }
+
+    pub fn covariance(&self) -> &Covariance {
+        &self.p
+    }
+
+    /// Standard deviation of error component `i`.
+    pub fn sigma(&self, i: usize) -> f64 {
+        self.p[(i, i)].max(0.0).sqrt()
+    }
+
+    pub fn counts(&self, source: AidingSource) -> AidingCounts {
+        self.counts[source as usize]
+    }
+
+    /// Propagates the nominal state by one IMU sample (see [`Strapdown::propagate`]) and the
+    /// covariance with it. The covariance is only predicted when the step was applied.
+    pub fn predict(
+        &mut self,
+        rate_rps: [f64; 3],
+        specific_force: [f64; 3],
+        dt_s: f64,
+    ) -> StepOutcome {
+        let c = self
+            .strapdown
+            .state()
+            .attitude
+            .to_rotation_matrix()
+            .into_inner();
+        let outcome = self.strapdown.propagate(rate_rps, specific_force, dt_s);
+        if !outcome.is_applied() {
+            return outcome;
+        }
+        let f_skew = skew(&self.strapdown.specific_force_ned());
+        // Φ P Φᵀ with Φ = I + F Δt, expanded so that only F's non-zero blocks are multiplied.
+        let fp = f_times(&self.p, &c, &f_skew);
+        let fpft = f_times(&fp.transpose(), &c, &f_skew).transpose();
+        let mut p = self.p + (fp + fp.transpose()) * dt_s + fpft * (dt_s * dt_s);
+        let n = &self.noise;
+        let q = [
+            (ATT, n.gyro_noise_density),
+            (VEL, n.accel_noise_density),
+            (BG, n.gyro_bias_walk),
+            (BA, n.accel_bias_walk),
+        ];
+        // G Q Gᵀ: the white noises enter through ±C, and C σ² I Cᵀ = σ² I.
+        for (start, density) in q {
+            for i in start..start + 3 {
+                p[(i, i)] += density * density * dt_s;
+            }
+        }
+        self.p = (p + p.transpose()) * 0.5;
+        outcome
+    }
+
+    /// Applies measurement `innovation = z − h(x̂)` with Jacobian `h` and noise `r` when its
+    /// squared Mahalanobis distance is at most `gate²`; counts it for `source`.
+    pub fn update<const M: usize>(
+        &mut self,
+        source: AidingSource,
+        h: &SMatrix<f64, M, STATES>,
+        innovation: &SVector<f64, M>,
+        r: &SMatrix<f64, M, M>,
+        gate: f64,
+    ) -> UpdateOutcome {
+        let ph = self.p * h.transpose();
+        let s = h * ph + r;
+        let Some(chol) = s.cholesky() else {
+            self.counts[source as usize].rejected += 1;
+            return UpdateOutcome::Singular;
+        };
+        let d2 = innovation.dot(&chol.solve(innovation));
+        if d2.is_nan() || d2 > gate * gate {
+            self.counts[source as usize].rejected += 1;
+            return UpdateOutcome::Rejected { d2 };
+        }
+        // K = P Hᵀ S⁻¹, from Kᵀ = S⁻¹ H P (S and P symmetric).
+        let k = chol.solve(&ph.transpose()).transpose();
+        let dx = k * innovation;
+        let i_kh = Covariance::identity() - k * h;
+        let p = i_kh * self.p * i_kh.transpose() + k * r * k.transpose();
+        self.p = (p + p.transpose()) * 0.5;
+        self.inject(&dx);
+        self.counts[source as usize].accepted += 1;
+        UpdateOutcome::Accepted { d2 }
+    }
+
+    /// Moves the estimated error into the nominal state and biases (the error resets to zero).
+    fn inject(&mut self, dx: &SVector<f64, STATES>) {
+        let d_theta = Vector3::new(dx[ATT], dx[ATT + 1], dx[ATT + 2]);
+        let d_v = Vector3::new(dx[VEL], dx[VEL + 1], dx[VEL + 2]);
+        let s = self.strapdown.state_mut();
+        let mut q = rotation_vector_to_quaternion(&d_theta) * s.attitude;
+        q.renormalize();
+        s.attitude = q;
+        s.velocity_ned += d_v;
+        let cos_lat = s.lat.cos().max(MIN_COS_LATITUDE);
+        s.lat = (s.lat + dx[POS] / (meridian_radius(s.lat) + s.alt))
+            .clamp(-std::f64::consts::FRAC_PI_2, std::f64::consts::FRAC_PI_2);
+        s.lon = wrap_pi(s.lon + dx[POS + 1] / ((prime_vertical_radius(s.lat) + s.alt) * cos_lat));
+        s.alt -= dx[POS + 2];
+        let b = self.strapdown.bias_mut();
+        b.gyro_rps += Vector3::new(dx[BG], dx[BG + 1], dx[BG + 2]);
+        b.accel_mps2 += Vector3::new(dx[BA], dx[BA + 1], dx[BA + 2]);
+    }
+}

@@ -1,0 +1,64 @@
+//! The aiding measurements: each builds `h`, the innovation and `R`, then calls
+//! [`ErrorStateEkf::update`].
+
+use nalgebra::{Matrix3, SMatrix, SVector, Vector1};
+
+use super::filter::{AidingSource, ErrorStateEkf, UpdateOutcome};
+use super::{ATT, POS, STATES, VEL};
+use crate::attitude::wrap_pi;
+
+/// `∂ψ/∂δθ` for the yaw `ψ = atan2(C₁₀, C₀₀)` of `C = (I + [δθ×]) Ĉ`: with `[δθ×]` acting on Ĉ's
+/// first column, `dC₁₀ = δθ_z Ĉ₀₀ − δθ_x Ĉ₂₀` and `dC₀₀ = −δθ_z Ĉ₁₀ + δθ_y Ĉ₂₀`. Level, it is
+/// `[0, 0, 1]`; tilted, roll and pitch errors move the heading too.
+pub fn heading_jacobian(c: &Matrix3<f64>) -> [f64; 3] {
+    let (c00, c10, c20) = (c[(0, 0)], c[(1, 0)], c[(2, 0)]);
+    let n = c00 * c00 + c10 * c10;
+    if n < 1e-12 {
+        // Pointing straight up or down: heading undefined.
+        return [0.0; 3];
+    }
+    // dψ = (C₀₀ dC₁₀ − C₁₀ dC₀₀) / n
+    [-c00 * c20 / n, -c10 * c20 / n, (c00 * c00 + c10 * c10) / n]
+}
+
+impl ErrorStateEkf {
+    /// Zero-velocity update: `z = 0`, `h = [0 I 0 0 0]`, each axis with σ `sigma_mps`.
+    pub fn zupt(&mut self, sigma_mps: f64, gate: f64) -> UpdateOutcome {
+        let mut h = SMatrix::<f64, 3, STATES>::zeros();
+        h.fixed_view_mut::<3, 3>(0, VEL)
+            .copy_from(&Matrix3::identity());
+        let innovation = -self.state().velocity_ned;
+        let r = Matrix3::identity() * (sigma_mps * sigma_mps);
+        self.update(AidingSource::Zupt, &h, &innovation, &r, gate)
+    }
+
+    /// Height measurement (barometric altitude), m, σ `sigma_m`: `δh = −δp_D`.
+    pub fn height(&mut self, height_m: f64, sigma_m: f64, gate: f64) -> UpdateOutcome {
+        let mut h = SMatrix::<f64, 1, STATES>::zeros();
+        h[(0, POS + 2)] = -1.0;
+        let innovation = Vector1::new(height_m - self.state().alt);
+        let r = Vector1::new(sigma_m * sigma_m);
+        self.update(AidingSource::Baro, &h, &innovation, &SMatrix::from(r), gate)
+    }
+
+    /// Heading measurement, rad from north, σ `sigma_rad` (magnetometer heading, or the stance
+    /// heading of a HUPT); the innovation is wrapped to (−π, π].
+    pub fn heading(
+        &mut self,
+        source: AidingSource,
+        heading_rad: f64,
+        sigma_rad: f64,
+        gate: f64,
+    ) -> UpdateOutcome {
+        let c = self.state().attitude.to_rotation_matrix().into_inner();
+        let psi = c[(1, 0)].atan2(c[(0, 0)]);
+        let jac = heading_jacobian(&c);
+        let mut h = SMatrix::<f64, 1, STATES>::zeros();
+        for (k, j) in jac.iter().enumerate() {
+            h[(0, ATT + k)] = *j;
+        }
+        let innovation = SVector::<f64, 1>::new(wrap_pi(heading_rad - psi));
+        let r = SMatrix::<f64, 1, 1>::new(sigma_rad * sigma_rad);
+        self.update(source, &h, &innovation, &r, gate)
+    }
+}

@@ -1,0 +1,105 @@
+//! Stance detectors: each fires at rest and not in swing, and rejects bad settings by name.
+
+use rins_navigator::stance::{StanceConfig, StanceDetector, StanceTest};
+
+const G: f64 = 9.81;
+const REST_FORCE: [f64; 3] = [0.0, 0.0, -G];
+
+fn shoe() -> StanceConfig {
+    StanceConfig {
+        window: 5,
+        detector: StanceTest::Shoe {
+            accel_sigma_mps2: 0.01,
+            gyro_sigma_rps: 0.1f64.to_radians(),
+            threshold: 1e5,
+        },
+    }
+}
+
+#[test]
+fn shoe_statistic_is_the_closed_form_and_separates_rest_from_swing() {
+    let mut d = StanceDetector::new(shoe());
+    // Not before the window is full.
+    for _ in 0..4 {
+        assert!(!d.push([0.0; 3], REST_FORCE, None, G));
+    }
+    assert!(d.push([0.0; 3], REST_FORCE, None, G));
+    assert!(d.last_statistic().abs() < 1e-9);
+    // A constant 0.01 rad/s rate: T = |ω|²/σ_ω² exactly (the specific force term is zero).
+    for _ in 0..5 {
+        d.push([0.0, 0.0, 0.01], REST_FORCE, None, G);
+    }
+    let expected = (0.01 / 0.1f64.to_radians()).powi(2);
+    assert!((d.last_statistic() - expected).abs() < 1e-6 * expected);
+    // Swing: 3 rad/s and 5 m/s² of acceleration.
+    for _ in 0..5 {
+        assert!(!d.push([3.0, 0.0, 0.0], [5.0, 0.0, -G], None, G));
+    }
+    // Back at rest, a full window later.
+    let fired: Vec<bool> = (0..5)
+        .map(|_| d.push([0.0; 3], REST_FORCE, None, G))
+        .collect();
+    assert_eq!(fired, [false, false, false, false, true]);
+}
+
+#[test]
+fn shoe_ignores_the_direction_of_gravity() {
+    // A tilted foot at rest: the specific force is g along any direction.
+    let mut d = StanceDetector::new(shoe());
+    let f = [G * 0.6, 0.0, -G * 0.8];
+    let fired = (0..5).map(|_| d.push([0.0; 3], f, None, G)).last();
+    assert_eq!(fired, Some(true));
+}
+
+#[test]
+fn magnitude_thresholds_need_every_sample_of_the_window() {
+    let mut d = StanceDetector::new(StanceConfig {
+        window: 3,
+        detector: StanceTest::Thresholds {
+            accel_tolerance_mps2: 0.5,
+            gyro_max_rps: 0.2,
+        },
+    });
+    assert!(!d.push([0.0; 3], REST_FORCE, None, G));
+    assert!(!d.push([0.0; 3], REST_FORCE, None, G));
+    assert!(d.push([0.0; 3], REST_FORCE, None, G));
+    // One rotating sample keeps the window out of stance for three samples.
+    assert!(!d.push([0.3, 0.0, 0.0], REST_FORCE, None, G));
+    assert!(!d.push([0.0; 3], REST_FORCE, None, G));
+    assert!(!d.push([0.0; 3], REST_FORCE, None, G));
+    assert!(d.push([0.0; 3], REST_FORCE, None, G));
+    // |f| 1 m/s² off g is not stance.
+    for _ in 0..3 {
+        assert!(!d.push([0.0; 3], [0.0, 0.0, -G - 1.0], None, G));
+    }
+}
+
+#[test]
+fn foot_pressure_decides_alone_and_a_missing_reading_is_swing() {
+    let mut d = StanceDetector::new(StanceConfig {
+        window: 1,
+        detector: StanceTest::Fsr { threshold: 0.5 },
+    });
+    assert!(d.push([5.0; 3], [9.0; 3], Some(0.8), G));
+    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.2), G));
+    assert!(!d.push([0.0; 3], REST_FORCE, None, G));
+}
+
+#[test]
+fn bad_settings_name_the_field() {
+    let mut c = shoe();
+    c.window = 0;
+    assert_eq!(c.check(), Err(("window", 0.0)));
+    c.window = 65;
+    assert_eq!(c.check(), Err(("window", 65.0)));
+    c = StanceConfig {
+        window: 5,
+        detector: StanceTest::Shoe {
+            accel_sigma_mps2: 0.01,
+            gyro_sigma_rps: f64::NAN,
+            threshold: 1.0,
+        },
+    };
+    assert_eq!(c.check().map_err(|e| e.0), Err("gyro_sigma_rps"));
+    assert!(shoe().check().is_ok());
+}
