@@ -74,7 +74,6 @@ pub enum Command {
     Mc(McArgs),
 }
 
-
 #[derive(Debug, Subcommand)]
 pub enum EvalCommand {
     /// Fault detection and isolation on the four-IMU quadrotor recordings: false alarms without
