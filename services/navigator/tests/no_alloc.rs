@@ -113,10 +113,12 @@ fn the_error_state_filter_and_stance_detector_do_not_allocate_per_sample() {
     use rins_navigator::aided::{AidedNavigator, ZuptConfig};
     use rins_navigator::ekf::AidingSource;
 
-    let mut config = NavigatorConfig::default();
-    config.zupt = ZuptConfig {
-        enabled: true,
-        ..ZuptConfig::default()
+    let config = NavigatorConfig {
+        zupt: ZuptConfig {
+            enabled: true,
+            ..ZuptConfig::default()
+        },
+        ..NavigatorConfig::default()
     };
     let g = normal_gravity(0.0, 0.0);
     let mut nav = AidedNavigator::new(config.aided_config());
