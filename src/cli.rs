@@ -72,6 +72,31 @@ pub enum Command {
     },
     /// Monte Carlo comparison of the redundant block with an orthogonal triad, with a gyro kill.
     Mc(McArgs),
+    /// Fit sensor calibrations offline from recorded samples.
+    Calibrate {
+        #[command(subcommand)]
+        what: CalibrateCommand,
+    },
+}
+
+#[derive(Debug, Subcommand)]
+pub enum CalibrateCommand {
+    /// Magnetometer hard and soft iron from samples taken while the vehicle is turned through many
+    /// orientations; prints the fit and a `[navigator.mag_calibration]` configuration fragment.
+    Mag(CalibrateMagArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct CalibrateMagArgs {
+    /// CSV file: the output of `rins echo raw-mag --csv`, or a `mx_ut,my_ut,mz_ut` header and rows.
+    pub file: PathBuf,
+    /// Local field magnitude, µT (default: mean magnitude of the samples once the hard iron is
+    /// removed).
+    #[arg(long)]
+    pub field_ut: Option<f64>,
+    /// One JSON object on stdout instead of the summary.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Debug, Subcommand)]

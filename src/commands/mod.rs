@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+mod calibrate;
 mod control;
 mod echo;
 mod eval;
@@ -18,7 +19,7 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 
-use crate::cli::{Cli, Command, EvalCommand};
+use crate::cli::{CalibrateCommand, Cli, Command, EvalCommand};
 
 pub fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
@@ -53,5 +54,8 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             EvalCommand::Xio(args) => eval::run_xio(&args).map(|()| ExitCode::SUCCESS),
         },
         Command::Mc(args) => mc::run(&args).map(|()| ExitCode::SUCCESS),
+        Command::Calibrate { what } => match what {
+            CalibrateCommand::Mag(args) => calibrate::run_mag(&args).map(|()| ExitCode::SUCCESS),
+        },
     }
 }

@@ -10,6 +10,7 @@ pub mod baro_blend;
 pub mod config;
 pub mod earth;
 pub mod ekf;
+pub mod mag_calibration;
 pub mod mechanisation;
 pub mod navigator;
 pub mod service;
