@@ -18,6 +18,9 @@ use crate::cli::ScenarioArg;
 pub const BUILT_IN: &str = include_str!("../config/rins.toml");
 /// The pedestrian profile (foot-mounted unit): navigator settings only.
 pub const PEDESTRIAN: &str = include_str!("../config/pedestrian.toml");
+/// The UAV profile (baro and magnetometer aiding, zero-velocity updates only while landed):
+/// navigator settings only.
+pub const UAV: &str = include_str!("../config/uav.toml");
 
 /// What the sensor block's datasheet says about its converters.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -135,15 +138,24 @@ impl RinsConfig {
     }
 }
 
-/// Reads `path`, or the built-in configuration when none is given.
 /// The pedestrian profile, built in or from `path`.
 pub fn load_pedestrian(path: Option<&Path>) -> Result<RinsConfig> {
+    load_profile(PEDESTRIAN, "built-in pedestrian profile", path)
+}
+
+/// The UAV profile, built in or from `path`.
+pub fn load_uav(path: Option<&Path>) -> Result<RinsConfig> {
+    load_profile(UAV, "built-in uav profile", path)
+}
+
+fn load_profile(built_in: &str, origin: &str, path: Option<&Path>) -> Result<RinsConfig> {
     match path {
-        None => RinsConfig::parse(PEDESTRIAN, "built-in pedestrian profile"),
+        None => RinsConfig::parse(built_in, origin),
         Some(path) => load(Some(path)),
     }
 }
 
+/// Reads `path`, or the built-in configuration when none is given.
 pub fn load(path: Option<&Path>) -> Result<RinsConfig> {
     match path {
         None => RinsConfig::parse(BUILT_IN, "built-in configuration"),
@@ -163,6 +175,12 @@ mod tests {
     fn built_in_pedestrian_profile_is_valid() {
         let cfg = load_pedestrian(None).unwrap();
         assert!(cfg.navigator.zupt.enabled);
+    }
+
+    #[test]
+    fn built_in_uav_profile_is_valid() {
+        let cfg = load_uav(None).unwrap();
+        assert!(!cfg.navigator.zupt.enabled);
     }
 
     #[test]
