@@ -108,6 +108,17 @@ pub enum EvalCommand {
     Pyshoe(EvalPyshoeArgs),
     /// Foot-mounted closed-loop walks: end-point error, m and % of distance, pedestrian profile.
     Xio(EvalXioArgs),
+    /// Quadrotor flights, free inertial from the truth at the start: roll/pitch RMSE and height
+    /// error of each IMU alone and of the four fused, UAV profile.
+    Quadrotor(EvalQuadrotorArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct EvalQuadrotorArgs {
+    /// Data set directory (holding `<group>/path_<N>/IMU_k.csv` and `GT.csv`).
+    pub dir: PathBuf,
+    #[command(flatten)]
+    pub common: EvalProfileArgs,
 }
 
 #[derive(Debug, Args)]
@@ -132,8 +143,9 @@ pub struct EvalProfileArgs {
     /// One JSON object on stdout instead of a table.
     #[arg(long)]
     pub json: bool,
-    /// Profile configuration file (its `[navigator]` settings are used; default: the built-in
-    /// pedestrian profile, config/pedestrian.toml).
+    /// Profile configuration file (its `[navigator]` settings are used; default: the command's
+    /// built-in profile, config/pedestrian.toml for pyshoe and xio, config/uav.toml for
+    /// quadrotor).
     #[arg(long)]
     pub profile: Option<PathBuf>,
 }
@@ -188,6 +200,7 @@ pub enum ServiceName {
 pub enum ScenarioArg {
     Static,
     Uav,
+    Walk,
 }
 
 #[derive(Debug, Args)]

@@ -127,6 +127,7 @@ impl RinsConfig {
         match self.sim.scenario {
             rins_sim::Scenario::Static => "static",
             rins_sim::Scenario::Uav => "uav",
+            rins_sim::Scenario::Walk => "walk",
         }
     }
 
@@ -134,6 +135,7 @@ impl RinsConfig {
         self.sim.scenario = match scenario {
             ScenarioArg::Static => rins_sim::Scenario::Static,
             ScenarioArg::Uav => rins_sim::Scenario::Uav,
+            ScenarioArg::Walk => rins_sim::Scenario::Walk,
         };
     }
 }

@@ -11,7 +11,7 @@ use serde::Serialize;
 pub mod names;
 
 /// Version of every payload layout in this crate. Bump it on any layout change.
-pub const PAYLOAD_VERSION: u16 = 2;
+pub const PAYLOAD_VERSION: u16 = 3;
 
 /// Up to this many single-axis channels per sensor type (gyro, accelerometer).
 pub const MAX_CHANNELS: usize = 16;
@@ -324,7 +324,12 @@ pub mod aiding {
     pub const BARO: u32 = 1 << 0;
     pub const MAG: u32 = 1 << 1;
     pub const ZUPT: u32 = 1 << 2;
+    pub const HUPT: u32 = 1 << 3;
 }
+
+/// Aiding sources counted in [`NavState::aiding_accepted`] / [`NavState::aiding_rejected`], in
+/// this order: baro, mag, zupt, hupt.
+pub const AIDING_SOURCES: usize = 4;
 
 /// Navigator mode, [`NavState::mode`].
 #[repr(u8)]
@@ -381,6 +386,10 @@ pub struct NavState {
     pub longitude_rad: f64,
     pub altitude_m: f64,
     pub covariance_diag: [f64; NAV_STATES],
+    /// Updates accepted per aiding source since alignment (baro, mag, zupt, hupt).
+    pub aiding_accepted: [u32; AIDING_SOURCES],
+    /// Updates rejected by the innovation gate per aiding source since alignment.
+    pub aiding_rejected: [u32; AIDING_SOURCES],
 }
 
 impl Default for NavState {
@@ -397,6 +406,8 @@ impl Default for NavState {
             longitude_rad: 0.0,
             altitude_m: 0.0,
             covariance_diag: [0.0; NAV_STATES],
+            aiding_accepted: [0; AIDING_SOURCES],
+            aiding_rejected: [0; AIDING_SOURCES],
         }
     }
 }

@@ -1,10 +1,10 @@
-//! `rins eval fdi|pyshoe|xio`: loads the configuration, runs the evaluation from `rins-eval`
-//! with a progress bar and prints the report.
+//! `rins eval fdi|pyshoe|xio|quadrotor`: loads the configuration, runs the evaluation from
+//! `rins-eval` with a progress bar and prints the report.
 
 use anyhow::Result;
 use rins_eval::fdi::{FdiRequest, evaluate, to_table};
 
-use crate::cli::{EvalFdiArgs, EvalProfileArgs, EvalPyshoeArgs, EvalXioArgs};
+use crate::cli::{EvalFdiArgs, EvalProfileArgs, EvalPyshoeArgs, EvalQuadrotorArgs, EvalXioArgs};
 use crate::config;
 
 pub fn run_fdi(args: &EvalFdiArgs) -> Result<()> {
@@ -62,5 +62,19 @@ pub fn run_xio(args: &EvalXioArgs) -> Result<()> {
         args.common.json,
         &report,
         rins_eval::foot::report::xio_table,
+    )
+}
+
+pub fn run_quadrotor(args: &EvalQuadrotorArgs) -> Result<()> {
+    let aided = config::load_uav(args.common.profile.as_deref())?
+        .navigator
+        .aided_config();
+    let mut bar = super::progress::Progress::new("eval quadrotor");
+    let report = rins_eval::quadrotor_nav::evaluate(&args.dir, &aided, &mut |d, t| bar.set(d, t))?;
+    bar.finish();
+    print(
+        args.common.json,
+        &report,
+        rins_eval::quadrotor_nav::report::to_table,
     )
 }

@@ -52,6 +52,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             EvalCommand::Fdi(args) => eval::run_fdi(&args).map(|()| ExitCode::SUCCESS),
             EvalCommand::Pyshoe(args) => eval::run_pyshoe(&args).map(|()| ExitCode::SUCCESS),
             EvalCommand::Xio(args) => eval::run_xio(&args).map(|()| ExitCode::SUCCESS),
+            EvalCommand::Quadrotor(args) => eval::run_quadrotor(&args).map(|()| ExitCode::SUCCESS),
         },
         Command::Mc(args) => mc::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Calibrate { what } => match what {

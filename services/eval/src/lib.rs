@@ -7,6 +7,8 @@
 //!   faults injected into the data).
 //! - [`datasets`]: loaders of recorded data sets (the four-IMU quadrotor flights).
 //! - [`installation`]: relative rotation between IMUs from paired rate vectors (Wahba's problem).
+//! - [`quadrotor_nav`]: free-inertial roll, pitch and height on the quadrotor recordings, each unit
+//!   alone and the units fused.
 //! - [`stats`]: mean, 2σ and RMS helpers.
 
 pub mod datasets;
@@ -14,4 +16,5 @@ pub mod fdi;
 pub mod foot;
 pub mod installation;
 pub mod mc;
+pub mod quadrotor_nav;
 pub mod stats;

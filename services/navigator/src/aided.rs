@@ -1,14 +1,20 @@
 //! The aided navigator's inertial core: static alignment, then the error-state EKF predicted on
-//! every IMU sample, with the zero-velocity update whenever the stance detector fires.
+//! every IMU sample, with the zero-velocity update whenever the stance detector fires; barometric
+//! height and magnetometer heading updates arrive through [`AidedNavigator::on_baro`] and
+//! [`AidedNavigator::on_mag`] (see [`crate::aiding`]).
 //!
-//! The pedestrian profile runs it on a foot-mounted unit; the offline evaluations and the live
-//! navigator share this one code path, so what the real recordings measure is what flies.
+//! Both profiles run it — a foot-mounted unit (pedestrian) and the airframe (uav); the offline
+//! evaluations and the live navigator share this one code path, so what the real recordings
+//! measure is what flies.
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
+use crate::aiding::BaroAidingConfig;
 use crate::alignment::{AlignConfig, AlignError, Alignment, StaticAligner};
-use crate::ekf::{EkfNoise, ErrorStateEkf, UpdateOutcome};
+use crate::ekf::{AidingSource, EkfNoise, ErrorStateEkf, UpdateOutcome};
+use crate::mag_calibration::MagCalibration;
+use crate::mag_heading::{FieldReference, MagAidingConfig};
 use crate::mechanisation::{ImuBias, NominalState, StepOutcome, StrapdownConfig};
 use crate::stance::{StanceConfig, StanceDetector};
 
@@ -42,17 +48,23 @@ pub struct AidedConfig {
     pub noise: EkfNoise,
     pub zupt: ZuptConfig,
     pub stance: StanceConfig,
+    pub baro: BaroAidingConfig,
+    pub mag: MagAidingConfig,
+    /// Applied to every magnetometer sample before use.
+    pub mag_calibration: MagCalibration,
     /// Declination, rad, positive east.
     pub declination_rad: f64,
     /// Position where navigation starts: latitude, longitude (rad), altitude (m).
     pub origin: [f64; 3],
 }
 
-/// Where the navigator is in its sequence.
+/// Where the navigator is in its sequence. Held inline, not boxed, so that the step from
+/// alignment to navigation does not allocate either (the live navigator may realign in flight).
 #[derive(Debug, Clone)]
+#[allow(clippy::large_enum_variant)]
 enum Phase {
-    Aligning(Box<StaticAligner>),
-    Navigating(Box<ErrorStateEkf>),
+    Aligning(StaticAligner),
+    Navigating(ErrorStateEkf),
 }
 
 /// What one IMU sample did.
@@ -70,12 +82,24 @@ pub struct ImuStep {
 /// aligned.
 #[derive(Debug, Clone)]
 pub struct AidedNavigator {
-    config: AidedConfig,
+    pub(crate) config: AidedConfig,
     phase: Phase,
     stance: StanceDetector,
     alignment: Option<Alignment>,
     last_align_error: Option<AlignError>,
     last_time_us: Option<u64>,
+    /// Bias-corrected specific force of the last propagated sample, m/s².
+    pub(crate) last_force: Vector3<f64>,
+    /// The stance detector fired on the last sample.
+    pub(crate) in_stance: bool,
+    /// Magnitude and dip of the field in the alignment window.
+    pub(crate) field_reference: Option<FieldReference>,
+    /// First valid baro height, m: the altitude navigation starts from.
+    pub(crate) initial_height_m: Option<f64>,
+    /// Device time of the last accepted update per [`AidingSource`], µs.
+    pub(crate) last_accepted_us: [Option<u64>; AidingSource::COUNT],
+    /// Device time of the last magnetometer update attempted, µs (rate limit).
+    pub(crate) last_mag_update_us: Option<u64>,
 }
 
 impl AidedNavigator {
@@ -83,12 +107,52 @@ impl AidedNavigator {
         let stance = StanceDetector::new(config.stance);
         Self {
             config,
-            phase: Phase::Aligning(Box::new(StaticAligner::new(config.align))),
+            phase: Phase::Aligning(StaticAligner::new(config.align)),
             stance,
             alignment: None,
             last_align_error: None,
             last_time_us: None,
+            last_force: Vector3::zeros(),
+            in_stance: false,
+            field_reference: None,
+            initial_height_m: None,
+            last_accepted_us: [None; AidingSource::COUNT],
+            last_mag_update_us: None,
         }
+    }
+
+    /// The settings in use.
+    pub fn config(&self) -> &AidedConfig {
+        &self.config
+    }
+
+    /// True once aligned.
+    pub fn is_navigating(&self) -> bool {
+        matches!(self.phase, Phase::Navigating(_))
+    }
+
+    pub(crate) fn ekf_mut(&mut self) -> Option<&mut ErrorStateEkf> {
+        match &mut self.phase {
+            Phase::Navigating(ekf) => Some(ekf),
+            Phase::Aligning(_) => None,
+        }
+    }
+
+    pub(crate) fn aligner_mut(&mut self) -> Option<&mut StaticAligner> {
+        match &mut self.phase {
+            Phase::Aligning(aligner) => Some(aligner),
+            Phase::Navigating(_) => None,
+        }
+    }
+
+    /// Device time of the last IMU sample, µs.
+    pub fn time_us(&self) -> Option<u64> {
+        self.last_time_us
+    }
+
+    /// Device time of the last accepted update from `source`, µs.
+    pub fn last_accepted_us(&self, source: AidingSource) -> Option<u64> {
+        self.last_accepted_us[source as usize]
     }
 
     /// The filter, once aligned.
@@ -117,9 +181,8 @@ impl AidedNavigator {
         specific_force: [f64; 3],
         pressure: Option<f64>,
     ) -> ImuStep {
-        let dt_s = self
-            .last_time_us
-            .map_or(0.0, |last| t_us.saturating_sub(last) as f64 * 1e-6);
+        let previous_time_us = self.last_time_us;
+        let dt_s = previous_time_us.map_or(0.0, |last| t_us.saturating_sub(last) as f64 * 1e-6);
         self.last_time_us = Some(t_us);
         let mut step = ImuStep {
             propagated: None,
@@ -142,34 +205,63 @@ impl AidedNavigator {
             Phase::Navigating(ekf) => {
                 let outcome = ekf.predict(rate_rps, specific_force, dt_s);
                 step.propagated = Some(outcome);
+                if outcome == StepOutcome::NonFiniteInput {
+                    // The epoch stays: the next good sample integrates across this one.
+                    self.last_time_us = previous_time_us;
+                    return step;
+                }
+                // The detector sees bias-corrected rates, so a gyro bias the filter has learnt
+                // does not read as motion.
+                let b = ekf.bias();
+                let rate = Vector3::from(rate_rps) - b.gyro_rps;
+                let force = Vector3::from(specific_force) - b.accel_mps2;
+                self.last_force = force;
+                let g = ekf.strapdown().gravity();
+                step.stance = self.stance.push(rate.into(), force.into(), pressure, g);
+                self.in_stance = step.stance;
                 let z = self.config.zupt;
-                if z.enabled {
-                    // The detector sees bias-corrected rates, so a gyro bias the filter has
-                    // learnt does not read as motion.
-                    let b = ekf.bias();
-                    let rate = Vector3::from(rate_rps) - b.gyro_rps;
-                    let force = Vector3::from(specific_force) - b.accel_mps2;
-                    let g = ekf.strapdown().gravity();
-                    step.stance = self.stance.push(rate.into(), force.into(), pressure, g);
-                    if step.stance && outcome.is_applied() {
-                        step.zupt = Some(ekf.zupt(z.sigma_mps, z.gate));
+                if z.enabled && step.stance && outcome.is_applied() {
+                    let result = ekf.zupt(z.sigma_mps, z.gate);
+                    if result.is_accepted() {
+                        self.last_accepted_us[AidingSource::Zupt as usize] = Some(t_us);
                     }
+                    step.zupt = Some(result);
                 }
             }
         }
         step
     }
 
+    /// Starts the filter from a good alignment window: attitude and gyro bias from the window,
+    /// position from the configuration, altitude from the first valid baro reading when there was
+    /// one. The component of the mean specific force along itself in excess of model gravity is
+    /// taken as accelerometer bias, so the window integrates to zero velocity: at rest only this
+    /// component is observable, the rest of the bias is absorbed in roll and pitch.
     fn start(&mut self, a: Alignment) {
         let [lat, lon, alt] = self.config.origin;
-        let mut state = NominalState::at_rest(lat, lon, alt);
+        let mut state = NominalState::at_rest(lat, lon, self.initial_height_m.unwrap_or(alt));
         state.attitude = a.attitude;
-        let bias = ImuBias {
-            gyro_rps: a.gyro_bias_rps,
-            accel_mps2: Vector3::zeros(),
+        let mut ekf = ErrorStateEkf::new(
+            state,
+            ImuBias::default(),
+            self.config.strapdown,
+            self.config.noise,
+        );
+        let f = a.mean_specific_force_mps2;
+        let magnitude = f.norm();
+        let accel_bias = if magnitude > 0.0 {
+            f * (1.0 - ekf.strapdown().gravity() / magnitude)
+        } else {
+            Vector3::zeros()
         };
-        let ekf = ErrorStateEkf::new(state, bias, self.config.strapdown, self.config.noise);
+        ekf.set_bias(ImuBias {
+            gyro_rps: a.gyro_bias_rps,
+            accel_mps2: accel_bias,
+        });
+        self.field_reference = a
+            .mean_field_ut
+            .and_then(|m| FieldReference::from_field(&m, &a.attitude));
         self.alignment = Some(a);
-        self.phase = Phase::Navigating(Box::new(ekf));
+        self.phase = Phase::Navigating(ekf);
     }
 }

@@ -3,10 +3,12 @@
 use serde::{Deserialize, Serialize};
 
 use crate::aided::{AidedConfig, ZuptConfig};
+use crate::aiding::BaroAidingConfig;
 use crate::alignment::AlignConfig;
-use crate::baro_blend::BaroBlendConfig;
 use crate::earth::normal_gravity;
 use crate::ekf::EkfNoise;
+use crate::mag_calibration::MagCalibration;
+use crate::mag_heading::MagAidingConfig;
 use crate::mechanisation::StrapdownConfig;
 use crate::stance::StanceConfig;
 
@@ -26,10 +28,6 @@ pub struct NavigatorConfig {
     pub initial_longitude_deg: f64,
     /// Initial altitude, m; replaced by the first valid baro reading when there is one.
     pub initial_altitude_m: f64,
-    /// Time constant τ of the baro blend, s.
-    pub baro_time_constant_s: f64,
-    /// Largest accepted |baro reading time − navigation time|, s.
-    pub baro_max_lag_s: f64,
     /// Largest accepted IMU sample interval, s; longer gaps are skipped as device-time glitches.
     pub max_dt_s: f64,
     /// Two-sample coning correction in the attitude update.
@@ -50,21 +48,25 @@ pub struct NavigatorConfig {
     pub zupt: ZuptConfig,
     /// Stance detector (`[navigator.stance]`).
     pub stance: StanceConfig,
+    /// Barometric height updates (`[navigator.baro]`).
+    pub baro: BaroAidingConfig,
+    /// Magnetometer heading updates (`[navigator.mag]`).
+    pub mag: MagAidingConfig,
+    /// Hard- and soft-iron correction of the magnetometer (`[navigator.mag_calibration]`, as
+    /// printed by `rins calibrate mag`).
+    pub mag_calibration: MagCalibration,
 }
 
 impl Default for NavigatorConfig {
     fn default() -> Self {
         let align = AlignConfig::default();
         let strapdown = StrapdownConfig::default();
-        let baro = BaroBlendConfig::default();
         Self {
             align_s: align.window_s,
             declination_deg: 0.0,
             initial_latitude_deg: 0.0,
             initial_longitude_deg: 0.0,
             initial_altitude_m: 0.0,
-            baro_time_constant_s: baro.time_constant_s,
-            baro_max_lag_s: baro.max_lag_s,
             max_dt_s: strapdown.max_dt_s,
             coning_correction: strapdown.coning_correction,
             aiding_timeout_s: 1.0,
@@ -75,6 +77,9 @@ impl Default for NavigatorConfig {
             ekf: EkfNoise::default(),
             zupt: ZuptConfig::default(),
             stance: StanceConfig::default(),
+            baro: BaroAidingConfig::default(),
+            mag: MagAidingConfig::default(),
+            mag_calibration: MagCalibration::default(),
         }
     }
 }
@@ -126,18 +131,6 @@ impl NavigatorConfig {
             self.initial_altitude_m,
             |x| (-1000.0..=50_000.0).contains(&x),
             "must be in [-1000, 50000] m",
-        )?;
-        check(
-            "baro_time_constant_s",
-            self.baro_time_constant_s,
-            |x| x > 0.0 && x <= 1000.0,
-            "must be in (0, 1000] s",
-        )?;
-        check(
-            "baro_max_lag_s",
-            self.baro_max_lag_s,
-            |x| x >= 0.0,
-            "must be finite and >= 0 s",
         )?;
         check(
             "max_dt_s",
@@ -200,6 +193,30 @@ impl NavigatorConfig {
             )
             .within("navigator.stance"));
         }
+        if let Err((field, value)) = self.baro.check() {
+            return Err(
+                ConfigError::new(field, value, "must be finite and > 0").within("navigator.baro")
+            );
+        }
+        if let Err((field, value)) = self.mag.check() {
+            return Err(ConfigError::new(
+                field,
+                value,
+                "out of range (inflation >= 1, max_rate_hz >= 0, others finite and > 0)",
+            )
+            .within("navigator.mag"));
+        }
+        let calibration = &self.mag_calibration;
+        let entries = calibration
+            .hard_iron_ut
+            .iter()
+            .chain(calibration.soft_iron_correction.iter().flatten());
+        if let Some(bad) = entries.copied().find(|x| !x.is_finite()) {
+            return Err(
+                ConfigError::new("mag_calibration", bad, "every entry must be finite")
+                    .within("navigator"),
+            );
+        }
         Ok(())
     }
 
@@ -211,6 +228,9 @@ impl NavigatorConfig {
             noise: self.ekf,
             zupt: self.zupt,
             stance: self.stance,
+            baro: self.baro,
+            mag: self.mag,
+            mag_calibration: self.mag_calibration,
             declination_rad: self.declination_deg.to_radians(),
             origin: [
                 self.initial_latitude_deg.to_radians(),
@@ -240,14 +260,6 @@ impl NavigatorConfig {
         StrapdownConfig {
             max_dt_s: self.max_dt_s,
             coning_correction: self.coning_correction,
-        }
-    }
-
-    /// Baro blend settings.
-    pub fn baro_blend_config(&self) -> BaroBlendConfig {
-        BaroBlendConfig {
-            time_constant_s: self.baro_time_constant_s,
-            max_lag_s: self.baro_max_lag_s,
         }
     }
 }

@@ -1,23 +1,24 @@
-//! Navigator core: static alignment, quaternion strapdown mechanisation and baro height blend.
+//! Navigator core: static alignment, quaternion strapdown mechanisation, the error-state EKF and its
+//! aiding (baro height, magnetometer heading, zero-velocity updates).
 //!
 //! Pure functions and small structs, no I/O. Frames: NED navigation, FRD body; quaternions rotate
 //! body → NED (Hamilton, scalar first); SI units inside, degrees only in [`NavigatorConfig`].
 
 pub mod aided;
+pub mod aiding;
 pub mod alignment;
 pub mod attitude;
-pub mod baro_blend;
 pub mod config;
 pub mod earth;
 pub mod ekf;
 pub mod mag_calibration;
+pub mod mag_heading;
 pub mod mechanisation;
 pub mod navigator;
 pub mod service;
 pub mod stance;
 
 pub use alignment::{AlignConfig, AlignError, Alignment, StaticAligner};
-pub use baro_blend::{BaroBlend, BaroBlendConfig, BaroOutcome};
 pub use config::{ConfigError, NavigatorConfig};
 pub use mechanisation::{ImuBias, NominalState, StepOutcome, Strapdown, StrapdownConfig};
 pub use navigator::{NavOutput, Navigator};

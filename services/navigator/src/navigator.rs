@@ -1,4 +1,5 @@
-//! The navigator: static alignment, then strapdown propagation with the baro height blend.
+//! The navigator: static alignment, then the error-state EKF with baro height, magnetometer heading
+//! and zero-velocity aiding (see [`crate::aided`]), wrapped for the process and its payload.
 //!
 //! Sequence. IMU samples fill the alignment window; when it spans `align_s` of device time the window is
 //! checked and either gives the initial attitude and gyro bias or is discarded and restarted (the reason
@@ -9,20 +10,17 @@
 //!
 //! Initial state: position from the configuration, altitude from the first valid baro reading if one
 //! arrived (else the configured altitude, and the first valid reading after alignment then sets it),
-//! velocity zero. The component of the mean specific force along itself in excess of model gravity is
-//! taken as accelerometer bias, so that the static window integrates to exactly zero velocity: at rest
-//! only this component of the accelerometer bias is observable, the rest is absorbed in roll and pitch.
-//!
-//! Magnetometer samples are used only in the alignment window in this version.
+//! velocity zero, heading from the magnetometer when it reported during the window.
 
-use ipc_types::{NavMode, NavState, aiding};
-use nalgebra::Vector3;
+use ipc_types::{NAV_STATES, NavMode, NavState, aiding};
 
-use crate::alignment::{AlignError, Alignment, StaticAligner};
+use crate::aided::AidedNavigator;
+use crate::aiding::AidingOutcome;
+use crate::alignment::{AlignError, Alignment};
 use crate::attitude::quaternion_to_array;
-use crate::baro_blend::{BaroBlend, BaroOutcome};
 use crate::config::{ConfigError, NavigatorConfig};
-use crate::mechanisation::{ImuBias, NominalState, StepOutcome, Strapdown};
+use crate::ekf::{AidingCounts, AidingSource, ErrorStateEkf};
+use crate::mechanisation::{NominalState, StepOutcome};
 
 /// One navigation solution.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,43 +39,54 @@ pub struct NavOutput {
     pub alt: f64,
     /// Aligning or navigating.
     pub mode: NavMode,
-    /// A valid baro reading was blended within the aiding timeout.
-    pub aiding_baro: bool,
-    /// The heading was initialised from the magnetometer.
-    pub aiding_mag: bool,
+    /// Sources with an accepted update within the aiding timeout, bits of [`aiding`]; MAG also
+    /// while the heading is the magnetometer's from alignment and no heading update was tried.
+    pub aiding: u32,
+    /// Diagonal of the error-state covariance (δθ rad², δv (m/s)², δp m², δb_g, δb_a).
+    pub covariance_diag: [f64; NAV_STATES],
+    /// Accepted and gated-out updates per [`AidingSource`] since alignment.
+    pub counts: [AidingCounts; AidingSource::COUNT],
 }
 
 impl NavOutput {
-    /// Copies the solution into an IPC payload; leaves its header and covariance untouched.
+    /// Copies the solution into an IPC payload; leaves its header untouched.
     pub fn write_nav_state(&self, out: &mut NavState) {
         out.mode = self.mode as u8;
-        out.aiding = if self.aiding_baro { aiding::BARO } else { 0 }
-            | if self.aiding_mag { aiding::MAG } else { 0 };
+        out.aiding = self.aiding;
         out.quaternion = self.quaternion;
         out.velocity_ned_mps = self.velocity_ned;
         out.latitude_rad = self.lat;
         out.longitude_rad = self.lon;
         out.altitude_m = self.alt;
+        out.covariance_diag = self.covariance_diag;
+        for (k, c) in self.counts.iter().enumerate() {
+            out.aiding_accepted[k] = u32::try_from(c.accepted).unwrap_or(u32::MAX);
+            out.aiding_rejected[k] = u32::try_from(c.rejected).unwrap_or(u32::MAX);
+        }
+    }
+
+    /// True when `source`'s bit is set in [`NavOutput::aiding`].
+    pub fn aided_by(&self, bit: u32) -> bool {
+        self.aiding & bit != 0
     }
 }
 
-/// Strapdown navigator with static alignment and baro height blend. Allocation-free per sample.
+/// Aiding bit of each source.
+const SOURCE_BITS: [(AidingSource, u32); AidingSource::COUNT] = [
+    (AidingSource::Baro, aiding::BARO),
+    (AidingSource::Mag, aiding::MAG),
+    (AidingSource::Zupt, aiding::ZUPT),
+    (AidingSource::Hupt, aiding::HUPT),
+];
+
+/// The navigator of the process. Allocation-free per sample once aligned.
 #[derive(Debug, Clone)]
 pub struct Navigator {
     config: NavigatorConfig,
-    declination_rad: f64,
+    core: AidedNavigator,
     aiding_timeout_us: u64,
-    aligner: StaticAligner,
-    strapdown: Strapdown,
-    blend: BaroBlend,
-    mode: NavMode,
-    alignment: Option<Alignment>,
-    last_align_error: Option<AlignError>,
     /// Device time of the navigation state (of the last IMU sample while aligning), µs.
     state_time_us: u64,
-    /// First valid baro height seen, m.
-    baro_initial_altitude: Option<f64>,
-    last_baro_used_us: Option<u64>,
     rejected_imu_samples: u64,
 }
 
@@ -85,30 +94,13 @@ impl Navigator {
     /// A navigator waiting for its alignment window. Fails when the configuration is out of range.
     pub fn new(config: NavigatorConfig) -> Result<Self, ConfigError> {
         config.validate()?;
-        let rest = Self::rest_state(&config);
         Ok(Self {
-            declination_rad: config.declination_deg.to_radians(),
+            core: AidedNavigator::new(config.aided_config()),
             aiding_timeout_us: (config.aiding_timeout_s * 1e6).round() as u64,
-            aligner: StaticAligner::new(config.align_config()),
-            strapdown: Strapdown::new(rest, ImuBias::default(), config.strapdown_config()),
-            blend: BaroBlend::new(config.baro_blend_config()),
-            mode: NavMode::Aligning,
-            alignment: None,
-            last_align_error: None,
             state_time_us: 0,
-            baro_initial_altitude: None,
-            last_baro_used_us: None,
             rejected_imu_samples: 0,
             config,
         })
-    }
-
-    fn rest_state(config: &NavigatorConfig) -> NominalState {
-        NominalState::at_rest(
-            config.initial_latitude_deg.to_radians(),
-            config.initial_longitude_deg.to_radians(),
-            config.initial_altitude_m,
-        )
     }
 
     /// Drops the solution and starts a new alignment window.
@@ -126,22 +118,30 @@ impl Navigator {
 
     /// Aligning or navigating.
     pub fn mode(&self) -> NavMode {
-        self.mode
+        if self.core.is_navigating() {
+            NavMode::Navigating
+        } else {
+            NavMode::Aligning
+        }
     }
 
     /// The alignment the solution started from.
     pub fn alignment(&self) -> Option<&Alignment> {
-        self.alignment.as_ref()
+        self.core.alignment()
     }
 
     /// Why the last alignment window was discarded, until an alignment succeeds.
     pub fn last_align_error(&self) -> Option<&AlignError> {
-        self.last_align_error.as_ref()
+        if self.core.is_navigating() {
+            None
+        } else {
+            self.core.last_align_error()
+        }
     }
 
-    /// The strapdown integrator (nominal state and biases).
-    pub fn strapdown(&self) -> &Strapdown {
-        &self.strapdown
+    /// The filter (nominal state, biases, covariance, counts), once aligned.
+    pub fn ekf(&self) -> Option<&ErrorStateEkf> {
+        self.core.ekf()
     }
 
     /// IMU samples not integrated because of a device-time glitch or non-finite values.
@@ -157,121 +157,87 @@ impl Navigator {
         rate_rps: [f64; 3],
         specific_force: [f64; 3],
     ) -> Option<NavOutput> {
-        if self.mode == NavMode::Aligning {
-            self.state_time_us = device_time_us;
-            self.aligner
-                .push_imu(device_time_us, rate_rps, specific_force);
-            if !self.aligner.is_complete() {
-                return None;
-            }
-            match self.aligner.finish(self.declination_rad) {
-                Ok(alignment) => self.start_navigation(alignment, device_time_us),
-                Err(error) => {
-                    self.last_align_error = Some(error);
-                    self.aligner.reset();
-                    return None;
-                }
-            }
-            return Some(self.output());
-        }
-
-        let dt_s = if device_time_us > self.state_time_us {
-            (device_time_us - self.state_time_us) as f64 * 1e-6
-        } else {
-            0.0
-        };
-        match self.strapdown.propagate(rate_rps, specific_force, dt_s) {
-            StepOutcome::Applied => self.state_time_us = device_time_us,
-            StepOutcome::InvalidDt => {
+        let step = self
+            .core
+            .on_imu(device_time_us, rate_rps, specific_force, None);
+        match step.propagated {
+            Some(StepOutcome::Applied) | None => self.state_time_us = device_time_us,
+            Some(StepOutcome::InvalidDt) => {
                 self.state_time_us = device_time_us;
                 self.rejected_imu_samples += 1;
             }
-            // The epoch stays: the next good sample integrates across this one.
-            StepOutcome::NonFiniteInput => self.rejected_imu_samples += 1,
+            Some(StepOutcome::NonFiniteInput) => self.rejected_imu_samples += 1,
         }
-        Some(self.output())
+        self.core.is_navigating().then(|| self.output())
     }
 
-    fn start_navigation(&mut self, alignment: Alignment, device_time_us: u64) {
-        let mut state = Self::rest_state(&self.config);
-        state.attitude = alignment.attitude;
-        if let Some(alt) = self.baro_initial_altitude {
-            state.alt = alt;
-        }
-        let mut strapdown =
-            Strapdown::new(state, ImuBias::default(), self.config.strapdown_config());
-        let f = alignment.mean_specific_force_mps2;
-        let magnitude = f.norm();
-        let accel_bias = if magnitude > 0.0 {
-            f * (1.0 - strapdown.gravity() / magnitude)
-        } else {
-            Vector3::zeros()
-        };
-        *strapdown.bias_mut() = ImuBias {
-            gyro_rps: alignment.gyro_bias_rps,
-            accel_mps2: accel_bias,
-        };
-        self.strapdown = strapdown;
-        self.blend.restart();
-        self.state_time_us = device_time_us;
-        self.alignment = Some(alignment);
-        self.last_align_error = None;
-        self.mode = NavMode::Navigating;
+    /// One magnetometer sample, µT, body FRD: the alignment heading, then heading updates.
+    pub fn on_mag(&mut self, device_time_us: u64, field_ut: [f64; 3]) -> AidingOutcome {
+        self.core.on_mag(device_time_us, field_ut)
     }
 
-    /// One magnetometer sample, µT, body FRD. Used for the alignment heading.
-    pub fn on_mag(&mut self, device_time_us: u64, field_ut: [f64; 3]) {
-        if self.mode == NavMode::Aligning {
-            self.aligner.push_mag(device_time_us, field_ut);
-        }
-    }
-
-    /// One barometric height (m, positive up) at device time (µs); ignored unless `valid`.
-    pub fn on_baro(&mut self, device_time_us: u64, height_m: f64, valid: bool) {
-        if !valid || !height_m.is_finite() {
-            return;
-        }
-        if self.baro_initial_altitude.is_none() {
-            self.baro_initial_altitude = Some(height_m);
-            if self.mode != NavMode::Aligning {
-                // No baro at alignment: take the height directly rather than through a slow transient.
-                self.strapdown.state_mut().alt = height_m;
-                self.blend.restart();
-            }
-        }
-        if self.mode == NavMode::Aligning {
-            return;
-        }
-        let outcome = self.blend.apply(
-            self.strapdown.state_mut(),
-            self.state_time_us,
-            device_time_us,
-            height_m,
-            valid,
-        );
-        if matches!(outcome, BaroOutcome::Applied { .. } | BaroOutcome::Started) {
-            self.last_baro_used_us = Some(device_time_us);
-        }
+    /// One barometric height (m, positive up) with its variance (m²) at device time (µs);
+    /// ignored unless `valid`.
+    pub fn on_baro(
+        &mut self,
+        device_time_us: u64,
+        height_m: f64,
+        variance_m2: f64,
+        valid: bool,
+    ) -> AidingOutcome {
+        self.core
+            .on_baro(device_time_us, height_m, variance_m2, valid)
     }
 
     /// The current solution (a level, at-rest placeholder at the configured position while aligning).
     pub fn output(&self) -> NavOutput {
-        let s = self.strapdown.state();
-        let navigating = self.mode != NavMode::Aligning;
-        let aiding_baro = navigating
-            && self
-                .last_baro_used_us
-                .is_some_and(|t| self.state_time_us <= t.saturating_add(self.aiding_timeout_us));
+        let placeholder;
+        let (state, ekf) = match self.core.ekf() {
+            Some(ekf) => (ekf.state(), Some(ekf)),
+            None => {
+                let [lat, lon, alt] = self.core.config().origin;
+                placeholder = NominalState::at_rest(lat, lon, alt);
+                (&placeholder, None)
+            }
+        };
+        let mut aiding_bits = 0;
+        let mut counts = [AidingCounts::default(); AidingSource::COUNT];
+        let mut covariance_diag = [0.0; NAV_STATES];
+        if let Some(ekf) = ekf {
+            for (source, bit) in SOURCE_BITS {
+                let recent = self.core.last_accepted_us(source).is_some_and(|t| {
+                    self.state_time_us <= t.saturating_add(self.aiding_timeout_us)
+                });
+                if recent {
+                    aiding_bits |= bit;
+                }
+                counts[source as usize] = ekf.counts(source);
+            }
+            // Until the first heading update the heading is the magnetometer's from alignment.
+            let no_heading_update = [AidingSource::Mag, AidingSource::Hupt]
+                .iter()
+                .all(|s| counts[*s as usize] == AidingCounts::default());
+            let heading_from_alignment =
+                self.core.alignment().is_some_and(|a| a.heading_aided) && no_heading_update;
+            if heading_from_alignment {
+                aiding_bits |= aiding::MAG;
+            }
+            let p = ekf.covariance();
+            for (k, d) in covariance_diag.iter_mut().enumerate() {
+                *d = p[(k, k)];
+            }
+        }
         NavOutput {
             device_time_us: self.state_time_us,
-            quaternion: quaternion_to_array(&s.attitude),
-            velocity_ned: s.velocity_ned.into(),
-            lat: s.lat,
-            lon: s.lon,
-            alt: s.alt,
-            mode: self.mode,
-            aiding_baro,
-            aiding_mag: navigating && self.alignment.is_some_and(|a| a.heading_aided),
+            quaternion: quaternion_to_array(&state.attitude),
+            velocity_ned: state.velocity_ned.into(),
+            lat: state.lat,
+            lon: state.lon,
+            alt: state.alt,
+            mode: self.mode(),
+            aiding: aiding_bits,
+            covariance_diag,
+            counts,
         }
     }
 }

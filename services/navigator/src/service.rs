@@ -1,4 +1,4 @@
-//! The navigator process: fused IMU drives the strapdown solution; altitude and magnetometer aid it.
+//! The navigator process: fused IMU drives the filter; altitude and magnetometer aid it.
 //! A navigation state is published for every fused IMU sample, also while aligning, so consumers see
 //! a contiguous sequence.
 
@@ -55,9 +55,10 @@ pub fn run(config: &NavigatorConfig, settings: &IpcSettings, shutdown: &Shutdown
         // Aiding first: it is older than (or as old as) the IMU sample that woke us.
         while let Some(alt) = alt_in.receive()? {
             if alt.version == PAYLOAD_VERSION {
-                nav.on_baro(
+                let _ = nav.on_baro(
                     alt.header.origin_device_time_us,
                     alt.height_m,
+                    alt.height_var,
                     alt.valid != 0,
                 );
             } else {
@@ -66,7 +67,7 @@ pub fn run(config: &NavigatorConfig, settings: &IpcSettings, shutdown: &Shutdown
         }
         while let Some(mag) = mag_in.receive()? {
             if mag.version == PAYLOAD_VERSION {
-                nav.on_mag(
+                let _ = nav.on_mag(
                     mag.header.origin_device_time_us,
                     mag.field_ut.map(f64::from),
                 );

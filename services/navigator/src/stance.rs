@@ -16,6 +16,8 @@ use serde::{Deserialize, Serialize};
 
 /// Longest window the detector keeps, samples.
 pub const MAX_WINDOW: usize = 64;
+/// Largest `min_samples`.
+pub const MAX_MIN_SAMPLES: usize = 10_000;
 
 /// Which test decides stance, with its parameters.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -49,6 +51,11 @@ pub struct StanceConfig {
     pub window: usize,
     /// The test and its parameters.
     pub detector: StanceTest,
+    /// Consecutive positive decisions before stance is declared (1 = at once). The heel strike
+    /// can pass the test for a sample or two while the foot still moves; a zero-velocity update
+    /// there pulls the position back along the whole stride through the velocity–position
+    /// correlation, so brief detections are not trusted.
+    pub min_samples: usize,
 }
 
 impl Default for StanceConfig {
@@ -56,6 +63,7 @@ impl Default for StanceConfig {
     fn default() -> Self {
         Self {
             window: 5,
+            min_samples: 1,
             detector: StanceTest::Shoe {
                 accel_sigma_mps2: 0.01,
                 gyro_sigma_rps: 0.1_f64.to_radians(),
@@ -70,6 +78,9 @@ impl StanceConfig {
     pub fn check(&self) -> Result<(), (&'static str, f64)> {
         if !(1..=MAX_WINDOW).contains(&self.window) {
             return Err(("window", self.window as f64));
+        }
+        if !(1..=MAX_MIN_SAMPLES).contains(&self.min_samples) {
+            return Err(("min_samples", self.min_samples as f64));
         }
         let positive = |name: &'static str, v: f64| {
             if v.is_finite() && v > 0.0 {
@@ -121,6 +132,8 @@ pub struct StanceDetector {
     /// Next slot to write.
     head: usize,
     last_statistic: f64,
+    /// Consecutive positive decisions so far.
+    run: usize,
 }
 
 impl StanceDetector {
@@ -135,6 +148,7 @@ impl StanceDetector {
             len: 0,
             head: 0,
             last_statistic: f64::NAN,
+            run: 0,
         }
     }
 
@@ -147,6 +161,22 @@ impl StanceDetector {
     /// Adds a sample (rate rad/s, specific force m/s², optional foot pressure 0..1) and decides
     /// whether the foot is in stance; `gravity` is the local g, m/s². False until the window is full.
     pub fn push(
+        &mut self,
+        gyro: [f64; 3],
+        accel: [f64; 3],
+        pressure: Option<f64>,
+        gravity: f64,
+    ) -> bool {
+        if self.test(gyro, accel, pressure, gravity) {
+            self.run = self.run.saturating_add(1);
+        } else {
+            self.run = 0;
+        }
+        self.run >= self.config.min_samples
+    }
+
+    /// The detector's test on the window ending with this sample.
+    fn test(
         &mut self,
         gyro: [f64; 3],
         accel: [f64; 3],

@@ -1,4 +1,5 @@
-//! The navigator end to end on synthetic static data: alignment, propagation, baro and glitches.
+//! The navigator end to end on synthetic static data: alignment, propagation, baro and
+//! magnetometer aiding, glitches.
 
 mod common;
 
@@ -6,6 +7,7 @@ use common::{Noise, earth_field_ned, specific_force_at_rest};
 use ipc_types::{NavMode, NavState, aiding};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use rins_navigator::earth::normal_gravity;
+use rins_navigator::ekf::{AidingCounts, AidingSource};
 use rins_navigator::mechanisation::quaternion_from_euler;
 use rins_navigator::{AlignError, NavOutput, Navigator, NavigatorConfig};
 
@@ -55,10 +57,15 @@ impl StaticVehicle {
     fn step(&mut self, nav: &mut Navigator, k: u64) -> Option<NavOutput> {
         let t = T0_US + k * 1000;
         if k.is_multiple_of(10) {
-            nav.on_mag(t, (self.field_body + self.noise.vector(0.2)).into());
+            let _ = nav.on_mag(t, (self.field_body + self.noise.vector(0.2)).into());
         }
         if self.with_baro && k.is_multiple_of(40) {
-            nav.on_baro(t, BARO_HEIGHT + self.noise.scalar(BARO_SIGMA), true);
+            let _ = nav.on_baro(
+                t,
+                BARO_HEIGHT + self.noise.scalar(BARO_SIGMA),
+                BARO_SIGMA * BARO_SIGMA,
+                true,
+            );
         }
         let rate = self.gyro_bias + self.noise.vector(GYRO_SIGMA);
         let f = specific_force_at_rest(&self.attitude, self.gravity)
@@ -85,13 +92,13 @@ fn aligns_after_one_second_then_navigates_a_static_vehicle_within_predicted_drif
     let first = vehicle.step(&mut nav, 1000).expect("aligned");
     assert_eq!(first.mode, NavMode::Navigating);
     assert_eq!(first.device_time_us, T0_US + 1_000_000);
-    assert!(first.aiding_mag);
+    assert!(first.aided_by(aiding::MAG));
     assert_eq!(first.velocity_ned, [0.0; 3]);
     assert!((first.lat - 47f64.to_radians()).abs() < 1e-15);
     assert!((first.lon - 8f64.to_radians()).abs() < 1e-15);
     // Altitude from the first baro reading, not the configured 400 m.
     assert!((first.alt - BARO_HEIGHT).abs() < 5.0 * BARO_SIGMA);
-    let bias = nav.strapdown().bias().gyro_rps;
+    let bias = nav.ekf().unwrap().bias().gyro_rps;
     assert!((bias - vehicle.gyro_bias).amax() < 5.0 * GYRO_SIGMA / 1001f64.sqrt());
 
     let seconds = 10.0;
@@ -103,7 +110,12 @@ fn aligns_after_one_second_then_navigates_a_static_vehicle_within_predicted_drif
         last.device_time_us,
         T0_US + 1_000_000 + (seconds * 1e6) as u64
     );
-    assert!(last.aiding_baro && last.aiding_mag);
+    assert!(last.aided_by(aiding::BARO) && last.aided_by(aiding::MAG));
+    let baro = last.counts[AidingSource::Baro as usize];
+    let mag = last.counts[AidingSource::Mag as usize];
+    // Baro at 25 Hz and the magnetometer limited to 10 Hz over 10 s; the gate (5σ) passes all.
+    assert_eq!((baro.accepted, baro.rejected), (250, 0));
+    assert_eq!((mag.accepted, mag.rejected), (100, 0));
     assert_eq!(nav.rejected_imu_samples(), 0);
 
     // One-sigma horizontal velocity error from the alignment residuals: initial tilt error
@@ -192,7 +204,7 @@ fn without_baro_at_alignment_the_first_valid_reading_sets_the_altitude() {
     let mut nav = Navigator::new(config()).unwrap();
     let mut vehicle = StaticVehicle::new(2);
     vehicle.with_baro = false;
-    nav.on_baro(T0_US, 999.0, false);
+    let _ = nav.on_baro(T0_US, 999.0, 1.0, false);
     let mut k = 0;
     let out = loop {
         if let Some(out) = vehicle.step(&mut nav, k) {
@@ -201,21 +213,23 @@ fn without_baro_at_alignment_the_first_valid_reading_sets_the_altitude() {
         k += 1;
     };
     assert_eq!(out.alt, 400.0);
-    assert!(!out.aiding_baro);
+    assert!(!out.aided_by(aiding::BARO));
     let t = T0_US + k * 1000;
-    nav.on_baro(t, 455.0, true);
+    let _ = nav.on_baro(t, 455.0, 1.0, true);
     let out = nav.output();
     assert_eq!(out.alt, 455.0);
-    assert!(out.aiding_baro);
+    // The first reading sets the altitude; the following ones are updates.
+    let _ = nav.on_baro(t, 455.0, 1.0, true);
+    assert!(nav.output().aided_by(aiding::BARO));
     // Invalid readings are ignored and the flag lapses after the aiding timeout (1 s).
     for j in 1..=1500u64 {
         if j.is_multiple_of(40) {
-            nav.on_baro(t + j * 1000, 0.0, false);
+            let _ = nav.on_baro(t + j * 1000, 0.0, 1.0, false);
         }
         let _ = vehicle.step(&mut nav, k + j);
     }
     let out = nav.output();
-    assert!(!out.aiding_baro);
+    assert!(!out.aided_by(aiding::BARO));
     assert!((out.alt - 455.0).abs() < 1.0);
 }
 
@@ -229,13 +243,29 @@ fn output_fills_the_ipc_payload() {
         lon: 0.2,
         alt: 30.0,
         mode: NavMode::Navigating,
-        aiding_baro: true,
-        aiding_mag: false,
+        aiding: aiding::BARO | aiding::ZUPT,
+        covariance_diag: std::array::from_fn(|k| k as f64),
+        counts: [
+            AidingCounts {
+                accepted: 5,
+                rejected: 1,
+            },
+            AidingCounts::default(),
+            AidingCounts {
+                accepted: u64::MAX,
+                rejected: 0,
+            },
+            AidingCounts::default(),
+        ],
     };
     let mut state = NavState::default();
     out.write_nav_state(&mut state);
     assert_eq!(state.mode, NavMode::Navigating as u8);
-    assert_eq!(state.aiding, aiding::BARO);
+    assert_eq!(state.aiding, aiding::BARO | aiding::ZUPT);
+    assert_eq!(state.covariance_diag, out.covariance_diag);
+    // Counts saturate rather than wrap.
+    assert_eq!(state.aiding_accepted, [5, 0, u32::MAX, 0]);
+    assert_eq!(state.aiding_rejected, [1, 0, 0, 0]);
     assert_eq!(state.quaternion, out.quaternion);
     assert_eq!(state.velocity_ned_mps, out.velocity_ned);
     assert_eq!(
@@ -250,21 +280,25 @@ fn configuration_parses_partially_and_rejects_unknown_or_out_of_range_fields() {
         toml::from_str("align_s = 2.0\ninitial_latitude_deg = 47.5\n").unwrap();
     assert_eq!(parsed.align_s, 2.0);
     assert_eq!(parsed.initial_latitude_deg, 47.5);
-    assert_eq!(parsed.baro_time_constant_s, 5.0);
+    assert!(parsed.baro.enabled && parsed.mag.enabled);
     assert!(parsed.validate().is_ok());
     assert!(toml::from_str::<NavigatorConfig>("align_seconds = 2.0\n").is_err());
 
     type Spoil = fn(&mut NavigatorConfig);
-    let cases: [(&str, Spoil); 6] = [
+    let cases: [(&str, Spoil); 8] = [
         ("align_s", |c| c.align_s = -1.0),
         ("initial_latitude_deg", |c| c.initial_latitude_deg = 91.0),
         ("initial_longitude_deg", |c| {
             c.initial_longitude_deg = f64::NAN
         }),
-        ("baro_time_constant_s", |c| c.baro_time_constant_s = 0.0),
+        ("baro.sigma_floor_m", |c| c.baro.sigma_floor_m = 0.0),
         ("max_dt_s", |c| c.max_dt_s = f64::INFINITY),
         ("align_max_rate_std_rps", |c| {
             c.align_max_rate_std_rps = -0.1
+        }),
+        ("mag.inflation", |c| c.mag.inflation = 0.5),
+        ("mag_calibration", |c| {
+            c.mag_calibration.hard_iron_ut[1] = f64::NAN
         }),
     ];
     for (field, spoil) in cases {
@@ -279,4 +313,65 @@ fn configuration_parses_partially_and_rejects_unknown_or_out_of_range_fields() {
         ..NavigatorConfig::default()
     };
     assert_eq!(c.validate().unwrap_err().value, "-1");
+}
+
+/// Heading error of the output against the vehicle, rad.
+fn heading_error(out: &NavOutput, truth: &UnitQuaternion<f64>) -> f64 {
+    let yaw = |q: &UnitQuaternion<f64>| q.euler_angles().2;
+    rins_navigator::attitude::wrap_pi(yaw(&attitude_of(out)) - yaw(truth))
+}
+
+/// After alignment the magnetometer reads a field turned 5° about the vertical, either with the
+/// reference magnitude (undetectable: the heading must follow it) or also 40 % stronger (a
+/// disturbance: the adaptive σ grows tenfold times the ratio and the heading must hold).
+fn heading_after_turned_field(stronger: f64) -> f64 {
+    let mut nav = Navigator::new(config()).unwrap();
+    let mut vehicle = StaticVehicle::new(5);
+    let mut k = 0;
+    while vehicle.step(&mut nav, k).is_none() {
+        k += 1;
+    }
+    let turn = UnitQuaternion::from_euler_angles(0.0, 0.0, 5f64.to_radians());
+    let field_ned = earth_field_ned(21.0, 43.0, 2f64.to_radians());
+    vehicle.field_body = vehicle.attitude.inverse() * (turn * field_ned) * stronger;
+    let mut out = nav.output();
+    for j in 1..=20_000 {
+        out = vehicle.step(&mut nav, k + j).unwrap();
+    }
+    heading_error(&out, &vehicle.attitude)
+}
+
+/// Where a scalar Kalman filter with prior σ₀ (the configured initial heading σ) ends after `n`
+/// updates of σ `sigma_deg` all measuring `step_deg`: `step · n P₀ / (R + n P₀)`.
+fn scalar_filter_end(step_deg: f64, sigma_deg: f64, n: f64) -> f64 {
+    let p0 = NavigatorConfig::default()
+        .ekf
+        .initial_heading_sigma
+        .to_degrees()
+        .powi(2);
+    step_deg * n * p0 / (sigma_deg * sigma_deg + n * p0)
+}
+
+#[test]
+fn magnetometer_updates_follow_an_undisturbed_field_and_hold_against_a_disturbed_one() {
+    // 200 updates (10 Hz for 20 s). The field is turned east, so the vehicle appears turned west.
+    // Undisturbed: σ = 2°, each innovation inside the 5σ gate; the estimate ends on the field's
+    // heading, −5°. Tolerance: the gyro noise and bias-error drift over 20 s and 2°/√200 of
+    // measurement noise, about 0.3°.
+    let followed = heading_after_turned_field(1.0).to_degrees();
+    let expected = scalar_filter_end(-5.0, 2.0, 200.0);
+    assert!(
+        (followed - expected).abs() < 0.3,
+        "{followed} vs {expected}"
+    );
+    // Disturbed: |m| 40 % above the reference, ratio 0.4 · 47.85 µT / 5 µT = 3.83, so
+    // σ = 2° · 10 · 3.83 = 76.6°: the estimate moves only part of the way.
+    let held = heading_after_turned_field(1.4).to_degrees();
+    let sigma = 2.0 * 10.0 * 0.4 * 21f64.hypot(43.0) / 5.0;
+    let expected_held = scalar_filter_end(-5.0, sigma, 200.0);
+    assert!(
+        (held - expected_held).abs() < 0.3,
+        "{held} vs {expected_held}"
+    );
+    assert!(held > followed + 0.8, "{held} vs {followed}");
 }

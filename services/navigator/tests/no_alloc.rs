@@ -68,7 +68,7 @@ fn navigating_samples_do_not_allocate() {
     let aligning = allocations_during(|| {
         while !aligned {
             nav.on_mag(t, [20.0, 0.0, 40.0]);
-            nav.on_baro(t, 10.0, true);
+            let _ = nav.on_baro(t, 10.0, 0.04, true);
             aligned = nav.on_imu(t, [0.001, 0.0, 0.0], [0.0, 0.0, -g]).is_some();
             t += 1000;
         }
@@ -83,7 +83,7 @@ fn navigating_samples_do_not_allocate() {
                 nav.on_mag(time, [20.0, 0.0, 40.0]);
             }
             if k.is_multiple_of(40) {
-                nav.on_baro(time, 10.5, k.is_multiple_of(80));
+                let _ = nav.on_baro(time, 10.5, 0.04, k.is_multiple_of(80));
             }
             let out = nav
                 .on_imu(

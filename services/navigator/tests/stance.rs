@@ -13,6 +13,7 @@ fn shoe() -> StanceConfig {
             gyro_sigma_rps: 0.1f64.to_radians(),
             threshold: 1e5,
         },
+        min_samples: 1,
     }
 }
 
@@ -59,6 +60,7 @@ fn magnitude_thresholds_need_every_sample_of_the_window() {
             accel_tolerance_mps2: 0.5,
             gyro_max_rps: 0.2,
         },
+        min_samples: 1,
     });
     assert!(!d.push([0.0; 3], REST_FORCE, None, G));
     assert!(!d.push([0.0; 3], REST_FORCE, None, G));
@@ -79,6 +81,7 @@ fn foot_pressure_decides_alone_and_a_missing_reading_is_swing() {
     let mut d = StanceDetector::new(StanceConfig {
         window: 1,
         detector: StanceTest::Fsr { threshold: 0.5 },
+        min_samples: 1,
     });
     assert!(d.push([5.0; 3], [9.0; 3], Some(0.8), G));
     assert!(!d.push([0.0; 3], REST_FORCE, Some(0.2), G));
@@ -99,7 +102,30 @@ fn bad_settings_name_the_field() {
             gyro_sigma_rps: f64::NAN,
             threshold: 1.0,
         },
+        min_samples: 1,
     };
     assert_eq!(c.check().map_err(|e| e.0), Err("gyro_sigma_rps"));
+    c = shoe();
+    c.min_samples = 0;
+    assert_eq!(c.check(), Err(("min_samples", 0.0)));
     assert!(shoe().check().is_ok());
+}
+
+#[test]
+fn stance_is_declared_only_after_min_samples_consecutive_detections() {
+    let mut d = StanceDetector::new(StanceConfig {
+        window: 1,
+        detector: StanceTest::Fsr { threshold: 0.5 },
+        min_samples: 3,
+    });
+    // A two-sample touch is not stance; the third consecutive loaded sample is.
+    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.9), G));
+    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.9), G));
+    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.1), G));
+    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.9), G));
+    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.9), G));
+    assert!(d.push([0.0; 3], REST_FORCE, Some(0.9), G));
+    assert!(d.push([0.0; 3], REST_FORCE, Some(0.9), G));
+    // One unloaded sample ends it at once.
+    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.1), G));
 }

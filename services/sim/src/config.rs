@@ -69,7 +69,8 @@ pub struct SimConfig {
     pub origin_altitude_m: f64,
     /// Initial heading, degrees clockwise from true north.
     pub initial_heading_deg: f64,
-    /// UAV scenario: time parked level before moving, s.
+    /// UAV and walk scenarios: time at rest, level, before moving, s (the window a navigator's
+    /// static alignment needs).
     pub static_s: f64,
     /// Sea-level pressure of the ISA model, Pa.
     pub qnh_pa: f64,

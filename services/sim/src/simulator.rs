@@ -227,7 +227,7 @@ impl Simulator {
         };
         out.aux = if self.due(self.aux_rate_hz) {
             let mut aux = AuxFrame::default();
-            self.sensors.foot_pressure(&mut aux);
+            self.sensors.foot_pressure(truth.foot_load, &mut aux);
             Some(Frame {
                 seq: next(&mut self.seq.aux),
                 device_time_us,

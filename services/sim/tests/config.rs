@@ -60,7 +60,8 @@ fn toml_rejects_unknown_fields_and_scenarios() {
     assert!(toml::from_str::<SimConfig>("[sensors]\ngyro_noise = 1.0").is_err());
     assert!(toml::from_str::<SimConfig>("[earth_field]\ndip = 60.0").is_err());
     assert!(toml::from_str::<SimConfig>("scenario = \"Uav\"").is_err());
-    assert!(toml::from_str::<SimConfig>("scenario = \"walk\"").is_err());
+    assert!(toml::from_str::<SimConfig>("scenario = \"Walk\"").is_err());
+    assert!(toml::from_str::<SimConfig>("scenario = \"run\"").is_err());
 }
 
 fn error_of(mutate: impl FnOnce(&mut SimConfig)) -> String {

@@ -23,6 +23,8 @@ fn truth(rate: Vector3<f64>, force: Vector3<f64>) -> TruthState {
         latitude_rad: 0.0,
         longitude_rad: 0.0,
         altitude_m: 0.0,
+        foot_load: 0.0,
+        stance: false,
     }
 }
 

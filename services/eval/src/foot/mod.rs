@@ -89,8 +89,13 @@ pub fn evaluate_pyshoe_trial(trial: &FootTrial, config: &AidedConfig) -> Result<
         .ok_or_else(|| anyhow!("{}: no truth positions", trial.name))?;
     let run = run_trial(trial, config);
     let start = aligned(trial, &run)?;
-    // East, north of the estimate against the Vicon x, y (both right-handed about the vertical).
-    let estimate: Vec<[f64; 2]> = run.ned_m[start..].iter().map(|p| [p[1], p[0]]).collect();
+    // North, east of the estimate against the export's Vicon x, y. With the Vicon z up, that pair
+    // is mirrored (x, y, up is left-handed), so the export's horizontal axes do not form the
+    // right-handed frame their z suggests: matched as east, north, every trial's shape comes out
+    // mirrored and the rotation fit leaves metres of error; as north, east it fits within
+    // centimetres. Only a rotation is fitted, never a reflection, so this pairing is fixed for the
+    // whole data set, not chosen per trial.
+    let estimate: Vec<[f64; 2]> = run.ned_m[start..].iter().map(|p| [p[0], p[1]]).collect();
     let reference: Vec<[f64; 2]> = truth[start..].iter().map(|p| [p[0], p[1]]).collect();
     let (rmse, theta) = aligned_rmse_2d(&estimate, &reference);
     Ok(PyshoeTrial {

@@ -162,7 +162,7 @@ impl McConfig {
         }
         self.sim.validate()?;
         let full_flight_s = match self.sim.scenario {
-            Scenario::Uav => {
+            Scenario::Uav | Scenario::Walk => {
                 Trajectory::new(self.sim.scenario, self.sim.trajectory_start()).end_s()
             }
             Scenario::Static => 600.0,
@@ -198,7 +198,7 @@ impl McConfig {
 
         let gyro_channel_bias_ticks = if self.calibrate_gyro_channels_at_rest {
             let parked_s = match self.sim.scenario {
-                Scenario::Uav => self.sim.static_s,
+                Scenario::Uav | Scenario::Walk => self.sim.static_s,
                 Scenario::Static => f64::INFINITY,
             };
             if parked_s < navigator.align_s {

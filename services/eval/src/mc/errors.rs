@@ -196,8 +196,9 @@ mod tests {
             lon,
             alt,
             mode: NavMode::Navigating,
-            aiding_baro: true,
-            aiding_mag: true,
+            aiding: ipc_types::aiding::BARO | ipc_types::aiding::MAG,
+            covariance_diag: [0.0; ipc_types::NAV_STATES],
+            counts: Default::default(),
         }
     }
 

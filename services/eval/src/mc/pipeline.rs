@@ -116,14 +116,19 @@ impl Pipeline {
             && let Payload::Baro(baro) = frame.payload
         {
             let altitude = self.altimeter.update(time_us, f64::from(baro.pressure_pa));
-            self.navigator
-                .on_baro(time_us, altitude.height_m, altitude.valid);
+            let _ = self.navigator.on_baro(
+                time_us,
+                altitude.height_m,
+                altitude.height_var,
+                altitude.valid,
+            );
         }
         if let Some(frame) = &self.tick.mag
             && let Payload::Mag(mag) = frame.payload
         {
             // The wire carries nanotesla, the navigator takes microtesla.
-            self.navigator
+            let _ = self
+                .navigator
                 .on_mag(time_us, mag.field_nt.map(|nt| f64::from(nt) * 1e-3));
         }
         self.solution = None;

@@ -135,6 +135,11 @@ impl ErrorStateEkf {
         self.strapdown.bias()
     }
 
+    /// Replaces the bias estimate (the covariance is left as it is).
+    pub fn set_bias(&mut self, bias: ImuBias) {
+        *self.strapdown.bias_mut() = bias;
+    }
+
     pub fn strapdown(&self) -> &Strapdown {
         &self.strapdown
     }

@@ -244,9 +244,9 @@ impl SensorModel {
         self.mag.sample(attitude, &mut self.rng.mag, out);
     }
 
-    /// Samples the (unloaded) foot-pressure sensor.
-    pub fn foot_pressure(&mut self, out: &mut AuxFrame) {
-        self.foot.sample(0.0, &mut self.rng.aux, out);
+    /// Samples the foot-pressure sensor under the true load `foot_load` (fraction of full scale).
+    pub fn foot_pressure(&mut self, foot_load: f64, out: &mut AuxFrame) {
+        self.foot.sample(foot_load, &mut self.rng.aux, out);
     }
 
     fn bank(&self, sensor: InertialSensor) -> &InertialBank {

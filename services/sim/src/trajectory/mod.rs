@@ -1,36 +1,31 @@
 //! Deterministic truth trajectory, sampled at device time t (seconds).
 //!
-//! The motion is defined by three smooth schedules — horizontal ground speed V, heading rate ψ̇ and
-//! climb rate ḣ — whose values, derivatives and integrals are closed form. From them:
-//! - heading ψ = ψ₀ + ∫ψ̇, altitude h = h₀ + ∫ḣ;
-//! - bank φ = atan(V ψ̇ / g) (coordinated turn: no lateral specific force in a level turn),
-//!   pitch θ = atan2(ḣ, V) (the body x axis follows the flight path);
+//! Two motion generators share the conventions below: a vehicle moved by smooth schedules (the
+//! static and UAV scenarios, [`flight`]) and a foot-mounted sensor on a walking person ([`walk`]).
+//! Each gives Euler angles and their rates, velocity and acceleration in closed form; then
 //! - attitude q = R_z(ψ) R_y(θ) R_x(φ) (body FRD → NED);
 //! - body rate from the exact Euler-rate relation, so it is the true derivative of q;
-//! - velocity NED v = [V cos ψ, V sin ψ, −ḣ] and its exact derivative a;
 //! - specific force f_b = C_nbᵀ (a − g_n), g_n = [0, 0, +g].
 //!
 //! The Earth is **non-rotating**: the truth body rate has no Earth-rate component and the specific
-//! force has no Coriolis or centripetal terms. Gravity is the constant [`GRAVITY_MPS2`]. Latitude and
-//! longitude integrate the velocity over the WGS84 ellipsoid (see [`geodesy`]); altitude is above
-//! mean sea level, the origin altitude being ground level.
+//! force has no Coriolis or centripetal terms. Gravity is the constant [`GRAVITY_MPS2`]. Altitude is
+//! above mean sea level, the origin altitude being ground level.
 
+pub mod flight;
+pub mod gait;
 pub mod geodesy;
 pub mod schedule;
 pub mod uav_profile;
+pub mod walk;
 
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::Deserialize;
 
 use crate::GRAVITY_MPS2;
-use geodesy::{GeodeticTable, Kinematics};
-use schedule::Schedule;
-use uav_profile::UavProfile;
+use flight::FlightPath;
+use walk::WalkPath;
 
-/// Grid spacing of the precomputed latitude/longitude table, seconds.
-const GEODETIC_TABLE_SPACING_S: f64 = 0.01;
-
-/// Which motion the simulator flies.
+/// Which motion the simulator produces.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Scenario {
@@ -39,6 +34,8 @@ pub enum Scenario {
     Static,
     /// Take-off, climb, cruise circuits with banked turns, descent and landing (see [`uav_profile`]).
     Uav,
+    /// A foot-mounted sensor walked once round a 50 m × 12.9 m rectangle (see [`walk`]).
+    Walk,
 }
 
 /// Where and how the trajectory starts.
@@ -52,7 +49,7 @@ pub struct TrajectoryStart {
     pub altitude_m: f64,
     /// Initial heading (yaw from north, clockwise), rad.
     pub heading_rad: f64,
-    /// Time parked level before the UAV profile starts moving, s.
+    /// Time at rest, level, before the UAV profile or the walk starts moving, s.
     pub static_s: f64,
 }
 
@@ -79,19 +76,38 @@ pub struct TruthState {
     pub longitude_rad: f64,
     /// Altitude above mean sea level, m.
     pub altitude_m: f64,
+    /// Load on the foot-pressure sensor, 0 (none) ..= 1 (full scale); 0 unless walking.
+    pub foot_load: f64,
+    /// The sensor is at rest — velocity and body rate exactly zero: the foot flat on the floor
+    /// between steps in the walk, parked before and after the motion in the other scenarios. This
+    /// is what a zero-velocity detector should find.
+    pub stance: bool,
+}
+
+/// Landmark times of a motion, s.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Landmarks {
+    /// The vehicle leaves the ground; in the walk, the foot's first lift-off (∞ if never).
+    pub lift_off_s: f64,
+    /// The vehicle touches down; in the walk, the foot's last heel strike (∞ if it never flies).
+    pub touchdown_s: f64,
+    /// At rest for good from here on (0 if it never moves).
+    pub end_s: f64,
+}
+
+/// The motion generator behind a [`Trajectory`].
+#[derive(Debug, Clone)]
+enum Motion {
+    Flight(FlightPath),
+    Walk(WalkPath),
 }
 
 /// A deterministic trajectory; sampling is allocation-free.
 #[derive(Debug, Clone)]
 pub struct Trajectory {
     start: TrajectoryStart,
-    speed: Schedule,
-    heading_rate: Schedule,
-    climb_rate: Schedule,
-    geodetic: GeodeticTable,
-    lift_off_s: f64,
-    touchdown_s: f64,
-    end_s: f64,
+    motion: Motion,
+    landmarks: Landmarks,
 }
 
 impl Trajectory {
@@ -99,63 +115,44 @@ impl Trajectory {
     /// ([`crate::SimConfig::validate`]): out-of-range values do not panic but give meaningless truth
     /// (NaN for non-finite input, huge longitude rates near the poles).
     pub fn new(scenario: Scenario, start: TrajectoryStart) -> Self {
-        match scenario {
-            Scenario::Static => Self {
-                start,
-                speed: Schedule::new(0.0),
-                heading_rate: Schedule::new(0.0),
-                climb_rate: Schedule::new(0.0),
-                geodetic: GeodeticTable::fixed(start.latitude_rad, start.longitude_rad),
-                lift_off_s: f64::INFINITY,
-                touchdown_s: f64::INFINITY,
-                end_s: 0.0,
-            },
-            Scenario::Uav => {
-                let profile = UavProfile::new(start.static_s);
-                let mut trajectory = Self {
-                    start,
-                    speed: profile.speed,
-                    heading_rate: profile.heading_rate,
-                    climb_rate: profile.climb_rate,
-                    geodetic: GeodeticTable::fixed(start.latitude_rad, start.longitude_rad),
-                    lift_off_s: profile.lift_off_s,
-                    touchdown_s: profile.touchdown_s,
-                    end_s: profile.end_s,
-                };
-                let geodetic = GeodeticTable::integrate(
-                    start.latitude_rad,
-                    start.longitude_rad,
-                    start.static_s,
-                    profile.end_s,
-                    GEODETIC_TABLE_SPACING_S,
-                    |t| {
-                        let (v, _, _, alt) = trajectory.horizontal(t);
-                        Kinematics {
-                            v_north: v[0],
-                            v_east: v[1],
-                            altitude_m: alt,
-                        }
-                    },
-                );
-                trajectory.geodetic = geodetic;
-                trajectory
+        let (motion, landmarks) = match scenario {
+            Scenario::Static => {
+                let (path, landmarks) = FlightPath::parked(start);
+                (Motion::Flight(path), landmarks)
             }
+            Scenario::Uav => {
+                let (path, landmarks) = FlightPath::uav(start);
+                (Motion::Flight(path), landmarks)
+            }
+            Scenario::Walk => {
+                let path = WalkPath::new(start);
+                let landmarks = path.landmarks();
+                (Motion::Walk(path), landmarks)
+            }
+        };
+        Self {
+            start,
+            motion,
+            landmarks,
         }
     }
 
-    /// Time after which the vehicle stays parked (0 for the static scenario), s.
+    /// Time after which the vehicle (or the walker) stays at rest for good (0 for the static
+    /// scenario), s.
     pub fn end_s(&self) -> f64 {
-        self.end_s
+        self.landmarks.end_s
     }
 
-    /// Time the vehicle leaves the ground (∞ if it never does), s.
+    /// Time the vehicle leaves the ground — in the walk, the foot's first lift-off (∞ if it never
+    /// does), s.
     pub fn lift_off_s(&self) -> f64 {
-        self.lift_off_s
+        self.landmarks.lift_off_s
     }
 
-    /// Time the vehicle touches down (∞ if it never flies), s.
+    /// Time the vehicle touches down — in the walk, the foot's last heel strike (∞ if it never
+    /// flies), s.
     pub fn touchdown_s(&self) -> f64 {
-        self.touchdown_s
+        self.landmarks.touchdown_s
     }
 
     /// The start point and heading.
@@ -163,73 +160,38 @@ impl Trajectory {
         &self.start
     }
 
-    /// Velocity NED, heading, heading rate and altitude at `t`, without the attitude.
-    fn horizontal(&self, t: f64) -> ([f64; 3], f64, f64, f64) {
-        let v = self.speed.sample(t).value;
-        let hr = self.heading_rate.sample(t);
-        let cr = self.climb_rate.sample(t);
-        let psi = self.start.heading_rad + hr.integral;
-        let (s, c) = psi.sin_cos();
-        (
-            [v * c, v * s, -cr.value],
-            psi,
-            hr.value,
-            self.start.altitude_m + cr.integral,
-        )
-    }
-
     /// The true state at time `t` seconds (clamped to t ≥ 0).
     pub fn sample(&self, t: f64) -> TruthState {
         let t = t.max(0.0);
-        let sp = self.speed.sample(t);
-        let hr = self.heading_rate.sample(t);
-        let cr = self.climb_rate.sample(t);
-        let (v, v_dot) = (sp.value, sp.rate);
-        let (psi_dot, psi_ddot) = (hr.value, hr.rate);
-        let psi = self.start.heading_rad + hr.integral;
-        let (h_dot, h_ddot) = (cr.value, cr.rate);
-
-        let k = v * psi_dot / GRAVITY_MPS2;
-        let roll = k.atan();
-        let roll_dot = (v_dot * psi_dot + v * psi_ddot) / GRAVITY_MPS2 / (1.0 + k * k);
-        let d = v * v + h_dot * h_dot;
-        let (pitch, pitch_dot) = if d > 1e-12 {
-            (h_dot.atan2(v), (v * h_ddot - h_dot * v_dot) / d)
-        } else {
-            (0.0, 0.0)
-        };
-
-        let (sr, cr_) = roll.sin_cos();
-        let (sp_, cp) = pitch.sin_cos();
-        let angular_rate_b = Vector3::new(
-            roll_dot - psi_dot * sp_,
-            pitch_dot * cr_ + psi_dot * sr * cp,
-            -pitch_dot * sr + psi_dot * cr_ * cp,
-        );
-        let attitude = UnitQuaternion::from_euler_angles(roll, pitch, psi);
-
-        let (spsi, cpsi) = psi.sin_cos();
-        let velocity_n = Vector3::new(v * cpsi, v * spsi, -h_dot);
-        let acceleration_n = Vector3::new(
-            v_dot * cpsi - v * psi_dot * spsi,
-            v_dot * spsi + v * psi_dot * cpsi,
-            -h_ddot,
-        );
-        let specific_force_b = attitude
-            .inverse_transform_vector(&(acceleration_n - Vector3::new(0.0, 0.0, GRAVITY_MPS2)));
-        let [latitude_rad, longitude_rad] = self.geodetic.sample(t);
-
-        TruthState {
-            time_s: t,
-            attitude,
-            euler_rad: [roll, pitch, psi],
-            angular_rate_b,
-            specific_force_b,
-            velocity_n,
-            acceleration_n,
-            latitude_rad,
-            longitude_rad,
-            altitude_m: self.start.altitude_m + cr.integral,
+        match &self.motion {
+            Motion::Flight(path) => path.sample(t),
+            Motion::Walk(path) => path.sample(t),
         }
     }
+}
+
+/// Attitude R_z(ψ) R_y(θ) R_x(φ) of `[φ, θ, ψ]` and the body rate that is its exact derivative,
+/// given the Euler-angle rates: ω = [φ̇ − ψ̇ sin θ, θ̇ cos φ + ψ̇ sin φ cos θ, −θ̇ sin φ + ψ̇ cos φ cos θ].
+fn attitude_and_body_rate(
+    euler: [f64; 3],
+    euler_rate: [f64; 3],
+) -> (UnitQuaternion<f64>, Vector3<f64>) {
+    let [roll, pitch, yaw] = euler;
+    let [roll_dot, pitch_dot, yaw_dot] = euler_rate;
+    let (sr, cr) = roll.sin_cos();
+    let (sp, cp) = pitch.sin_cos();
+    let angular_rate_b = Vector3::new(
+        roll_dot - yaw_dot * sp,
+        pitch_dot * cr + yaw_dot * sr * cp,
+        -pitch_dot * sr + yaw_dot * cr * cp,
+    );
+    (
+        UnitQuaternion::from_euler_angles(roll, pitch, yaw),
+        angular_rate_b,
+    )
+}
+
+/// Specific force in the body frame, f_b = C_nbᵀ (a − g_n), for acceleration `a` NED.
+fn specific_force_b(attitude: &UnitQuaternion<f64>, acceleration_n: &Vector3<f64>) -> Vector3<f64> {
+    attitude.inverse_transform_vector(&(acceleration_n - Vector3::new(0.0, 0.0, GRAVITY_MPS2)))
 }
