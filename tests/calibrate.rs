@@ -3,7 +3,6 @@
 
 mod common;
 
-use std::io::Write;
 use std::process::Output;
 
 use common::Isolated;
@@ -17,33 +16,11 @@ const HARD_IRON_UT: [f64; 3] = [12.0, -7.0, 30.0];
 /// Symmetric, so the symmetric correction the command chooses is its inverse.
 const SOFT_IRON: [[f64; 3]; 3] = [[1.1, 0.05, 0.05], [0.05, 0.9, 0.05], [0.05, 0.05, 1.05]];
 const SAMPLES: usize = 600;
+fn mag_csv(text: &str) -> common::TempFile {
+    common::TempFile::new("mag", "csv", text)
+}
+
 const AXES: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-
-/// A CSV file that is removed when dropped.
-struct TempCsv(std::path::PathBuf);
-
-impl TempCsv {
-    fn new(text: &str) -> Self {
-        static N: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
-        let n = N.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let path =
-            std::env::temp_dir().join(format!("rins-test-mag-{}-{n}.csv", std::process::id()));
-        std::fs::File::create(&path)
-            .and_then(|mut f| f.write_all(text.as_bytes()))
-            .expect("cannot write a temporary CSV file");
-        Self(path)
-    }
-
-    fn path(&self) -> &str {
-        self.0.to_str().expect("temporary path is UTF-8")
-    }
-}
-
-impl Drop for TempCsv {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.0);
-    }
-}
 
 /// The simulator's sensor configuration, its magnetometer with the test's iron.
 fn sensor_config() -> SensorModelConfig {
@@ -138,7 +115,7 @@ fn sim_readings_round_trip_to_the_configured_iron() {
     let field_ut = sim.earth_field.intensity_ut;
     let sigma = sim.sensors.mag_noise_ut;
     let samples = sim_readings(&sim);
-    let csv = TempCsv::new(&plain_csv(&samples));
+    let csv = mag_csv(&plain_csv(&samples));
     let field_arg = field_ut.to_string();
     let ipc = Isolated::new("calibrate");
     let report = stdout_json(&ipc.run(&[
@@ -250,8 +227,8 @@ fn echo_raw_mag_csv_gives_the_same_fit_and_a_pasteable_fragment() {
         ..SimConfig::default()
     };
     let samples = sim_readings(&sim);
-    let echo = TempCsv::new(&echo_csv(&samples));
-    let plain = TempCsv::new(&plain_csv(&samples));
+    let echo = mag_csv(&echo_csv(&samples));
+    let plain = mag_csv(&plain_csv(&samples));
     let ipc = Isolated::new("calibrate");
     let out = ipc.run(&["calibrate", "mag", echo.path()]);
     assert!(
@@ -319,7 +296,7 @@ fn malformed_files_are_refused_by_file_and_line() {
         ),
     ];
     for (text, expected) in cases {
-        let csv = TempCsv::new(text);
+        let csv = mag_csv(text);
         let located = format!("{}{expected}", csv.path());
         let expected = if text.is_empty() { expected } else { &located };
         fails_with(&["calibrate", "mag", csv.path()], &[expected]);
@@ -337,7 +314,7 @@ fn unusable_samples_are_refused_with_the_reason() {
         ..SimConfig::default()
     };
     let samples = sim_readings(&sim);
-    let few = TempCsv::new(&plain_csv(&samples[..19]));
+    let few = mag_csv(&plain_csv(&samples[..19]));
     fails_with(
         &["calibrate", "mag", few.path()],
         &[few.path(), "19 samples: at least 20 are needed"],
@@ -354,13 +331,13 @@ fn unusable_samples_are_refused_with_the_reason() {
             frame.field_nt.map(|nt| f64::from(nt) * 1e-3)
         })
         .collect();
-    let flat = TempCsv::new(&plain_csv(&yaw_only));
+    let flat = mag_csv(&plain_csv(&yaw_only));
     fails_with(
         &["calibrate", "mag", flat.path()],
         &["rotate the vehicle through more orientations"],
     );
 
-    let all = TempCsv::new(&plain_csv(&samples));
+    let all = mag_csv(&plain_csv(&samples));
     fails_with(
         &["calibrate", "mag", all.path(), "--field-ut", "0"],
         &["--field-ut 0: must be a positive number"],

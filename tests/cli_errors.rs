@@ -3,34 +3,10 @@
 
 mod common;
 
-use std::io::Write;
+use common::{Isolated, TempFile};
 
-use common::Isolated;
-
-/// A configuration file that is removed when dropped.
-struct ConfigFile(std::path::PathBuf);
-
-impl ConfigFile {
-    fn new(text: &str) -> Self {
-        static N: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
-        let n = N.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let path =
-            std::env::temp_dir().join(format!("rins-test-config-{}-{n}.toml", std::process::id()));
-        std::fs::File::create(&path)
-            .and_then(|mut f| f.write_all(text.as_bytes()))
-            .expect("cannot write a temporary configuration file");
-        Self(path)
-    }
-
-    fn path(&self) -> &str {
-        self.0.to_str().expect("temporary path is UTF-8")
-    }
-}
-
-impl Drop for ConfigFile {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.0);
-    }
+fn config_file(text: &str) -> TempFile {
+    TempFile::new("config", "toml", text)
 }
 
 fn fails_with(args: &[&str], expected: &[&str]) {
@@ -48,7 +24,7 @@ fn fails_with(args: &[&str], expected: &[&str]) {
 
 #[test]
 fn unknown_config_key_is_rejected_by_name() {
-    let f = ConfigFile::new("[navigator]\nalign_seconds = 2.0\n");
+    let f = config_file("[navigator]\nalign_seconds = 2.0\n");
     fails_with(
         &["up", "--duration", "1", "--config", f.path()],
         &["align_seconds", "unknown field"],
@@ -57,12 +33,12 @@ fn unknown_config_key_is_rejected_by_name() {
 
 #[test]
 fn out_of_range_value_names_field_and_value() {
-    let f = ConfigFile::new("[sim]\nimu_rate_hz = 0\n");
+    let f = config_file("[sim]\nimu_rate_hz = 0\n");
     fails_with(
         &["up", "--duration", "1", "--config", f.path()],
         &["sim.imu_rate_hz = 0"],
     );
-    let f = ConfigFile::new(
+    let f = config_file(
         "[fusion.geometry.gyro]\nkind = \"pyramid\"\nn = 2\nalpha_deg = 30\nbeta0_deg = 0\n",
     );
     fails_with(

@@ -2,23 +2,14 @@
 //! The recordings live outside the repository (`<repo>/../shared/data/quadrotor-4imu`); the FDI
 //! tests print a note and return when they are absent.
 
-use std::path::PathBuf;
+mod common;
+
 use std::process::Command;
 
 use serde_json::Value;
 
 fn rins() -> Command {
     Command::new(env!("CARGO_BIN_EXE_rins"))
-}
-
-fn data_dir() -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/quadrotor-4imu");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("note: {} not found; test skipped", dir.display());
-        None
-    }
 }
 
 fn run_json(args: &[&str]) -> Value {
@@ -32,7 +23,7 @@ fn run_json(args: &[&str]) -> Value {
 }
 
 fn eval_fdi() -> Option<Value> {
-    let dir = data_dir()?;
+    let dir = common::quadrotor_data_dir()?;
     Some(run_json(&["eval", "fdi", dir.to_str().unwrap(), "--json"]))
 }
 

@@ -2,6 +2,8 @@
 //! (`<repo>/../shared/data/quadrotor-4imu`); the tests on them print a note and return when they
 //! are absent. The error cases need no data.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -12,16 +14,6 @@ fn rins(args: &[&str]) -> Output {
         .args(args)
         .output()
         .unwrap()
-}
-
-fn data_dir() -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/quadrotor-4imu");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("note: {} not found; test skipped", dir.display());
-        None
-    }
 }
 
 /// A fresh directory under the system's temporary directory, removed on drop.
@@ -73,7 +65,9 @@ fn check_run(run: &Value) {
 
 #[test]
 fn eval_quadrotor_reports_every_trial_every_unit_and_the_fused_units() {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = common::quadrotor_data_dir() else {
+        return;
+    };
     let out = rins(&["eval", "quadrotor", dir.to_str().unwrap(), "--json"]);
     assert!(
         out.status.success(),
@@ -110,7 +104,9 @@ fn eval_quadrotor_reports_every_trial_every_unit_and_the_fused_units() {
 
 #[test]
 fn eval_quadrotor_prints_a_table_without_json() {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = common::quadrotor_data_dir() else {
+        return;
+    };
     let out = rins(&["eval", "quadrotor", dir.to_str().unwrap()]);
     assert!(out.status.success());
     let table = String::from_utf8_lossy(&out.stdout);
@@ -156,7 +152,9 @@ fn eval_quadrotor_names_a_bad_file() {
 
 #[test]
 fn eval_quadrotor_names_a_missing_truth_file() {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = common::quadrotor_data_dir() else {
+        return;
+    };
     let data = Scratch::new("no-truth");
     let trial = data.path().join("Horizontal/path_1");
     std::fs::create_dir_all(&trial).unwrap();
@@ -173,7 +171,9 @@ fn eval_quadrotor_names_a_missing_truth_file() {
 
 #[test]
 fn eval_quadrotor_names_a_bad_profile() {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = common::quadrotor_data_dir() else {
+        return;
+    };
     assert_fails_naming(
         &[
             "eval",

@@ -105,3 +105,43 @@ pub fn num(v: &serde_json::Value, key: &str) -> f64 {
         .as_f64()
         .unwrap_or_else(|| panic!("summary has no number {key:?}: {v}"))
 }
+
+/// A temporary file with the given text, removed when dropped; `kind` and `extension` name it.
+pub struct TempFile(PathBuf);
+
+impl TempFile {
+    pub fn new(kind: &str, extension: &str, text: &str) -> Self {
+        use std::io::Write;
+        static N: AtomicU32 = AtomicU32::new(0);
+        let n = N.fetch_add(1, Ordering::Relaxed);
+        let path = std::env::temp_dir().join(format!(
+            "rins-test-{kind}-{}-{n}.{extension}",
+            std::process::id()
+        ));
+        std::fs::File::create(&path)
+            .and_then(|mut f| f.write_all(text.as_bytes()))
+            .expect("cannot write a temporary file");
+        Self(path)
+    }
+
+    pub fn path(&self) -> &str {
+        self.0.to_str().expect("temporary path is UTF-8")
+    }
+}
+
+impl Drop for TempFile {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
+/// The quadrotor recordings beside the repository, or `None` (with a note) when they are absent.
+pub fn quadrotor_data_dir() -> Option<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/quadrotor-4imu");
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!("note: {} not found; test skipped", dir.display());
+        None
+    }
+}

@@ -4,6 +4,7 @@
 //! filter applies them to its current state. A baro reading further from the navigation time than
 //! `max_lag_s` is dropped rather than applied to the wrong epoch.
 
+use crate::checks::positive;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -40,13 +41,6 @@ impl Default for BaroAidingConfig {
 impl BaroAidingConfig {
     /// `(field, value)` of the first out-of-range parameter.
     pub fn check(&self) -> Result<(), (&'static str, f64)> {
-        let positive = |name: &'static str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err((name, v))
-            }
-        };
         positive("sigma_floor_m", self.sigma_floor_m)?;
         positive("gate", self.gate)?;
         positive("max_lag_s", self.max_lag_s)

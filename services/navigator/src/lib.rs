@@ -8,6 +8,7 @@ pub mod aided;
 pub mod aiding;
 pub mod alignment;
 pub mod attitude;
+mod checks;
 pub mod config;
 pub mod earth;
 pub mod ekf;

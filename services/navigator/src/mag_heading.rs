@@ -13,6 +13,7 @@
 //! ratio `r` of departure to tolerance scales σ: `σ = σ₀` while `r ≤ 1`, `σ = σ₀ · inflation · r`
 //! beyond. The reference magnitude and dip are those of the mean field in the alignment window.
 
+use crate::checks::positive;
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -63,13 +64,6 @@ impl Default for MagAidingConfig {
 impl MagAidingConfig {
     /// `(field, value)` of the first out-of-range parameter.
     pub fn check(&self) -> Result<(), (&'static str, f64)> {
-        let positive = |name: &'static str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err((name, v))
-            }
-        };
         positive("sigma_deg", self.sigma_deg)?;
         positive(
             "specific_force_tolerance_mps2",

@@ -12,6 +12,7 @@
 //! costs nothing in a stance phase of 100 ms or more, and keeps the detector causal for the live
 //! pipeline.
 
+use crate::checks::positive;
 use serde::{Deserialize, Serialize};
 
 /// Longest window the detector keeps, samples.
@@ -82,13 +83,6 @@ impl StanceConfig {
         if !(1..=MAX_MIN_SAMPLES).contains(&self.min_samples) {
             return Err(("min_samples", self.min_samples as f64));
         }
-        let positive = |name: &'static str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err((name, v))
-            }
-        };
         match self.detector {
             StanceTest::Thresholds {
                 accel_tolerance_mps2,

@@ -3,10 +3,10 @@
 //! swing dynamics, the foot-pressure load, and the configuration switch.
 
 mod common;
+#[path = "common/counting_alloc.rs"]
+mod counting_alloc;
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-
+use counting_alloc::allocations_during;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use rins_acquisition::protocol::Payload;
 use rins_sim::trajectory::geodesy::{geodetic_rates, meridian_radius_m, prime_vertical_radius_m};
@@ -285,7 +285,7 @@ fn phases(traj: &Trajectory) -> Phases {
 ///
 /// Swing: the foot's peak speed is twice the mean stride speed, 2·(50/38 m)/0.6 s = 4.386 m/s (3–6
 /// m/s is typical of a foot at mid-swing in normal walking). The peak body rate is the pitch rate
-/// 1.155·(2π/T)·20° = 4.22 rad/s, raised to ~4.70 rad/s where a corner's yaw rate adds; it must stay
+/// at mid-swing, (16/(3√3))·(π/T)·15° = 4.22 rad/s, raised to ~4.70 rad/s where a corner's yaw rate adds; it must stay
 /// under the 300 °/s (5.24 rad/s) range of the default gyros. Rates and accelerations are
 /// continuous: the largest analytic angular acceleration is ~116 rad/s² and jerk ~245 m/s³, so
 /// between 1 ms samples the rate changes by < 0.15 rad/s and the acceleration by < 0.3 m/s²; a
@@ -487,49 +487,15 @@ fn other_scenarios_have_no_load_and_stance_means_parked() {
     }
 }
 
-struct CountingAllocator;
-
-thread_local! {
-    static COUNTING: Cell<bool> = const { Cell::new(false) };
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-// SAFETY: forwards every call to the system allocator unchanged; only counts on the current thread.
-unsafe impl GlobalAlloc for CountingAllocator {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if COUNTING.with(Cell::get) {
-            ALLOCATIONS.with(|a| a.set(a.get() + 1));
-        }
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: `ptr` came from `System.alloc` with this layout.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if COUNTING.with(Cell::get) {
-            ALLOCATIONS.with(|a| a.set(a.get() + 1));
-        }
-        // SAFETY: same contract as the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static ALLOCATOR: CountingAllocator = CountingAllocator;
-
 #[test]
 fn sampling_the_walk_does_not_allocate() {
     let (traj, _, _) = walk(0.0);
     let mut checksum = 0.0;
-    COUNTING.with(|c| c.set(true));
-    for t in grid(&traj) {
-        checksum += traj.sample(t).foot_load;
-    }
-    COUNTING.with(|c| c.set(false));
-    assert_eq!(ALLOCATIONS.with(Cell::get), 0);
+    let allocations = allocations_during(|| {
+        for t in grid(&traj) {
+            checksum += traj.sample(t).foot_load;
+        }
+    });
+    assert_eq!(allocations, 0);
     assert!(checksum > 0.0);
 }

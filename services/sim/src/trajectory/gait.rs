@@ -61,15 +61,19 @@ pub fn lift(u: f64, duration_s: f64) -> Profile {
     )
 }
 
-/// Foot pitch, normalised: −sin³(2πu). Toe down (−1 at u = 1/4) after toe-off, toe up (+1 at
-/// u = 3/4) before heel strike, level with zero rate at mid-swing. The rate peaks at
-/// (2π/T)·2/√3 ≈ 1.155·2π/T at u ≈ 0.152, 0.348, 0.652, 0.848.
+/// Foot pitch, normalised: −k sin³(πu) cos(πu) = −k (2 sin 2πu − sin 4πu)/8, k = 1/max(sin³x cos x)
+/// = 16/(3√3). Toe down (−1 at u = 1/3) after toe-off, toe up (+1 at u = 2/3) before heel strike,
+/// and rotating fastest through level at mid-swing, k·π/T per unit amplitude, as a real foot does
+/// (the shank swings it through): a foot that paused its rotation there while moving at constant
+/// speed would read exactly like one standing still to a stance detector.
 pub fn pitch(u: f64, duration_s: f64) -> Profile {
-    let (s, c) = (TAU * u).sin_cos();
+    let k = 16.0 / (3.0 * 3f64.sqrt());
+    let (s1, c1) = (TAU * u).sin_cos();
+    let (s2, c2) = (2.0 * TAU * u).sin_cos();
     in_time(
-        -s * s * s,
-        -3.0 * TAU * s * s * c,
-        -3.0 * TAU * TAU * s * (2.0 * c * c - s * s),
+        -k * (2.0 * s1 - s2) / 8.0,
+        -k * TAU * (c1 - c2) / 4.0,
+        -k * TAU * TAU * (2.0 * s2 - s1) / 4.0,
         duration_s,
     )
 }
@@ -123,8 +127,13 @@ mod tests {
         assert!((progress(1.0, T).value - 1.0).abs() < 1e-15);
         assert!(lift(0.0, T).value.abs() < 1e-15 && lift(1.0, T).value.abs() < 1e-15);
         assert!((lift(0.5, T).value - 1.0).abs() < 1e-15);
-        assert!((pitch(0.25, T).value + 1.0).abs() < 1e-15);
-        assert!((pitch(0.75, T).value - 1.0).abs() < 1e-15);
+        assert!((pitch(1.0 / 3.0, T).value + 1.0).abs() < 1e-14);
+        assert!((pitch(2.0 / 3.0, T).value - 1.0).abs() < 1e-14);
+        // Level and rotating fastest at mid-swing: k·π/T toe up.
+        let mid = pitch(0.5, T);
+        let k = 16.0 / (3.0 * 3f64.sqrt());
+        assert!(mid.value.abs() < 1e-15);
+        assert!((mid.rate - k * PI / T).abs() < 1e-12, "{}", mid.rate);
     }
 
     #[test]

@@ -47,9 +47,9 @@ pub const STRIDE_PERIOD_S: f64 = STANCE_S + SWING_S;
 /// Peak foot lift at mid-swing, m.
 pub const LIFT_M: f64 = 0.1;
 /// Peak foot pitch, toe down after toe-off and toe up before heel strike, degrees. The pitch rate
-/// then peaks at 1.155·(2π/T)·20° ≈ 4.2 rad/s, and the body rate at ≈ 4.7 rad/s (270 °/s) where a
-/// corner's yaw rate adds to it: inside the 300 °/s range of the default gyros.
-pub const PITCH_AMPLITUDE_DEG: f64 = 20.0;
+/// then peaks at mid-swing at (16/(3√3))·(π/T)·15° ≈ 4.22 rad/s, and the body rate at ≈ 4.7 rad/s
+/// (270 °/s) where a corner's yaw rate adds to it: inside the 300 °/s range of the default gyros.
+pub const PITCH_AMPLITUDE_DEG: f64 = 15.0;
 /// Standing still after the last step before [`WalkPath::end_s`], s.
 pub const FINAL_STAND_S: f64 = 5.0;
 /// Pressure-sensor load while standing, fraction of full scale.
