@@ -1,9 +1,9 @@
 //! `rins`: one executable, one subcommand per process kind and tool. Each service still runs as its
 //! own OS process (`rins service NAME`), started and supervised by `rins up`.
 
-mod cli;
 mod commands;
-mod config;
+
+use rins::{cli, config};
 
 use clap::Parser;
 

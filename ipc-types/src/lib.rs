@@ -325,6 +325,12 @@ pub mod aiding {
     pub const MAG: u32 = 1 << 1;
     pub const ZUPT: u32 = 1 << 2;
     pub const HUPT: u32 = 1 << 3;
+    /// Baro aiding is configured but no reading arrived within the aiding timeout: the altitude
+    /// coasts on the inertial solution.
+    pub const BARO_STALE: u32 = 1 << 8;
+    /// Magnetometer aiding is configured but no reading arrived within the aiding timeout: the
+    /// heading coasts on the gyros.
+    pub const MAG_STALE: u32 = 1 << 9;
 }
 
 /// Aiding sources counted in [`NavState::aiding_accepted`] / [`NavState::aiding_rejected`], in

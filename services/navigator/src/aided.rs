@@ -52,6 +52,9 @@ pub struct AidedConfig {
     pub mag: MagAidingConfig,
     /// Applied to every magnetometer sample before use.
     pub mag_calibration: MagCalibration,
+    /// An aiding source whose last reading is older than this is stale: the filter coasts on the
+    /// inertial solution and re-admits the source, without its innovation gate, when it returns, s.
+    pub stale_after_s: f64,
     /// Declination, rad, positive east.
     pub declination_rad: f64,
     /// Position where navigation starts: latitude, longitude (rad), altitude (m).
@@ -100,6 +103,10 @@ pub struct AidedNavigator {
     pub(crate) last_accepted_us: [Option<u64>; AidingSource::COUNT],
     /// Device time of the last magnetometer update attempted, µs (rate limit).
     pub(crate) last_mag_update_us: Option<u64>,
+    /// Device time of the last valid reading per [`AidingSource`] (baro and mag), µs.
+    pub(crate) last_reading_us: [Option<u64>; AidingSource::COUNT],
+    /// Device time navigation started, µs.
+    pub(crate) navigating_since_us: Option<u64>,
 }
 
 impl AidedNavigator {
@@ -118,7 +125,27 @@ impl AidedNavigator {
             initial_height_m: None,
             last_accepted_us: [None; AidingSource::COUNT],
             last_mag_update_us: None,
+            last_reading_us: [None; AidingSource::COUNT],
+            navigating_since_us: None,
         }
+    }
+
+    /// True when `source` is in use but has gone quiet: no valid reading for `stale_after_s`
+    /// (counted from the start of navigation when it never reported). Always false while
+    /// aligning and for a disabled source.
+    pub fn is_stale(&self, source: AidingSource) -> bool {
+        let enabled = match source {
+            AidingSource::Baro => self.config.baro.enabled,
+            AidingSource::Mag => self.config.mag.enabled && !self.config.mag.stance_only,
+            AidingSource::Zupt | AidingSource::Hupt => false,
+        };
+        let (Some(now), Some(since)) = (self.last_time_us, self.navigating_since_us) else {
+            return false;
+        };
+        let last = self.last_reading_us[source as usize]
+            .unwrap_or(since)
+            .max(since);
+        enabled && now.saturating_sub(last) as f64 * 1e-6 > self.config.stale_after_s
     }
 
     /// The settings in use.
@@ -262,6 +289,7 @@ impl AidedNavigator {
             .mean_field_ut
             .and_then(|m| FieldReference::from_field(&m, &a.attitude));
         self.alignment = Some(a);
+        self.navigating_since_us = self.last_time_us;
         self.phase = Phase::Navigating(ekf);
     }
 }

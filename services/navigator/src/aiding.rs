@@ -9,7 +9,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use crate::aided::AidedNavigator;
-use crate::ekf::{AidingSource, UpdateOutcome};
+use crate::ekf::{AidingSource, POS, UpdateOutcome};
 use crate::mag_heading::{adaptive_sigma, measured_heading};
 
 /// Settings of the barometric height aiding (`[navigator.baro]`).
@@ -54,6 +54,9 @@ pub enum AidingOutcome {
     Update(UpdateOutcome),
     /// Kept for later: before alignment (the first baro height, the alignment heading).
     Stored,
+    /// The first reading after an outage: the state was re-set from it (baro) or it was applied
+    /// without the innovation gate (mag).
+    Readmitted,
     /// Not used: aiding disabled, a bad reading, too old, rate limit, outside stance for HUPT.
     Skipped,
 }
@@ -77,6 +80,10 @@ impl AidedNavigator {
         if first {
             self.initial_height_m = Some(height_m);
         }
+        // Back after an outage: the altitude has coasted on the accelerometers and the weather
+        // may have moved the baro; the reading re-sets the altitude rather than face the gate.
+        let returning = c.enabled && self.is_stale(AidingSource::Baro);
+        self.last_reading_us[AidingSource::Baro as usize] = Some(t_us);
         let now_us = self.time_us();
         let Some(ekf) = self.ekf_mut() else {
             return AidingOutcome::Stored;
@@ -87,6 +94,17 @@ impl AidedNavigator {
         }
         if !c.enabled {
             return AidingOutcome::Skipped;
+        }
+        if returning {
+            let variance = if variance_m2.is_finite() {
+                variance_m2
+            } else {
+                0.0
+            };
+            ekf.state_mut().alt = height_m;
+            ekf.reset_component(POS + 2, variance.max(c.sigma_floor_m * c.sigma_floor_m));
+            self.last_accepted_us[AidingSource::Baro as usize] = Some(t_us);
+            return AidingOutcome::Readmitted;
         }
         let lag_s = now_us.map_or(f64::INFINITY, |n| n.abs_diff(t_us) as f64 * 1e-6);
         if lag_s > c.max_lag_s {
@@ -121,6 +139,10 @@ impl AidedNavigator {
         if !c.enabled || (c.stance_only && !self.in_stance) {
             return AidingOutcome::Skipped;
         }
+        // Back after an outage: the heading has coasted on the gyros; the first reading is
+        // applied whatever its innovation, the following ones are gated again.
+        let returning = self.is_stale(AidingSource::Mag);
+        self.last_reading_us[AidingSource::Mag as usize] = Some(t_us);
         if c.max_rate_hz > 0.0
             && let Some(last) = self.last_mag_update_us
             && (t_us.saturating_sub(last) as f64) < 1e6 / c.max_rate_hz
@@ -146,11 +168,16 @@ impl AidedNavigator {
         };
         let g = ekf.strapdown().gravity();
         let sigma = adaptive_sigma(&c, &reference, &force, g, &field, &attitude);
-        let outcome = ekf.heading(source, psi, sigma, c.gate);
+        let gate = if returning { f64::INFINITY } else { c.gate };
+        let outcome = ekf.heading(source, psi, sigma, gate);
         self.last_mag_update_us = Some(t_us);
         if outcome.is_accepted() {
             self.last_accepted_us[source as usize] = Some(t_us);
         }
-        AidingOutcome::Update(outcome)
+        if returning && outcome.is_accepted() {
+            AidingOutcome::Readmitted
+        } else {
+            AidingOutcome::Update(outcome)
+        }
     }
 }

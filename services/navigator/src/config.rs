@@ -32,7 +32,8 @@ pub struct NavigatorConfig {
     pub max_dt_s: f64,
     /// Two-sample coning correction in the attitude update.
     pub coning_correction: bool,
-    /// An aiding source counts as used while its last reading is younger than this, s.
+    /// An aiding source counts as used while its last accepted update is younger than this, and
+    /// as stale (the filter coasts, the nav state says so) once its last reading is older, s.
     pub aiding_timeout_s: f64,
     /// Alignment: largest accepted | |f̄| − g |, m/s².
     pub align_specific_force_tolerance_mps2: f64,
@@ -231,6 +232,7 @@ impl NavigatorConfig {
             baro: self.baro,
             mag: self.mag,
             mag_calibration: self.mag_calibration,
+            stale_after_s: self.aiding_timeout_s,
             declination_rad: self.declination_deg.to_radians(),
             origin: [
                 self.initial_latitude_deg.to_radians(),

@@ -40,7 +40,8 @@ pub struct NavOutput {
     /// Aligning or navigating.
     pub mode: NavMode,
     /// Sources with an accepted update within the aiding timeout, bits of [`aiding`]; MAG also
-    /// while the heading is the magnetometer's from alignment and no heading update was tried.
+    /// while the heading is the magnetometer's from alignment and no heading update was tried;
+    /// BARO_STALE / MAG_STALE while a configured source has been silent for the timeout.
     pub aiding: u32,
     /// Diagonal of the error-state covariance (δθ rad², δv (m/s)², δp m², δb_g, δb_a).
     pub covariance_diag: [f64; NAV_STATES],
@@ -221,6 +222,14 @@ impl Navigator {
                 self.core.alignment().is_some_and(|a| a.heading_aided) && no_heading_update;
             if heading_from_alignment {
                 aiding_bits |= aiding::MAG;
+            }
+            for (source, bit) in [
+                (AidingSource::Baro, aiding::BARO_STALE),
+                (AidingSource::Mag, aiding::MAG_STALE),
+            ] {
+                if self.core.is_stale(source) {
+                    aiding_bits |= bit;
+                }
             }
             let p = ekf.covariance();
             for (k, d) in covariance_diag.iter_mut().enumerate() {

@@ -36,6 +36,8 @@ struct StaticVehicle {
     field_body: Vector3<f64>,
     noise: Noise,
     with_baro: bool,
+    /// Added to every baro reading, m (a change of weather).
+    baro_offset: f64,
 }
 
 impl StaticVehicle {
@@ -50,6 +52,7 @@ impl StaticVehicle {
             field_body: attitude.inverse() * earth_field_ned(21.0, 43.0, 2f64.to_radians()),
             noise: Noise::new(seed),
             with_baro: true,
+            baro_offset: 0.0,
         }
     }
 
@@ -62,7 +65,7 @@ impl StaticVehicle {
         if self.with_baro && k.is_multiple_of(40) {
             let _ = nav.on_baro(
                 t,
-                BARO_HEIGHT + self.noise.scalar(BARO_SIGMA),
+                BARO_HEIGHT + self.baro_offset + self.noise.scalar(BARO_SIGMA),
                 BARO_SIGMA * BARO_SIGMA,
                 true,
             );
@@ -374,4 +377,43 @@ fn magnetometer_updates_follow_an_undisturbed_field_and_hold_against_a_disturbed
         "{held} vs {expected_held}"
     );
     assert!(held > followed + 0.8, "{held} vs {followed}");
+}
+
+#[test]
+fn a_baro_outage_is_flagged_and_the_returning_baro_re_sets_the_altitude() {
+    let mut nav = Navigator::new(config()).unwrap();
+    let mut vehicle = StaticVehicle::new(9);
+    let mut k = 0;
+    while vehicle.step(&mut nav, k).is_none() {
+        k += 1;
+    }
+    let mut run = |vehicle: &mut StaticVehicle, nav: &mut Navigator, samples: u64| {
+        for _ in 0..samples {
+            k += 1;
+            let _ = vehicle.step(nav, k);
+        }
+        nav.output()
+    };
+    let out = run(&mut vehicle, &mut nav, 2000);
+    assert!(out.aided_by(aiding::BARO) && !out.aided_by(aiding::BARO_STALE));
+    // 5 s without a reading: stale after the 1 s aiding timeout, no longer counted as aiding.
+    vehicle.with_baro = false;
+    let out = run(&mut vehicle, &mut nav, 5000);
+    assert!(out.aided_by(aiding::BARO_STALE) && !out.aided_by(aiding::BARO));
+    let before = out.counts[AidingSource::Baro as usize];
+    // The baro returns 30 m higher: sixty times the 0.5 m σ floor, far outside the 5σ gate. The
+    // first reading re-sets the altitude; the next ones are ordinary updates and all pass.
+    vehicle.with_baro = true;
+    vehicle.baro_offset = 30.0;
+    let out = run(&mut vehicle, &mut nav, 2000);
+    assert!(out.aided_by(aiding::BARO) && !out.aided_by(aiding::BARO_STALE));
+    assert!(
+        (out.alt - (BARO_HEIGHT + 30.0)).abs() < 5.0 * BARO_SIGMA,
+        "alt {}",
+        out.alt
+    );
+    let after = out.counts[AidingSource::Baro as usize];
+    assert_eq!(after.rejected, before.rejected);
+    // 2 s at 25 Hz: 50 readings, the first re-sets, 49 updates.
+    assert_eq!(after.accepted - before.accepted, 49);
 }

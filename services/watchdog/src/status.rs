@@ -36,6 +36,15 @@ pub fn status_line(
                 NavMode::from_u8(nav.mode).name(),
                 nav.altitude_m
             ));
+            // Say so when the filter coasts: a configured aiding source has gone quiet.
+            for (bit, what) in [
+                (ipc_types::aiding::BARO_STALE, "baro stale"),
+                (ipc_types::aiding::MAG_STALE, "mag stale"),
+            ] {
+                if nav.aiding & bit != 0 {
+                    line.push_str(&format!(" | {what}, coasting"));
+                }
+            }
         }
         None => line.push_str(" | no navigation output yet"),
     }
@@ -76,5 +85,19 @@ mod tests {
             line.contains("navigating") && line.contains("12.5"),
             "{line}"
         );
+        assert!(!line.contains("stale"), "{line}");
+        let coasting = NavState {
+            aiding: ipc_types::aiding::BARO_STALE,
+            ..nav
+        };
+        let line = status_line(
+            3.0,
+            &[1000.0, 0.0, 100.0, 1000.0, 0.0, 1000.0],
+            0,
+            &DeviceCounters::default(),
+            Some(&coasting),
+        );
+        assert!(line.contains("baro stale, coasting"), "{line}");
+        assert!(!line.contains("mag stale"), "{line}");
     }
 }

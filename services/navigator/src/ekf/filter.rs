@@ -148,6 +148,20 @@ impl ErrorStateEkf {
         &self.p
     }
 
+    /// Forgets what the filter knew about error component `i`: its correlations with every other
+    /// component are dropped and its variance set to `variance`. Used when a state is re-set from a
+    /// measurement (the altitude from a baro reading after an outage).
+    pub fn reset_component(&mut self, i: usize, variance: f64) {
+        if i >= STATES {
+            return;
+        }
+        for k in 0..STATES {
+            self.p[(i, k)] = 0.0;
+            self.p[(k, i)] = 0.0;
+        }
+        self.p[(i, i)] = variance;
+    }
+
     /// Standard deviation of error component `i`.
     pub fn sigma(&self, i: usize) -> f64 {
         self.p[(i, i)].max(0.0).sqrt()

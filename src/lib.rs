@@ -1,0 +1,5 @@
+//! The parts of the `rins` executable other programs build on: its command line and its
+//! configuration loader (the fuzz targets feed the loader arbitrary text).
+
+pub mod cli;
+pub mod config;
