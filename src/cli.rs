@@ -31,8 +31,18 @@ pub enum Command {
     /// Run the device simulator on a pseudo-terminal.
     Sim(SimArgs),
     /// Print every sample of a topic.
+    /// The watchdog's report on every process: state, pid, restarts, heartbeat age, output rate.
+    Status {
+        /// One JSON object instead of the table.
+        #[arg(long)]
+        json: bool,
+        /// Fail when no report arrives within this many seconds.
+        #[arg(long, default_value_t = 2.0)]
+        timeout: f64,
+    },
     Echo {
-        /// Topic: raw-imu, raw-baro, raw-mag, raw-aux, fused-imu, altitude, nav, truth, health.
+        /// Topic: raw-imu, raw-baro, raw-mag, raw-aux, fused-imu, altitude, nav, truth, heartbeat,
+        /// health.
         topic: String,
         /// Stop after this many samples.
         #[arg(long)]

@@ -683,3 +683,82 @@ pub struct Health {
     /// Payloads rejected for a wrong version or malformed content.
     pub rejected: u64,
 }
+
+/// Up to this many processes in a [`HealthReport`].
+pub const MAX_SUPERVISED: usize = 8;
+
+/// What the watchdog knows of one supervised process, [`ServiceHealth::state`].
+#[repr(u8)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ServiceState {
+    /// Started, no heartbeat from this process yet.
+    #[default]
+    Starting = 0,
+    /// Running and heartbeating.
+    Running = 1,
+    /// Exited; waiting out its restart backoff.
+    Restarting = 2,
+    /// Its heartbeat is overdue although the process is still there (hung or starved).
+    Silent = 3,
+}
+
+impl ServiceState {
+    pub const ALL: [ServiceState; 4] = [
+        ServiceState::Starting,
+        ServiceState::Running,
+        ServiceState::Restarting,
+        ServiceState::Silent,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ServiceState::Starting => "starting",
+            ServiceState::Running => "running",
+            ServiceState::Restarting => "restarting",
+            ServiceState::Silent => "silent",
+        }
+    }
+
+    pub fn from_u8(v: u8) -> Option<Self> {
+        Self::ALL.get(v as usize).copied()
+    }
+}
+
+/// One process in a [`HealthReport`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::ServiceHealth")]
+pub struct ServiceHealth {
+    /// [`ServiceKind`] as u8.
+    pub service: u8,
+    /// [`ServiceState`] as u8.
+    pub state: u8,
+    pub _pad: [u8; 2],
+    /// Process id (0 while restarting).
+    pub pid: u32,
+    /// Restarts since the watchdog started.
+    pub restarts: u32,
+    /// Age of the last heartbeat, ms; `u32::MAX` when none has arrived.
+    pub heartbeat_age_ms: u32,
+    /// Samples per second on the process's output topic over the last report period (NaN for a
+    /// process without one).
+    pub output_rate_hz: f32,
+    pub _pad2: [u8; 4],
+}
+
+/// The watchdog's view of every process, published a few times a second on
+/// [`names::HEALTH`]; `rins status` prints it.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::HealthReport")]
+pub struct HealthReport {
+    pub version: u16,
+    /// Entries of [`HealthReport::services`] in use.
+    pub count: u8,
+    pub _pad: [u8; 5],
+    /// CLOCK_MONOTONIC ns when the report was made.
+    pub now_ns: u64,
+    /// Time since the watchdog started, ms.
+    pub uptime_ms: u64,
+    pub services: [ServiceHealth; MAX_SUPERVISED],
+}

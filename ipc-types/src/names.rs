@@ -8,6 +8,9 @@ pub const FUSED_IMU: &str = "rins/fused/imu";
 pub const ALTITUDE: &str = "rins/altitude";
 pub const NAV_STATE: &str = "rins/nav/state";
 pub const TRUTH: &str = "rins/sim/truth";
+/// Each process's once-a-second heartbeat with its counters ([`crate::Health`]).
+pub const HEARTBEAT: &str = "rins/heartbeat";
+/// The watchdog's report on every process ([`crate::HealthReport`]).
 pub const HEALTH: &str = "rins/health";
 /// Commands to the simulator (fault injection).
 pub const SIM_CONTROL: &str = "rins/control/sim";
@@ -18,7 +21,7 @@ pub const SIM_FAULT_APPLIED: &str = "rins/sim/fault";
 pub const FUSION_CONTROL: &str = "rins/control/fusion";
 
 /// Every published topic, with the short name `rins echo` accepts.
-pub const TOPICS: [(&str, &str); 9] = [
+pub const TOPICS: [(&str, &str); 10] = [
     ("raw-imu", RAW_IMU),
     ("raw-baro", RAW_BARO),
     ("raw-mag", RAW_MAG),
@@ -27,5 +30,6 @@ pub const TOPICS: [(&str, &str); 9] = [
     ("altitude", ALTITUDE),
     ("nav", NAV_STATE),
     ("truth", TRUTH),
+    ("heartbeat", HEARTBEAT),
     ("health", HEALTH),
 ];

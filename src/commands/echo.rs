@@ -5,7 +5,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Result, bail};
 use ipc_types::{
-    Altitude, FusedImu, Health, NavState, RawAux, RawBaro, RawImu, RawMag, Truth, names,
+    Altitude, FusedImu, Health, HealthReport, NavState, RawAux, RawBaro, RawImu, RawMag, Truth,
+    names,
 };
 use rins_runtime::ipc::{IpcSettings, TopicSubscriber, create_node};
 use rins_runtime::shutdown::Shutdown;
@@ -124,7 +125,8 @@ pub fn run(topic: &str, count: Option<u64>, csv: bool, timeout_s: f64) -> Result
         names::ALTITUDE => echo_topic::<Altitude>(names::ALTITUDE, opts),
         names::NAV_STATE => echo_topic::<NavState>(names::NAV_STATE, opts),
         names::TRUTH => echo_topic::<Truth>(names::TRUTH, opts),
-        _ => echo_topic::<Health>(names::HEALTH, opts),
+        names::HEARTBEAT => echo_topic::<Health>(names::HEARTBEAT, opts),
+        _ => echo_topic::<HealthReport>(names::HEALTH, opts),
     }
 }
 

@@ -9,6 +9,7 @@ use anyhow::{Context, Result, bail};
 use rins_runtime::ipc::{IpcSettings, create_node};
 use rins_runtime::shm_cleanup;
 use rins_runtime::shutdown::Shutdown;
+use rins_watchdog::health_publisher::HealthPublisher;
 use rins_watchdog::monitor::{COUNTED, Monitor};
 use rins_watchdog::status::status_line;
 use rins_watchdog::summary::Summary;
@@ -136,6 +137,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     let mut monitor = Monitor::new(&node)?;
     let mut supervisor = Supervisor::new(cfg.watchdog.restart_policy());
     let started = Instant::now();
+    let mut health = HealthPublisher::new(&node, started)?;
     let outcome = (|| -> Result<()> {
         for name in SERVICES {
             let mut child_args = vec!["service".to_string(), name.to_string()];
@@ -163,6 +165,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
             &shutdown,
             &mut supervisor,
             &mut monitor,
+            &mut health,
             started,
         )
     })();
@@ -171,6 +174,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     // Drain what the children published while stopping, then release our own ports.
     let _ = monitor.drain();
     let summary = summarise(&monitor, &supervisor, started.elapsed(), simulate);
+    drop(health);
     drop(monitor);
     drop(node);
     shm_cleanup::remove_all(&settings);
@@ -213,6 +217,7 @@ fn supervise(
     shutdown: &Shutdown,
     supervisor: &mut Supervisor,
     monitor: &mut Monitor,
+    health: &mut HealthPublisher,
     started: Instant,
 ) -> Result<()> {
     let end = args.duration.map(|d| started + Duration::from_secs_f64(d));
@@ -225,6 +230,7 @@ fn supervise(
     while !shutdown.requested() && end.is_none_or(|e| Instant::now() < e) {
         monitor.drain()?;
         supervisor.poll(&mut events);
+        health.tick(supervisor, monitor)?;
         for event in events.drain(..) {
             match event {
                 ChildEvent::Exited {

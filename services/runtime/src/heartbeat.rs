@@ -1,4 +1,4 @@
-//! Once-a-second heartbeat with the process's counters, on the `health` topic.
+//! Once-a-second heartbeat with the process's counters, on the `heartbeat` topic.
 
 use anyhow::Result;
 use ipc_types::{Health, PAYLOAD_VERSION, ServiceKind, names};
@@ -17,7 +17,7 @@ pub struct Heartbeat {
 impl Heartbeat {
     pub fn new(node: &IpcNode, service: ServiceKind) -> Result<Self> {
         Ok(Self {
-            publisher: TopicPublisher::new(node, names::HEALTH)?,
+            publisher: TopicPublisher::new(node, names::HEARTBEAT)?,
             template: Health {
                 version: PAYLOAD_VERSION,
                 service: service as u8,

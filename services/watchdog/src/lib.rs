@@ -4,6 +4,8 @@
 pub mod accuracy;
 pub mod config;
 pub mod fault_tracking;
+pub mod health_publisher;
+pub mod health_report;
 pub mod monitor;
 pub mod restart_policy;
 pub mod seq_gaps;

@@ -46,6 +46,8 @@ pub struct Monitor {
     truth_ring: Box<[Truth]>,
     /// Latest acquisition counters per process id (a restarted acquisition starts from zero).
     acquisition: Vec<(u32, DeviceCounters)>,
+    /// Last heartbeat per [`ServiceKind`]: the sender's pid and its CLOCK_MONOTONIC time, ns.
+    pub heartbeats: [Option<(u32, u64)>; ServiceKind::ALL.len()],
 }
 
 impl Monitor {
@@ -58,7 +60,7 @@ impl Monitor {
             alt: TopicSubscriber::new(node, names::ALTITUDE)?,
             nav: TopicSubscriber::new(node, names::NAV_STATE)?,
             truth: TopicSubscriber::new(node, names::TRUTH)?,
-            health: TopicSubscriber::new(node, names::HEALTH)?,
+            health: TopicSubscriber::new(node, names::HEARTBEAT)?,
             fault_events: TopicSubscriber::new(node, names::SIM_FAULT_APPLIED)?,
             totals: [0; COUNTED.len()],
             nav_gaps: SeqGaps::default(),
@@ -75,6 +77,7 @@ impl Monitor {
             ]
             .into_boxed_slice(),
             acquisition: Vec::new(),
+            heartbeats: [None; ServiceKind::ALL.len()],
         })
     }
 
@@ -125,7 +128,11 @@ impl Monitor {
     }
 
     fn on_health(&mut self, h: &Health) {
-        if ServiceKind::from_u8(h.service) != Some(ServiceKind::Acquisition) {
+        let Some(kind) = ServiceKind::from_u8(h.service) else {
+            return;
+        };
+        self.heartbeats[kind as usize] = Some((h.pid, h.now_ns));
+        if kind != ServiceKind::Acquisition {
             return;
         }
         let counters = DeviceCounters {

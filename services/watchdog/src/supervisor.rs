@@ -31,6 +31,15 @@ pub struct Supervisor {
     policy: RestartPolicy,
 }
 
+/// One child as [`Supervisor::children`] reports it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ChildStatus {
+    pub name: String,
+    /// `None` while the child waits out its restart backoff.
+    pub pid: Option<u32>,
+    pub restarts: u64,
+}
+
 /// What happened to a child during [`Supervisor::poll`].
 #[derive(Debug, Clone, PartialEq)]
 pub enum ChildEvent {
@@ -144,6 +153,18 @@ impl Supervisor {
         self.children
             .iter()
             .filter_map(|m| m.child.as_ref().map(|c| (m.spec.name.clone(), c.id())))
+            .collect()
+    }
+
+    /// Every supervised child: name, current pid (`None` while waiting to restart), restarts.
+    pub fn children(&self) -> Vec<ChildStatus> {
+        self.children
+            .iter()
+            .map(|m| ChildStatus {
+                name: m.spec.name.clone(),
+                pid: m.child.as_ref().map(Child::id),
+                restarts: m.restarts,
+            })
             .collect()
     }
 

@@ -1,0 +1,94 @@
+//! Publishes the [`HealthReport`] a few times a second from the supervisor's children and the
+//! monitor's heartbeats and topic counts.
+
+use std::time::{Duration, Instant};
+
+use anyhow::Result;
+use ipc_types::{HealthReport, ServiceKind, names};
+use rins_runtime::clock::monotonic_ns;
+use rins_runtime::ipc::{IpcNode, TopicPublisher};
+
+use crate::health_report::{ProcessView, build_report};
+use crate::monitor::{COUNTED, Monitor};
+use crate::supervisor::Supervisor;
+
+/// Report period.
+pub const PERIOD: Duration = Duration::from_millis(250);
+/// A running process whose heartbeat (once a second) is older than this is reported silent.
+pub const SILENT_AFTER: Duration = Duration::from_secs(3);
+
+/// The topic of [`COUNTED`] each process publishes (`None`: none the monitor counts).
+fn output_topic(kind: ServiceKind) -> Option<usize> {
+    let name = match kind {
+        ServiceKind::Acquisition => "imu",
+        ServiceKind::Fusion => "fused",
+        ServiceKind::Altimeter => "alt",
+        ServiceKind::Navigator => "nav",
+        ServiceKind::Simulator | ServiceKind::Watchdog => return None,
+    };
+    COUNTED.iter().position(|c| *c == name)
+}
+
+pub struct HealthPublisher {
+    publisher: TopicPublisher<HealthReport>,
+    started: Instant,
+    next_due: Instant,
+    last_at: Instant,
+    last_totals: [u64; COUNTED.len()],
+}
+
+impl HealthPublisher {
+    pub fn new(node: &IpcNode, started: Instant) -> Result<Self> {
+        let now = Instant::now();
+        Ok(Self {
+            publisher: TopicPublisher::new(node, names::HEALTH)?,
+            started,
+            next_due: now,
+            last_at: now,
+            last_totals: [0; COUNTED.len()],
+        })
+    }
+
+    /// Publishes a report when one is due.
+    pub fn tick(&mut self, supervisor: &Supervisor, monitor: &Monitor) -> Result<()> {
+        let now = Instant::now();
+        if now < self.next_due {
+            return Ok(());
+        }
+        self.next_due = now + PERIOD;
+        let dt = now.duration_since(self.last_at).as_secs_f64().max(1e-3);
+        self.last_at = now;
+        let totals = monitor.totals;
+        let me = std::process::id();
+        let watchdog = ProcessView {
+            kind: ServiceKind::Watchdog,
+            pid: Some(me),
+            restarts: 0,
+            heartbeat: Some((me, monotonic_ns())),
+            output_rate_hz: f64::NAN,
+        };
+        let views: Vec<ProcessView> = std::iter::once(watchdog)
+            .chain(supervisor.children().into_iter().filter_map(|child| {
+                let kind = ServiceKind::from_name(&child.name)?;
+                let output_rate_hz = output_topic(kind).map_or(f64::NAN, |i| {
+                    totals[i].saturating_sub(self.last_totals[i]) as f64 / dt
+                });
+                Some(ProcessView {
+                    kind,
+                    pid: child.pid,
+                    restarts: child.restarts,
+                    heartbeat: monitor.heartbeats[kind as usize],
+                    output_rate_hz,
+                })
+            }))
+            .collect();
+        self.last_totals = totals;
+        let report = build_report(
+            monotonic_ns(),
+            self.started.elapsed().as_millis() as u64,
+            &views,
+            SILENT_AFTER.as_nanos() as u64,
+        );
+        self.publisher.publish(report)
+    }
+}

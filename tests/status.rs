@@ -1,0 +1,122 @@
+//! `rins status` against a running pipeline, and what it shows when a service is killed with a
+//! real SIGKILL: the watchdog restarts it and the report counts the restart under a new pid.
+
+mod common;
+
+use std::process::Stdio;
+use std::time::{Duration, Instant};
+
+use common::{Isolated, PipelineSlot, last_json};
+use serde_json::Value;
+
+fn status(ipc: &Isolated) -> Value {
+    let out = ipc.run(&["status", "--json", "--timeout", "10"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    last_json(&out)
+}
+
+fn service<'a>(report: &'a Value, name: &str) -> &'a Value {
+    report["services"]
+        .as_array()
+        .expect("services array")
+        .iter()
+        .find(|s| s["service"] == name)
+        .unwrap_or_else(|| panic!("no {name} in {report}"))
+}
+
+/// Polls the status until `done` holds (or fails after `limit`).
+fn wait_for(ipc: &Isolated, limit: Duration, done: impl Fn(&Value) -> bool) -> Value {
+    let start = Instant::now();
+    loop {
+        let report = status(ipc);
+        if done(&report) {
+            return report;
+        }
+        assert!(start.elapsed() < limit, "gave up waiting: {report}");
+        std::thread::sleep(Duration::from_millis(200));
+    }
+}
+
+#[test]
+fn status_shows_every_process_and_counts_a_restart_after_sigkill() {
+    let _slot = PipelineSlot::take();
+    let ipc = Isolated::new("status");
+    let up = ipc
+        .command()
+        .args(["up", "--scenario", "static", "--duration", "300", "--json"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("cannot start rins up");
+    let first = ipc.run(&["echo", "nav", "--count", "1", "--timeout", "120"]);
+    assert!(first.status.success());
+
+    let names = [
+        "watchdog",
+        "acquisition",
+        "fusion",
+        "altimeter",
+        "navigator",
+        "sim",
+    ];
+    let report = wait_for(&ipc, Duration::from_secs(20), |r| {
+        names.iter().all(|n| service(r, n)["state"] == "running")
+    });
+    for name in names {
+        let s = service(&report, name);
+        assert_eq!(s["restarts"], 0, "{s}");
+        assert!(s["pid"].as_u64().unwrap() > 0, "{s}");
+        // Heartbeats come once a second.
+        assert!(s["heartbeat_age_ms"].as_u64().unwrap() < 3000, "{s}");
+    }
+    // 1 kHz input: the navigator and fusion publish every sample. The report's window is 250 ms,
+    // so a busy machine may shift a few samples between windows.
+    for name in ["fusion", "navigator"] {
+        let rate = service(&report, name)["output_rate_hz"].as_f64().unwrap();
+        assert!((500.0..=1500.0).contains(&rate), "{name} {rate}");
+    }
+    assert!(service(&report, "sim")["output_rate_hz"].is_null());
+
+    // A real SIGKILL to fusion: the watchdog restarts it, the report shows the new pid and the
+    // restart, and navigation output resumes.
+    let old_pid = service(&report, "fusion")["pid"].as_u64().unwrap();
+    let pid = libc::pid_t::try_from(old_pid).expect("pid fits pid_t");
+    // SAFETY: sends a signal to a process of this test's own pipeline.
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGKILL) }, 0);
+    let after = wait_for(&ipc, Duration::from_secs(20), |r| {
+        let f = service(r, "fusion");
+        f["restarts"] == 1 && f["state"] == "running"
+    });
+    let fusion = service(&after, "fusion");
+    assert_ne!(fusion["pid"].as_u64().unwrap(), old_pid, "{fusion}");
+    for name in ["acquisition", "altimeter", "navigator", "sim"] {
+        assert_eq!(service(&after, name)["restarts"], 0, "{name}: {after}");
+    }
+    let again = ipc.run(&["echo", "nav", "--count", "5", "--timeout", "30"]);
+    assert!(again.status.success());
+
+    let pid = libc::pid_t::try_from(up.id()).expect("pid fits pid_t");
+    // SAFETY: sends a signal to our own child process, which has not been reaped yet.
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGTERM) }, 0);
+    let out = up.wait_with_output().expect("rins up did not finish");
+    assert!(out.status.success());
+    let summary = last_json(&out);
+    assert_eq!(summary["restarts"], 1, "{summary}");
+    assert_eq!(ipc.shm_entries(), Vec::<String>::new());
+}
+
+#[test]
+fn status_without_a_pipeline_fails_naming_the_prefix() {
+    let ipc = Isolated::new("status_none");
+    let out = ipc.run(&["status", "--timeout", "0.5"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("no health report") && err.contains(&ipc.prefix),
+        "{err}"
+    );
+}
