@@ -120,3 +120,46 @@ fn status_without_a_pipeline_fails_naming_the_prefix() {
         "{err}"
     );
 }
+
+#[test]
+fn a_stopped_service_is_seen_silent_killed_and_restarted() {
+    let _slot = PipelineSlot::take();
+    let ipc = Isolated::new("hang");
+    let up = ipc
+        .command()
+        .args(["up", "--scenario", "static", "--duration", "300", "--json"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("cannot start rins up");
+    let report = wait_for(&ipc, Duration::from_secs(60), |r| {
+        service(r, "navigator")["state"] == "running"
+    });
+    let old_pid = service(&report, "navigator")["pid"].as_u64().unwrap();
+    let pid = libc::pid_t::try_from(old_pid).expect("pid fits pid_t");
+    // SIGSTOP: the process is still there but does nothing, as if hung. Its heartbeat stops; after
+    // the 3 s heartbeat timeout the watchdog kills and restarts it.
+    // SAFETY: sends a signal to a process of this test's own pipeline.
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGSTOP) }, 0);
+    let after = wait_for(&ipc, Duration::from_secs(30), |r| {
+        let n = service(r, "navigator");
+        n["restarts"] == 1 && n["state"] == "running"
+    });
+    assert_ne!(
+        service(&after, "navigator")["pid"].as_u64().unwrap(),
+        old_pid
+    );
+    // The stopped process is gone (killed and reaped: no zombie under the old pid).
+    // SAFETY: signal 0 only checks whether the pid exists.
+    assert_ne!(unsafe { libc::kill(pid, 0) }, 0, "pid {pid} still exists");
+    let again = ipc.run(&["echo", "nav", "--count", "5", "--timeout", "30"]);
+    assert!(again.status.success());
+
+    let up_pid = libc::pid_t::try_from(up.id()).expect("pid fits pid_t");
+    // SAFETY: sends a signal to our own child process, which has not been reaped yet.
+    assert_eq!(unsafe { libc::kill(up_pid, libc::SIGTERM) }, 0);
+    let out = up.wait_with_output().expect("rins up did not finish");
+    assert!(out.status.success());
+    assert_eq!(last_json(&out)["restarts"], 1);
+    assert_eq!(ipc.shm_entries(), Vec::<String>::new());
+}

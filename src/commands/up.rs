@@ -137,7 +137,12 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     let mut monitor = Monitor::new(&node)?;
     let mut supervisor = Supervisor::new(cfg.watchdog.restart_policy());
     let started = Instant::now();
-    let mut health = HealthPublisher::new(&node, started)?;
+    // With the check off, a silent process is still reported, after an hour.
+    let silent_after = match cfg.watchdog.heartbeat_timeout_s {
+        0.0 => Duration::from_secs(3600),
+        s => Duration::from_secs_f64(s),
+    };
+    let mut health = HealthPublisher::new(&node, started, silent_after)?;
     let outcome = (|| -> Result<()> {
         for name in SERVICES {
             let mut child_args = vec!["service".to_string(), name.to_string()];
@@ -161,6 +166,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
         }
         supervise(
             &cfg,
+            &settings,
             args,
             &shutdown,
             &mut supervisor,
@@ -211,8 +217,28 @@ fn sim_args(cfg: &RinsConfig, config_args: &[String], link: &Path, up: &UpArgs) 
     args
 }
 
+/// SIGKILL to every process the report calls silent (heartbeat overdue while it still runs: hung or
+/// stopped); the supervisor restarts it like any process that exited.
+fn kill_hung(report: &ipc_types::HealthReport, supervisor: &mut Supervisor) {
+    let count = usize::from(report.count).min(report.services.len());
+    for s in &report.services[..count] {
+        let silent =
+            ipc_types::ServiceState::from_u8(s.state) == Some(ipc_types::ServiceState::Silent);
+        let own = s.pid == std::process::id();
+        if silent && !own && supervisor.kill(s.pid) {
+            tracing::warn!(
+                service = ipc_types::ServiceKind::from_u8(s.service).map_or("?", |k| k.name()),
+                pid = s.pid,
+                heartbeat_age_ms = s.heartbeat_age_ms,
+                "heartbeat overdue: killed, will be restarted"
+            );
+        }
+    }
+}
+
 fn supervise(
     cfg: &RinsConfig,
+    settings: &IpcSettings,
     args: &UpArgs,
     shutdown: &Shutdown,
     supervisor: &mut Supervisor,
@@ -230,7 +256,11 @@ fn supervise(
     while !shutdown.requested() && end.is_none_or(|e| Instant::now() < e) {
         monitor.drain()?;
         supervisor.poll(&mut events);
-        health.tick(supervisor, monitor)?;
+        if let Some(report) = health.tick(supervisor, monitor)?
+            && cfg.watchdog.heartbeat_timeout_s > 0.0
+        {
+            kill_hung(&report, supervisor);
+        }
         for event in events.drain(..) {
             match event {
                 ChildEvent::Exited {
@@ -238,7 +268,15 @@ fn supervise(
                     status,
                     restart_in,
                 } => {
-                    tracing::warn!(child = %name, %status, restart_in_ms = restart_in.as_millis() as u64, "child exited")
+                    tracing::warn!(child = %name, %status, restart_in_ms = restart_in.as_millis() as u64, "child exited");
+                    // Its node is dead now: free its shared memory before the restart.
+                    match rins_runtime::ipc::remove_dead_nodes(settings) {
+                        Ok(n) if n > 0 => {
+                            tracing::info!(child = %name, nodes = n, "removed the resources of dead nodes")
+                        }
+                        Ok(_) => {}
+                        Err(e) => tracing::warn!(error = %e, "cannot clean up dead nodes"),
+                    }
                 }
                 ChildEvent::Restarted { name, pid } => {
                     tracing::info!(child = %name, pid, "child restarted")

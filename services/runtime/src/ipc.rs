@@ -80,6 +80,23 @@ fn install_global_config(settings: &IpcSettings, config: &Config) -> Result<()> 
 }
 
 /// Creates this process's node. Signal handling is left to [`crate::shutdown::Shutdown`].
+/// Removes the shared memory and other resources of every dead node of this deployment (a
+/// process that was killed without dropping its node); returns how many nodes were cleaned.
+pub fn remove_dead_nodes(settings: &IpcSettings) -> Result<usize> {
+    let config = settings.iceoryx_config()?;
+    let mut removed = 0;
+    Node::<ipc::Service>::list(&config, |state| {
+        if let NodeState::Dead(view) = state
+            && view.try_remove_stale_resources().is_ok()
+        {
+            removed += 1;
+        }
+        CallbackProgression::Continue
+    })
+    .map_err(|e| anyhow!("cannot list iceoryx2 nodes: {e:?}"))?;
+    Ok(removed)
+}
+
 pub fn create_node(name: &str, settings: &IpcSettings) -> Result<IpcNode> {
     let config = settings.iceoryx_config()?;
     install_global_config(settings, &config)?;

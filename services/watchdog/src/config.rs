@@ -17,6 +17,9 @@ pub struct WatchdogConfig {
     pub stop_grace_ms: u64,
     /// Print the status line this often; 0 turns it off.
     pub status_period_s: f64,
+    /// A child whose heartbeat (once a second) is older than this is hung: it is killed and
+    /// restarted. 0 turns the check off.
+    pub heartbeat_timeout_s: f64,
 }
 
 impl Default for WatchdogConfig {
@@ -27,6 +30,7 @@ impl Default for WatchdogConfig {
             restart_stable_after_s: 10.0,
             stop_grace_ms: 2_000,
             status_period_s: 1.0,
+            heartbeat_timeout_s: 3.0,
         }
     }
 }
@@ -49,6 +53,12 @@ impl WatchdogConfig {
             return Err(format!(
                 "watchdog.status_period_s = {}: must be a non-negative number",
                 self.status_period_s
+            ));
+        }
+        let h = self.heartbeat_timeout_s;
+        if !(h.is_finite() && (h == 0.0 || (1.5..=600.0).contains(&h))) {
+            return Err(format!(
+                "watchdog.heartbeat_timeout_s = {h}: must be 0 (off) or in [1.5, 600] s (heartbeats come once a second)"
             ));
         }
         if self.stop_grace_ms > 60_000 {

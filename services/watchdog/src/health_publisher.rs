@@ -14,8 +14,6 @@ use crate::supervisor::Supervisor;
 
 /// Report period.
 pub const PERIOD: Duration = Duration::from_millis(250);
-/// A running process whose heartbeat (once a second) is older than this is reported silent.
-pub const SILENT_AFTER: Duration = Duration::from_secs(3);
 
 /// The topic of [`COUNTED`] each process publishes (`None`: none the monitor counts).
 fn output_topic(kind: ServiceKind) -> Option<usize> {
@@ -31,6 +29,8 @@ fn output_topic(kind: ServiceKind) -> Option<usize> {
 
 pub struct HealthPublisher {
     publisher: TopicPublisher<HealthReport>,
+    /// A running process whose heartbeat is older than this is reported silent.
+    silent_after: Duration,
     started: Instant,
     next_due: Instant,
     last_at: Instant,
@@ -38,10 +38,11 @@ pub struct HealthPublisher {
 }
 
 impl HealthPublisher {
-    pub fn new(node: &IpcNode, started: Instant) -> Result<Self> {
+    pub fn new(node: &IpcNode, started: Instant, silent_after: Duration) -> Result<Self> {
         let now = Instant::now();
         Ok(Self {
             publisher: TopicPublisher::new(node, names::HEALTH)?,
+            silent_after,
             started,
             next_due: now,
             last_at: now,
@@ -49,11 +50,15 @@ impl HealthPublisher {
         })
     }
 
-    /// Publishes a report when one is due.
-    pub fn tick(&mut self, supervisor: &Supervisor, monitor: &Monitor) -> Result<()> {
+    /// Publishes a report when one is due, and returns it.
+    pub fn tick(
+        &mut self,
+        supervisor: &Supervisor,
+        monitor: &Monitor,
+    ) -> Result<Option<HealthReport>> {
         let now = Instant::now();
         if now < self.next_due {
-            return Ok(());
+            return Ok(None);
         }
         self.next_due = now + PERIOD;
         let dt = now.duration_since(self.last_at).as_secs_f64().max(1e-3);
@@ -87,8 +92,9 @@ impl HealthPublisher {
             monotonic_ns(),
             self.started.elapsed().as_millis() as u64,
             &views,
-            SILENT_AFTER.as_nanos() as u64,
+            u64::try_from(self.silent_after.as_nanos()).unwrap_or(u64::MAX),
         );
-        self.publisher.publish(report)
+        self.publisher.publish(report)?;
+        Ok(Some(report))
     }
 }

@@ -156,6 +156,20 @@ impl Supervisor {
             .collect()
     }
 
+    /// SIGKILL to the child running as `pid` (a hung one); [`Supervisor::poll`] then reaps and
+    /// restarts it as after any exit. False when no child runs as `pid`.
+    pub fn kill(&mut self, pid: u32) -> bool {
+        let Some(child) = self
+            .children
+            .iter_mut()
+            .filter_map(|m| m.child.as_mut())
+            .find(|c| c.id() == pid)
+        else {
+            return false;
+        };
+        child.kill().is_ok()
+    }
+
     /// Every supervised child: name, current pid (`None` while waiting to restart), restarts.
     pub fn children(&self) -> Vec<ChildStatus> {
         self.children
