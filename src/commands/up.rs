@@ -169,9 +169,11 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
             &settings,
             args,
             &shutdown,
-            &mut supervisor,
-            &mut monitor,
-            &mut health,
+            Watch {
+                supervisor: &mut supervisor,
+                monitor: &mut monitor,
+                health: &mut health,
+            },
             started,
         )
     })();
@@ -236,16 +238,26 @@ fn kill_hung(report: &ipc_types::HealthReport, supervisor: &mut Supervisor) {
     }
 }
 
+/// What the supervision loop drives.
+struct Watch<'a> {
+    supervisor: &'a mut Supervisor,
+    monitor: &'a mut Monitor,
+    health: &'a mut HealthPublisher,
+}
+
 fn supervise(
     cfg: &RinsConfig,
     settings: &IpcSettings,
     args: &UpArgs,
     shutdown: &Shutdown,
-    supervisor: &mut Supervisor,
-    monitor: &mut Monitor,
-    health: &mut HealthPublisher,
+    watch: Watch<'_>,
     started: Instant,
 ) -> Result<()> {
+    let Watch {
+        supervisor,
+        monitor,
+        health,
+    } = watch;
     let end = args.duration.map(|d| started + Duration::from_secs_f64(d));
     let period = (cfg.watchdog.status_period_s > 0.0)
         .then(|| Duration::from_secs_f64(cfg.watchdog.status_period_s));
