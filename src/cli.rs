@@ -31,6 +31,9 @@ pub enum Command {
     /// Run the device simulator on a pseudo-terminal.
     Sim(SimArgs),
     /// Print every sample of a topic.
+    /// Randomised SIGKILLs of the services under a running pipeline; JSON summary of kills,
+    /// restarts, lost navigation samples, the longest output gap and leaked shared memory.
+    Soak(SoakArgs),
     /// The watchdog's report on every process: state, pid, restarts, heartbeat age, output rate.
     Status {
         /// One JSON object instead of the table.
@@ -282,4 +285,20 @@ pub struct SimArgs {
     pub duration: Option<f64>,
     #[command(flatten)]
     pub faults: FaultArgs,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct SoakArgs {
+    /// How long to run, minutes.
+    #[arg(long)]
+    pub minutes: f64,
+    /// Seed of the kill schedule.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Shortest time between two kills, s.
+    #[arg(long = "min-interval", default_value_t = 2.0)]
+    pub min_interval_s: f64,
+    /// Longest time between two kills, s.
+    #[arg(long = "max-interval", default_value_t = 6.0)]
+    pub max_interval_s: f64,
 }
