@@ -163,3 +163,54 @@ fn a_stopped_service_is_seen_silent_killed_and_restarted() {
     assert_eq!(last_json(&out)["restarts"], 1);
     assert_eq!(ipc.shm_entries(), Vec::<String>::new());
 }
+
+#[test]
+fn fusion_says_when_acquisition_goes_quiet_and_when_it_is_back() {
+    let _slot = PipelineSlot::take();
+    let ipc = Isolated::new("stale");
+    let up = ipc
+        .command()
+        .args(["up", "--scenario", "static", "--duration", "300", "--json"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("cannot start rins up");
+    let report = wait_for(&ipc, Duration::from_secs(60), |r| {
+        service(r, "acquisition")["state"] == "running"
+            && service(r, "fusion")["state"] == "running"
+    });
+    assert_eq!(service(&report, "fusion")["input_stale"], false);
+    let pid = service(&report, "acquisition")["pid"].as_u64().unwrap();
+    let pid = libc::pid_t::try_from(pid).expect("pid fits pid_t");
+    // Acquisition stopped: fusion's input deadline (50 ms) passes and its next heartbeat (within
+    // a second) says so; after the 3 s heartbeat timeout the watchdog replaces acquisition and
+    // fusion's input returns.
+    // SAFETY: sends a signal to a process of this test's own pipeline.
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGSTOP) }, 0);
+    wait_for(&ipc, Duration::from_secs(10), |r| {
+        service(r, "fusion")["input_stale"] == true
+    });
+    wait_for(&ipc, Duration::from_secs(30), |r| {
+        let a = service(r, "acquisition");
+        a["restarts"] == 1
+            && a["state"] == "running"
+            && service(r, "fusion")["input_stale"] == false
+    });
+    let heartbeat = ipc.run(&["echo", "heartbeat", "--count", "20", "--timeout", "10"]);
+    assert!(heartbeat.status.success());
+    let text = String::from_utf8_lossy(&heartbeat.stdout);
+    let fusion_episodes = text
+        .lines()
+        .filter_map(|l| serde_json::from_str::<Value>(l).ok())
+        .filter(|h| h["service"] == 2)
+        .map(|h| h["stale_input_episodes"].as_u64().unwrap())
+        .max();
+    assert!(fusion_episodes.is_some_and(|n| n >= 1), "{text}");
+
+    let up_pid = libc::pid_t::try_from(up.id()).expect("pid fits pid_t");
+    // SAFETY: sends a signal to our own child process, which has not been reaped yet.
+    assert_eq!(unsafe { libc::kill(up_pid, libc::SIGTERM) }, 0);
+    let out = up.wait_with_output().expect("rins up did not finish");
+    assert!(out.status.success());
+    assert_eq!(ipc.shm_entries(), Vec::<String>::new());
+}

@@ -682,6 +682,11 @@ pub struct Health {
     pub reconnects: u64,
     /// Payloads rejected for a wrong version or malformed content.
     pub rejected: u64,
+    /// Periods in which the process's input went quiet for longer than its deadline.
+    pub stale_input_episodes: u64,
+    /// 1 while the input is quiet (stale) now.
+    pub input_stale: u8,
+    pub _pad2: [u8; 7],
 }
 
 /// Up to this many processes in a [`HealthReport`].
@@ -733,7 +738,9 @@ pub struct ServiceHealth {
     pub service: u8,
     /// [`ServiceState`] as u8.
     pub state: u8,
-    pub _pad: [u8; 2],
+    /// 1 when the process's last heartbeat said its input is quiet (stale).
+    pub input_stale: u8,
+    pub _pad: [u8; 1],
     /// Process id (0 while restarting).
     pub pid: u32,
     /// Restarts since the watchdog started.

@@ -30,7 +30,8 @@ pub fn run(name: ServiceName, config_path: Option<&Path>, port: Option<String>) 
                 cfg.device.accel_lsb_mps2(),
             )
             .map_err(|e| anyhow!("{}", e.within("fusion")))?;
-            rins_fusion::service::run(fuser, &settings, &shutdown)
+            let deadline = rins_fusion::service::input_deadline(cfg.fusion.sample_rate_hz);
+            rins_fusion::service::run(fuser, deadline, &settings, &shutdown)
         }
         ServiceName::Altimeter => {
             let estimator = rins_altimeter::AltitudeEstimator::new(cfg.altimeter.clone())

@@ -15,6 +15,8 @@ pub struct ServiceRow {
     pub state: String,
     pub pid: u32,
     pub restarts: u32,
+    /// Its last heartbeat said its input is quiet.
+    pub input_stale: bool,
     /// `None` before the first heartbeat.
     pub heartbeat_age_ms: Option<u32>,
     /// `None` for a process without an output topic.
@@ -39,6 +41,7 @@ pub fn rows(report: &HealthReport) -> StatusReport {
                 .map_or_else(|| format!("state {}", s.state), |k| k.name().into()),
             pid: s.pid,
             restarts: s.restarts,
+            input_stale: s.input_stale != 0,
             heartbeat_age_ms: (s.heartbeat_age_ms != u32::MAX).then_some(s.heartbeat_age_ms),
             output_rate_hz: s
                 .output_rate_hz
@@ -62,9 +65,10 @@ pub fn table(report: &StatusReport) -> String {
         let rate = r
             .output_rate_hz
             .map_or_else(|| "-".to_string(), |h| format!("{h:.0}/s"));
+        let stale = if r.input_stale { "  input stale" } else { "" };
         out.push_str(&format!(
-            "{:<12} {:<11} {:<8} {:<9} {:<10} {}\n",
-            r.service, r.state, r.pid, r.restarts, age, rate
+            "{:<12} {:<11} {:<8} {:<9} {:<10} {rate}{stale}\n",
+            r.service, r.state, r.pid, r.restarts, age
         ));
     }
     out

@@ -9,6 +9,7 @@ use ipc_types::{
 };
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::heartbeat::Heartbeat;
+use rins_runtime::input_watch::{InputChange, InputWatch};
 use rins_runtime::ipc::{IpcSettings, TopicPublisher, TopicSubscriber, create_node};
 use rins_runtime::shutdown::Shutdown;
 
@@ -18,7 +19,8 @@ use crate::fuser::{ACCEL_MASK_SHIFT, Fused, ImuFuser};
 const _: () = assert!(ACCEL_MASK_SHIFT == 16);
 
 /// Longest sleep between looks at the shutdown flag and the heartbeat.
-const WAIT: Duration = Duration::from_millis(100);
+/// Longest sleep waiting for input; also how often the input deadline is checked.
+const WAIT: Duration = Duration::from_millis(10);
 
 /// The fused message for one raw frame: estimate, fault-detection fields and the raw frame's header
 /// (the fusion stamp is left to the caller).
@@ -82,7 +84,18 @@ fn readmit(fuser: &mut ImuFuser, cmd: &FusionControl) {
     }
 }
 
-pub fn run(mut fuser: ImuFuser, settings: &IpcSettings, shutdown: &Shutdown) -> Result<()> {
+/// How long fusion waits for raw IMU before it reports acquisition stale: twenty sample periods,
+/// at least 50 ms (a few lost frames are not an outage).
+pub fn input_deadline(sample_rate_hz: f64) -> Duration {
+    Duration::from_secs_f64((20.0 / sample_rate_hz).max(0.05))
+}
+
+pub fn run(
+    mut fuser: ImuFuser,
+    deadline: Duration,
+    settings: &IpcSettings,
+    shutdown: &Shutdown,
+) -> Result<()> {
     let node = create_node("fusion", settings)?;
     let input = TopicSubscriber::<RawImu>::new(&node, names::RAW_IMU)?;
     let output = TopicPublisher::<FusedImu>::new(&node, names::FUSED_IMU)?;
@@ -92,6 +105,7 @@ pub fn run(mut fuser: ImuFuser, settings: &IpcSettings, shutdown: &Shutdown) -> 
     let mut counters = Health::default();
     let mut last_seq: Option<u64> = None;
     let mut mismatch_reported = false;
+    let mut acquisition = InputWatch::new(deadline);
 
     while !shutdown.requested() {
         input.wait(WAIT)?;
@@ -102,7 +116,9 @@ pub fn run(mut fuser: ImuFuser, settings: &IpcSettings, shutdown: &Shutdown) -> 
                 counters.rejected += 1;
             }
         }
+        let mut received_any = false;
         while let Some(raw) = input.receive()? {
+            received_any = true;
             counters.received += 1;
             if let Some(last) = last_seq
                 && raw.header.origin_seq > last + 1
@@ -137,6 +153,25 @@ pub fn run(mut fuser: ImuFuser, settings: &IpcSettings, shutdown: &Shutdown) -> 
             output.publish(msg)?;
             counters.published += 1;
         }
+        let now = monotonic_ns();
+        let change = if received_any {
+            acquisition.input(now)
+        } else {
+            acquisition.idle(now)
+        };
+        match change {
+            InputChange::WentStale => tracing::warn!(
+                deadline_ms = deadline.as_millis() as u64,
+                "no raw IMU from acquisition within the deadline: no fused output until it returns"
+            ),
+            InputChange::CameBack(gap) => tracing::warn!(
+                gap_ms = gap.as_millis() as u64,
+                "raw IMU from acquisition again"
+            ),
+            InputChange::None => {}
+        }
+        counters.stale_input_episodes = acquisition.episodes;
+        counters.input_stale = u8::from(acquisition.is_stale());
         heartbeat.tick(&counters)?;
     }
     Ok(())

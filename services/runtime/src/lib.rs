@@ -4,6 +4,7 @@
 pub mod clock;
 pub mod config_error;
 pub mod heartbeat;
+pub mod input_watch;
 pub mod ipc;
 pub mod logging;
 pub mod shm_cleanup;

@@ -9,7 +9,7 @@ use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{IpcNode, TopicPublisher};
 
 use crate::health_report::{ProcessView, build_report};
-use crate::monitor::{COUNTED, Monitor};
+use crate::monitor::{COUNTED, HeartbeatSeen, Monitor};
 use crate::supervisor::Supervisor;
 
 /// Report period.
@@ -69,7 +69,11 @@ impl HealthPublisher {
             kind: ServiceKind::Watchdog,
             pid: Some(me),
             restarts: 0,
-            heartbeat: Some((me, monotonic_ns())),
+            heartbeat: Some(HeartbeatSeen {
+                pid: me,
+                at_ns: monotonic_ns(),
+                input_stale: false,
+            }),
             output_rate_hz: f64::NAN,
         };
         let views: Vec<ProcessView> = std::iter::once(watchdog)

@@ -5,6 +5,8 @@ use ipc_types::{
     HealthReport, MAX_SUPERVISED, PAYLOAD_VERSION, ServiceHealth, ServiceKind, ServiceState,
 };
 
+use crate::monitor::HeartbeatSeen;
+
 /// What is known of one process when the report is made.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ProcessView {
@@ -12,8 +14,8 @@ pub struct ProcessView {
     /// Current pid; `None` while it waits out its restart backoff.
     pub pid: Option<u32>,
     pub restarts: u64,
-    /// The last heartbeat: the sender's pid and its CLOCK_MONOTONIC time, ns.
-    pub heartbeat: Option<(u32, u64)>,
+    /// The last heartbeat of this kind of process.
+    pub heartbeat: Option<HeartbeatSeen>,
     /// Samples per second on its output topic (NaN when it has none).
     pub output_rate_hz: f64,
 }
@@ -25,8 +27,8 @@ pub fn state_of(view: &ProcessView, now_ns: u64, silent_after_ns: u64) -> (Servi
         return (ServiceState::Restarting, u32::MAX);
     };
     match view.heartbeat {
-        Some((from, at_ns)) if from == pid => {
-            let age_ns = now_ns.saturating_sub(at_ns);
+        Some(h) if h.pid == pid => {
+            let age_ns = now_ns.saturating_sub(h.at_ns);
             let age_ms = u32::try_from(age_ns / 1_000_000).unwrap_or(u32::MAX - 1);
             let state = if age_ns > silent_after_ns {
                 ServiceState::Silent
@@ -54,9 +56,11 @@ pub fn build_report(
     };
     for (slot, view) in report.services.iter_mut().zip(views) {
         let (state, heartbeat_age_ms) = state_of(view, now_ns, silent_after_ns);
+        let own_heartbeat = view.heartbeat.filter(|h| Some(h.pid) == view.pid);
         *slot = ServiceHealth {
             service: view.kind as u8,
             state: state as u8,
+            input_stale: u8::from(own_heartbeat.is_some_and(|h| h.input_stale)),
             pid: view.pid.unwrap_or(0),
             restarts: u32::try_from(view.restarts).unwrap_or(u32::MAX),
             heartbeat_age_ms,
@@ -79,7 +83,11 @@ mod tests {
             kind: ServiceKind::Fusion,
             pid,
             restarts: 2,
-            heartbeat,
+            heartbeat: heartbeat.map(|(pid, at_ns)| HeartbeatSeen {
+                pid,
+                at_ns,
+                input_stale: true,
+            }),
             output_rate_hz: 1000.0,
         }
     }
@@ -120,6 +128,10 @@ mod tests {
         assert_eq!(ServiceKind::from_u8(s.service), Some(ServiceKind::Fusion));
         assert_eq!(ServiceState::from_u8(s.state), Some(ServiceState::Running));
         assert_eq!((s.pid, s.restarts, s.heartbeat_age_ms), (8, 2, 0));
+        assert_eq!(s.input_stale, 1);
+        // A stale flag from a previous incarnation is not carried over.
+        let r = build_report(5, 0, &[view(Some(9), Some((8, 5)))], SILENT_NS);
+        assert_eq!(r.services[0].input_stale, 0);
         assert_eq!(s.output_rate_hz, 1000.0);
     }
 }

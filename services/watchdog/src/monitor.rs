@@ -18,6 +18,16 @@ const TRUTH_RING: usize = 8192;
 /// Topics counted for the status line, in display order.
 pub const COUNTED: [&str; 6] = ["imu", "baro", "mag", "fused", "alt", "nav"];
 
+/// The last heartbeat of one process kind.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HeartbeatSeen {
+    pub pid: u32,
+    /// The sender's CLOCK_MONOTONIC time, ns.
+    pub at_ns: u64,
+    /// The sender said its input is quiet.
+    pub input_stale: bool,
+}
+
 #[derive(Debug, Clone, Copy, Default)]
 pub struct DeviceCounters {
     pub crc_errors: u64,
@@ -46,8 +56,8 @@ pub struct Monitor {
     truth_ring: Box<[Truth]>,
     /// Latest acquisition counters per process id (a restarted acquisition starts from zero).
     acquisition: Vec<(u32, DeviceCounters)>,
-    /// Last heartbeat per [`ServiceKind`]: the sender's pid and its CLOCK_MONOTONIC time, ns.
-    pub heartbeats: [Option<(u32, u64)>; ServiceKind::ALL.len()],
+    /// Last heartbeat per [`ServiceKind`].
+    pub heartbeats: [Option<HeartbeatSeen>; ServiceKind::ALL.len()],
 }
 
 impl Monitor {
@@ -131,7 +141,11 @@ impl Monitor {
         let Some(kind) = ServiceKind::from_u8(h.service) else {
             return;
         };
-        self.heartbeats[kind as usize] = Some((h.pid, h.now_ns));
+        self.heartbeats[kind as usize] = Some(HeartbeatSeen {
+            pid: h.pid,
+            at_ns: h.now_ns,
+            input_stale: h.input_stale != 0,
+        });
         if kind != ServiceKind::Acquisition {
             return;
         }
