@@ -3,10 +3,9 @@
 
 mod common;
 
-use std::process::Stdio;
 use std::time::{Duration, Instant};
 
-use common::{Isolated, PipelineSlot, last_json};
+use common::{Isolated, PipelineSlot, last_json, spawn_up, stop_up};
 use serde_json::Value;
 
 fn status(ipc: &Isolated) -> Value {
@@ -45,13 +44,10 @@ fn wait_for(ipc: &Isolated, limit: Duration, done: impl Fn(&Value) -> bool) -> V
 fn status_shows_every_process_and_counts_a_restart_after_sigkill() {
     let _slot = PipelineSlot::take();
     let ipc = Isolated::new("status");
-    let up = ipc
-        .command()
-        .args(["up", "--scenario", "static", "--duration", "300", "--json"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("cannot start rins up");
+    let up = spawn_up(
+        &ipc,
+        &["--scenario", "static", "--duration", "300", "--json"],
+    );
     let first = ipc.run(&["echo", "nav", "--count", "1", "--timeout", "120"]);
     assert!(first.status.success());
 
@@ -99,14 +95,8 @@ fn status_shows_every_process_and_counts_a_restart_after_sigkill() {
     let again = ipc.run(&["echo", "nav", "--count", "5", "--timeout", "30"]);
     assert!(again.status.success());
 
-    let pid = libc::pid_t::try_from(up.id()).expect("pid fits pid_t");
-    // SAFETY: sends a signal to our own child process, which has not been reaped yet.
-    assert_eq!(unsafe { libc::kill(pid, libc::SIGTERM) }, 0);
-    let out = up.wait_with_output().expect("rins up did not finish");
-    assert!(out.status.success());
-    let summary = last_json(&out);
+    let summary = stop_up(&ipc, up);
     assert_eq!(summary["restarts"], 1, "{summary}");
-    assert_eq!(ipc.shm_entries(), Vec::<String>::new());
 }
 
 #[test]
@@ -125,13 +115,10 @@ fn status_without_a_pipeline_fails_naming_the_prefix() {
 fn a_stopped_service_is_seen_silent_killed_and_restarted() {
     let _slot = PipelineSlot::take();
     let ipc = Isolated::new("hang");
-    let up = ipc
-        .command()
-        .args(["up", "--scenario", "static", "--duration", "300", "--json"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("cannot start rins up");
+    let up = spawn_up(
+        &ipc,
+        &["--scenario", "static", "--duration", "300", "--json"],
+    );
     let report = wait_for(&ipc, Duration::from_secs(60), |r| {
         service(r, "navigator")["state"] == "running"
     });
@@ -155,26 +142,17 @@ fn a_stopped_service_is_seen_silent_killed_and_restarted() {
     let again = ipc.run(&["echo", "nav", "--count", "5", "--timeout", "30"]);
     assert!(again.status.success());
 
-    let up_pid = libc::pid_t::try_from(up.id()).expect("pid fits pid_t");
-    // SAFETY: sends a signal to our own child process, which has not been reaped yet.
-    assert_eq!(unsafe { libc::kill(up_pid, libc::SIGTERM) }, 0);
-    let out = up.wait_with_output().expect("rins up did not finish");
-    assert!(out.status.success());
-    assert_eq!(last_json(&out)["restarts"], 1);
-    assert_eq!(ipc.shm_entries(), Vec::<String>::new());
+    assert_eq!(stop_up(&ipc, up)["restarts"], 1);
 }
 
 #[test]
 fn fusion_says_when_acquisition_goes_quiet_and_when_it_is_back() {
     let _slot = PipelineSlot::take();
     let ipc = Isolated::new("stale");
-    let up = ipc
-        .command()
-        .args(["up", "--scenario", "static", "--duration", "300", "--json"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("cannot start rins up");
+    let up = spawn_up(
+        &ipc,
+        &["--scenario", "static", "--duration", "300", "--json"],
+    );
     let report = wait_for(&ipc, Duration::from_secs(60), |r| {
         service(r, "acquisition")["state"] == "running"
             && service(r, "fusion")["state"] == "running"
@@ -207,10 +185,5 @@ fn fusion_says_when_acquisition_goes_quiet_and_when_it_is_back() {
         .max();
     assert!(fusion_episodes.is_some_and(|n| n >= 1), "{text}");
 
-    let up_pid = libc::pid_t::try_from(up.id()).expect("pid fits pid_t");
-    // SAFETY: sends a signal to our own child process, which has not been reaped yet.
-    assert_eq!(unsafe { libc::kill(up_pid, libc::SIGTERM) }, 0);
-    let out = up.wait_with_output().expect("rins up did not finish");
-    assert!(out.status.success());
-    assert_eq!(ipc.shm_entries(), Vec::<String>::new());
+    stop_up(&ipc, up);
 }

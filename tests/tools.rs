@@ -2,21 +2,16 @@
 
 mod common;
 
-use std::process::Stdio;
-
-use common::{Isolated, last_json};
+use common::{Isolated, last_json, spawn_up, stop_up};
 
 #[test]
 fn echo_and_latency_read_a_running_pipeline() {
     let ipc = Isolated::new("tools");
-    let up = ipc
-        .command()
-        // Long enough for any machine load; the test stops it itself below.
-        .args(["up", "--scenario", "static", "--duration", "300", "--json"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("cannot start rins up");
+    // Long enough for any machine load; the test stops it itself below.
+    let up = spawn_up(
+        &ipc,
+        &["--scenario", "static", "--duration", "300", "--json"],
+    );
 
     // Waits until the pipeline publishes: the navigator's first samples.
     let echo = ipc.run(&["echo", "nav", "--count", "5", "--csv", "--timeout", "120"]);
@@ -74,14 +69,8 @@ fn echo_and_latency_read_a_running_pipeline() {
     assert!(p50 > 0.0 && p50 <= p99 && p99 <= max, "{end_to_end}");
 
     // SIGTERM is how an operator stops the pipeline: it must shut down cleanly and still report.
-    let pid = libc::pid_t::try_from(up.id()).expect("pid fits pid_t");
-    // SAFETY: sends a signal to our own child process, which has not been reaped yet.
-    assert_eq!(unsafe { libc::kill(pid, libc::SIGTERM) }, 0);
-    let out = up.wait_with_output().expect("rins up did not finish");
-    assert!(out.status.success());
-    let summary = last_json(&out);
+    let summary = stop_up(&ipc, up);
     assert_eq!(summary["dropped"], 0, "{summary}");
-    assert_eq!(ipc.shm_entries(), Vec::<String>::new());
 }
 
 #[test]

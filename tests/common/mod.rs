@@ -145,3 +145,26 @@ pub fn quadrotor_data_dir() -> Option<PathBuf> {
         None
     }
 }
+
+/// `rins up ARGS` started in the background on `ipc`'s namespace, stdout piped for its summary.
+pub fn spawn_up(ipc: &Isolated, args: &[&str]) -> std::process::Child {
+    ipc.command()
+        .arg("up")
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("cannot start rins up")
+}
+
+/// Stops a pipeline from [`spawn_up`] with SIGTERM, as an operator does, checks that it ended
+/// cleanly with no shared memory left, and returns its JSON summary.
+pub fn stop_up(ipc: &Isolated, up: std::process::Child) -> serde_json::Value {
+    let pid = libc::pid_t::try_from(up.id()).expect("pid fits pid_t");
+    // SAFETY: sends a signal to our own child process, which has not been reaped yet.
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGTERM) }, 0);
+    let out = up.wait_with_output().expect("rins up did not finish");
+    assert!(out.status.success(), "rins up: {:?}", out.status);
+    assert_eq!(ipc.shm_entries(), Vec::<String>::new());
+    last_json(&out)
+}
