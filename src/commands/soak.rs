@@ -2,7 +2,6 @@
 //! service with SIGKILL every few seconds, while watching the navigation output: how many samples
 //! never arrived (gaps in the frame sequence) and the longest silence. Prints a JSON summary.
 
-use std::io::Read;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -113,6 +112,25 @@ pub fn run(args: &SoakArgs) -> Result<()> {
         .stderr(Stdio::null())
         .spawn()
         .context("cannot start rins up")?;
+    // The watchdog's stdout: a status line per second, the JSON summary last. Read on a thread so
+    // the pipe never fills.
+    let (lines_tx, lines) = std::sync::mpsc::channel::<String>();
+    let stdout = up.stdout.take().context("rins up has no stdout")?;
+    let reader = std::thread::spawn(move || {
+        for line in std::io::BufRead::lines(std::io::BufReader::new(stdout)).map_while(Result::ok) {
+            if lines_tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    // Join the deployment only once the watchdog runs: it refuses to start while another process
+    // holds a node on the prefix, and this one would be such a process.
+    if lines.recv_timeout(Duration::from_secs(120)).is_err() {
+        // SAFETY: SIGTERM to our own child, not reaped yet.
+        unsafe { libc::kill(up.id() as libc::pid_t, libc::SIGTERM) };
+        let status = up.wait()?;
+        bail!("rins up printed nothing within 120 s ({status})");
+    }
     let settings = IpcSettings::from_env();
     let node = create_node(&format!("soak-{}", std::process::id()), &settings)?;
     let nav_in = TopicSubscriber::<NavState>::new(&node, names::NAV_STATE)?;
@@ -178,15 +196,12 @@ pub fn run(args: &SoakArgs) -> Result<()> {
     drop(node);
     // SAFETY: SIGTERM to our own child, not reaped yet: the watchdog stops everything cleanly.
     unsafe { libc::kill(up.id() as libc::pid_t, libc::SIGTERM) };
-    let mut out = String::new();
-    if let Some(mut stdout) = up.stdout.take() {
-        stdout.read_to_string(&mut out)?;
-    }
     let status = up.wait()?;
-    let up_summary: serde_json::Value = out
-        .lines()
+    let _ = reader.join();
+    let up_summary: serde_json::Value = lines
+        .try_iter()
         .last()
-        .and_then(|l| serde_json::from_str(l).ok())
+        .and_then(|l| serde_json::from_str(&l).ok())
         .with_context(|| format!("rins up ended ({status}) without its JSON summary"))?;
     let number = |key: &str| up_summary[key].as_u64().unwrap_or(0);
     let summary = SoakSummary {
