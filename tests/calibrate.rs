@@ -262,15 +262,7 @@ fn echo_raw_mag_csv_gives_the_same_fit_and_a_pasteable_fragment() {
 }
 
 fn fails_with(args: &[&str], expected: &[&str]) {
-    let out = Isolated::new("calibrate").run(args);
-    assert!(!out.status.success(), "{args:?} should fail");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    for e in expected {
-        assert!(
-            stderr.contains(e),
-            "{args:?}: stderr lacks {e:?}:\n{stderr}"
-        );
-    }
+    common::fails_with("calibrate", args, expected);
 }
 
 #[test]

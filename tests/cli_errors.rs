@@ -3,23 +3,14 @@
 
 mod common;
 
-use common::{Isolated, TempFile};
+use common::TempFile;
 
 fn config_file(text: &str) -> TempFile {
     TempFile::new("config", "toml", text)
 }
 
 fn fails_with(args: &[&str], expected: &[&str]) {
-    let ipc = Isolated::new("cli");
-    let out = ipc.run(args);
-    assert!(!out.status.success(), "{args:?} should fail");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    for e in expected {
-        assert!(
-            stderr.contains(e),
-            "{args:?}: stderr lacks {e:?}:\n{stderr}"
-        );
-    }
+    common::fails_with("cli", args, expected);
 }
 
 #[test]

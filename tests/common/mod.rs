@@ -168,3 +168,17 @@ pub fn stop_up(ipc: &Isolated, up: std::process::Child) -> serde_json::Value {
     assert_eq!(ipc.shm_entries(), Vec::<String>::new());
     last_json(&out)
 }
+
+/// Runs `rins ARGS` on a private namespace and checks that it fails with every `expected`
+/// fragment in its stderr.
+pub fn fails_with(test: &str, args: &[&str], expected: &[&str]) {
+    let out = Isolated::new(test).run(args);
+    assert!(!out.status.success(), "{args:?} should fail");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    for e in expected {
+        assert!(
+            stderr.contains(e),
+            "{args:?}: stderr lacks {e:?}:\n{stderr}"
+        );
+    }
+}
