@@ -30,10 +30,21 @@ const LOOP_PERIOD: Duration = Duration::from_millis(1);
 
 fn ensure_no_live_deployment(settings: &IpcSettings) -> Result<()> {
     let config = settings.iceoryx_config()?;
-    let mut alive = 0;
+    let (mut alive, mut tools) = (0, 0);
     iceoryx2::prelude::Node::<iceoryx2::prelude::ipc::Service>::list(&config, |state| {
-        if let iceoryx2::prelude::NodeState::Alive(_) = state {
-            alive += 1;
+        // Only the pipeline's own processes make a deployment; a tool (`rins echo`, `status`,
+        // `soak`, …) waiting on the prefix for the pipeline to start does not.
+        if let iceoryx2::prelude::NodeState::Alive(view) = &state {
+            use iceoryx2::node::NodeView;
+            let service = view
+                .details()
+                .as_ref()
+                .is_some_and(|d| ipc_types::ServiceKind::from_name(d.name().as_str()).is_some());
+            if service {
+                alive += 1;
+            } else {
+                tools += 1;
+            }
         }
         iceoryx2::prelude::CallbackProgression::Continue
     })
@@ -45,10 +56,22 @@ fn ensure_no_live_deployment(settings: &IpcSettings) -> Result<()> {
             rins_runtime::ipc::PREFIX_ENV
         );
     }
-    // Nothing alive: whatever is left belongs to a deployment that died; start clean.
-    let removed = shm_cleanup::remove_all(settings);
-    if removed > 0 {
-        tracing::info!(removed, "removed shared memory left by an earlier run");
+    // No pipeline alive: whatever is left belongs to a deployment that died; start clean. While a
+    // tool is already waiting on the prefix its shared memory must stay, so only the resources of
+    // dead nodes go then.
+    if tools == 0 {
+        let removed = shm_cleanup::remove_all(settings);
+        if removed > 0 {
+            tracing::info!(removed, "removed shared memory left by an earlier run");
+        }
+    } else {
+        let removed = rins_runtime::ipc::remove_dead_nodes(settings)?;
+        if removed > 0 {
+            tracing::info!(
+                removed,
+                "removed the resources of dead nodes left by an earlier run"
+            );
+        }
     }
     Ok(())
 }

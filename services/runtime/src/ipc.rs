@@ -79,7 +79,6 @@ fn install_global_config(settings: &IpcSettings, config: &Config) -> Result<()> 
     Ok(())
 }
 
-/// Creates this process's node. Signal handling is left to [`crate::shutdown::Shutdown`].
 /// Removes the shared memory and other resources of every dead node of this deployment (a
 /// process that was killed without dropping its node); returns how many nodes were cleaned.
 pub fn remove_dead_nodes(settings: &IpcSettings) -> Result<usize> {
@@ -97,17 +96,43 @@ pub fn remove_dead_nodes(settings: &IpcSettings) -> Result<usize> {
     Ok(removed)
 }
 
+/// Creates this process's node. Signal handling is left to [`crate::shutdown::Shutdown`].
 pub fn create_node(name: &str, settings: &IpcSettings) -> Result<IpcNode> {
     let config = settings.iceoryx_config()?;
-    install_global_config(settings, &config)?;
     let node_name = NodeName::new(name).map_err(|e| anyhow!("node name {name:?}: {e:?}"))?;
-    NodeBuilder::new()
-        .name(&node_name)
-        .config(&config)
-        .signal_handling_mode(SignalHandlingMode::Disabled)
-        .create::<ipc::Service>()
-        .map_err(|e| anyhow!("cannot create iceoryx2 node {name:?}: {e:?}"))
+    // Creating a node also cleans up dead nodes, and so does the watchdog after a child died:
+    // when two processes clean up the same dead node at the same moment, one of them can fail
+    // (an internal error, or files of the root vanishing under it). A few short retries let the
+    // other finish.
+    let mut attempt = 0;
+    loop {
+        let result = install_global_config(settings, &config).and_then(|()| {
+            NodeBuilder::new()
+                .name(&node_name)
+                .config(&config)
+                .signal_handling_mode(SignalHandlingMode::Disabled)
+                .create::<ipc::Service>()
+                .map_err(|e| anyhow!("{e:?}"))
+        });
+        match result {
+            Ok(node) => return Ok(node),
+            Err(e) if attempt < NODE_CREATE_RETRIES => {
+                attempt += 1;
+                tracing::debug!(node = name, error = %e, attempt, "node creation failed; retrying");
+                std::thread::sleep(NODE_CREATE_RETRY_DELAY);
+            }
+            Err(e) => {
+                return Err(anyhow!(
+                    "cannot create iceoryx2 node {name:?} (after {attempt} retries): {e}"
+                ));
+            }
+        }
+    }
 }
+
+/// Retries of a node creation that failed, and the pause before each.
+const NODE_CREATE_RETRIES: u32 = 5;
+const NODE_CREATE_RETRY_DELAY: Duration = Duration::from_millis(20);
 
 /// Queue depth of every subscriber: a consumer may sleep up to this many samples of a 1 kHz topic
 /// (plus margin at 8 kHz) before the oldest is overwritten.
