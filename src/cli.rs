@@ -243,7 +243,8 @@ pub struct UpArgs {
 #[derive(Debug, Args, Default)]
 pub struct FaultArgs {
     /// Apply a fault at a device time (s since the simulator started): CHANNEL:KIND[=PARAM]@TIME,
-    /// e.g. gyro2:dead@5s, accel1:bias=0.5@3.2s, gyro0:noise=10@2s. Repeatable.
+    /// e.g. gyro2:dead@5s, accel1:bias=0.5@3.2s, gyro0:noise=10@2s; or unplug the serial device
+    /// for SECONDS: disconnect=SECONDS@TIME, e.g. disconnect=1.5@5s. Repeatable.
     #[arg(long = "inject", value_name = "SPEC")]
     pub inject: Vec<String>,
     /// Scenario file of timed faults: [[fault]] tables with channel, kind, at_s and optional param.
@@ -259,14 +260,18 @@ impl FaultArgs {
 
 #[derive(Debug, Args)]
 pub struct InjectArgs {
-    /// Channel: gyro or accel followed by its 0-based index, e.g. gyro2, accel0.
+    /// Channel: gyro or accel followed by its 0-based index, e.g. gyro2, accel0; or `disconnect`
+    /// to unplug the whole serial device for --duration seconds.
     pub channel: String,
     /// dead | stuck | bias | ramp | noise | saturate | intermittent | clear.
-    pub fault: String,
+    pub fault: Option<String>,
     /// bias: STEP (rad/s, m/s²); ramp: RATE (per s); noise: FACTOR (>= 1, times the configured
     /// white noise); intermittent: PERIOD_S (default 0.2, dead for the first half).
     #[arg(allow_negative_numbers = true)]
     pub arg: Option<String>,
+    /// disconnect: seconds the device stays unplugged (> 0, <= 3600); frames of that time are lost.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    pub duration: Option<String>,
 }
 
 #[derive(Debug, Args)]

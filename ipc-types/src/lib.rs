@@ -11,7 +11,7 @@ use serde::Serialize;
 pub mod names;
 
 /// Version of every payload layout in this crate. Bump it on any layout change.
-pub const PAYLOAD_VERSION: u16 = 3;
+pub const PAYLOAD_VERSION: u16 = 4;
 
 /// Up to this many single-axis channels per sensor type (gyro, accelerometer).
 pub const MAX_CHANNELS: usize = 16;
@@ -379,7 +379,8 @@ pub struct NavState {
     pub version: u16,
     /// [`NavMode`] as u8.
     pub mode: u8,
-    pub _pad: [u8; 1],
+    /// Navigator lane that computed this solution (0 = primary, 1 = hot standby).
+    pub lane: u8,
     /// Aiding sources used in this solution, bits of [`aiding`].
     pub aiding: u32,
     pub header: Header,
@@ -396,6 +397,15 @@ pub struct NavState {
     pub aiding_accepted: [u32; AIDING_SOURCES],
     /// Updates rejected by the innovation gate per aiding source since alignment.
     pub aiding_rejected: [u32; AIDING_SOURCES],
+    /// `header.origin_seq` of the first sample of this solution (alignment completed or state taken
+    /// over from the other lane); 0 while aligning. A lane selector trusts a solution only once it
+    /// has run for a while, so that a lane that just reset is not chosen.
+    pub solution_start_seq: u64,
+    /// Estimated gyro bias (body, rad/s) and accelerometer bias (body, m/s²): with the attitude,
+    /// velocity, position and covariance they are the whole filter state, so that a restarted lane
+    /// can take over its peer's solution in flight.
+    pub gyro_bias_rps: [f64; 3],
+    pub accel_bias_mps2: [f64; 3],
 }
 
 impl Default for NavState {
@@ -403,7 +413,7 @@ impl Default for NavState {
         Self {
             version: PAYLOAD_VERSION,
             mode: NavMode::Aligning as u8,
-            _pad: [0],
+            lane: 0,
             aiding: 0,
             header: Header::default(),
             quaternion: [1.0, 0.0, 0.0, 0.0],
@@ -414,6 +424,9 @@ impl Default for NavState {
             covariance_diag: [0.0; NAV_STATES],
             aiding_accepted: [0; AIDING_SOURCES],
             aiding_rejected: [0; AIDING_SOURCES],
+            solution_start_seq: 0,
+            gyro_bias_rps: [0.0; 3],
+            accel_bias_mps2: [0.0; 3],
         }
     }
 }
@@ -493,10 +506,14 @@ pub enum SimFault {
     Saturate = 6,
     /// The channel drops out for the first half of every `param` seconds.
     Intermittent = 7,
+    /// The whole serial line goes away for `param` seconds, like a pulled cable: the device's
+    /// port vanishes and comes back as a new one. Addresses no channel: [`SimControl::sensor`] is
+    /// [`SimControl::WHOLE_DEVICE`] and `channel` 0.
+    Disconnect = 8,
 }
 
 impl SimFault {
-    pub const ALL: [SimFault; 8] = [
+    pub const ALL: [SimFault; 9] = [
         SimFault::Clear,
         SimFault::Dead,
         SimFault::Stuck,
@@ -505,6 +522,7 @@ impl SimFault {
         SimFault::Noise,
         SimFault::Saturate,
         SimFault::Intermittent,
+        SimFault::Disconnect,
     ];
 
     pub fn from_u8(v: u8) -> Option<Self> {
@@ -521,6 +539,7 @@ impl SimFault {
             SimFault::Noise => "noise",
             SimFault::Saturate => "saturate",
             SimFault::Intermittent => "intermittent",
+            SimFault::Disconnect => "disconnect",
         }
     }
 
@@ -543,6 +562,12 @@ pub struct SimControl {
     pub _pad: [u8; 3],
     /// Fault parameter, see [`SimFault`].
     pub param: f64,
+}
+
+impl SimControl {
+    /// [`SimControl::sensor`] of a fault of the whole device ([`SimFault::Disconnect`]): no
+    /// [`SensorType`], so that consumers of channel faults pass it by.
+    pub const WHOLE_DEVICE: u8 = u8::MAX;
 }
 
 /// What the simulator did with one [`SimControl`] command ([`FaultApplied::outcome`]).
@@ -625,16 +650,23 @@ pub enum ServiceKind {
     Altimeter = 3,
     Navigator = 4,
     Watchdog = 5,
+    /// The hot-standby navigator lane (lane 1).
+    NavigatorStandby = 6,
 }
 
 impl ServiceKind {
-    pub const ALL: [ServiceKind; 6] = [
+    /// The navigator process of each lane, [`NavState::lane`].
+    pub const NAVIGATOR_LANES: [ServiceKind; 2] =
+        [ServiceKind::Navigator, ServiceKind::NavigatorStandby];
+
+    pub const ALL: [ServiceKind; 7] = [
         ServiceKind::Simulator,
         ServiceKind::Acquisition,
         ServiceKind::Fusion,
         ServiceKind::Altimeter,
         ServiceKind::Navigator,
         ServiceKind::Watchdog,
+        ServiceKind::NavigatorStandby,
     ];
 
     pub fn name(self) -> &'static str {
@@ -645,6 +677,7 @@ impl ServiceKind {
             ServiceKind::Altimeter => "altimeter",
             ServiceKind::Navigator => "navigator",
             ServiceKind::Watchdog => "watchdog",
+            ServiceKind::NavigatorStandby => "navigator-standby",
         }
     }
 

@@ -7,6 +7,10 @@ pub const RAW_AUX: &str = "rins/raw/aux";
 pub const FUSED_IMU: &str = "rins/fused/imu";
 pub const ALTITUDE: &str = "rins/altitude";
 pub const NAV_STATE: &str = "rins/nav/state";
+/// Output topic of each navigator lane: lane 0 (primary) publishes on [`NAV_STATE`], so a
+/// single-lane deployment needs nothing else; lane 1 is the hot standby. Consumers that want the
+/// contiguous stream read both through the runtime's lane selector.
+pub const NAV_LANES: [&str; 2] = [NAV_STATE, "rins/nav/state/standby"];
 pub const TRUTH: &str = "rins/sim/truth";
 /// Each process's once-a-second heartbeat with its counters ([`crate::Health`]).
 pub const HEARTBEAT: &str = "rins/heartbeat";

@@ -8,7 +8,8 @@ use ipc_types::{
     Altitude, FusedImu, Health, HealthReport, NavState, RawAux, RawBaro, RawImu, RawMag, Truth,
     names,
 };
-use rins_runtime::ipc::{IpcSettings, TopicSubscriber, create_node};
+use rins_runtime::ipc::{IpcNode, IpcSettings, SampleSource, TopicSubscriber, create_node};
+use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::shutdown::Shutdown;
 use serde::Serialize;
 use serde_json::Value;
@@ -46,12 +47,53 @@ struct EchoOptions {
 
 fn echo_topic<T>(name: &'static str, opts: EchoOptions) -> Result<()>
 where
-    T: std::fmt::Debug + Copy + Serialize + iceoryx2::prelude::ZeroCopySend + 'static,
+    T: std::fmt::Debug + Copy + Serialize + ReceivedAt + iceoryx2::prelude::ZeroCopySend + 'static,
 {
+    echo_from(name, opts, |node| TopicSubscriber::<T>::new(node, name))
+}
+
+/// When a sample's originating frame was received (CLOCK_MONOTONIC ns), for payloads that say.
+trait ReceivedAt {
+    fn received_ns(&self) -> Option<u64>;
+}
+
+macro_rules! received_at {
+    (with header: $($t:ty),*; without: $($u:ty),*) => {
+        $(impl ReceivedAt for $t {
+            fn received_ns(&self) -> Option<u64> {
+                Some(self.header.origin_rx_ns)
+            }
+        })*
+        $(impl ReceivedAt for $u {
+            fn received_ns(&self) -> Option<u64> {
+                None
+            }
+        })*
+    };
+}
+
+received_at!(
+    with header: RawImu, RawBaro, RawMag, RawAux, FusedImu, Altitude, NavState;
+    // Truth comes from the simulator, not from a received frame: no receive time.
+    without: Truth, Health, HealthReport
+);
+
+/// Prints what `open` yields, a topic or the merged navigation stream. Samples from before the
+/// start (a topic's history, kept for restarted services) are skipped: echo shows what comes.
+fn echo_from<T, S>(
+    name: &'static str,
+    opts: EchoOptions,
+    open: impl FnOnce(&IpcNode) -> Result<S>,
+) -> Result<()>
+where
+    T: Serialize + ReceivedAt,
+    S: SampleSource<T>,
+{
+    let started_ns = rins_runtime::clock::monotonic_ns();
     let shutdown = Shutdown::install()?;
     let settings = IpcSettings::from_env();
     let node = create_node(&format!("echo-{}", std::process::id()), &settings)?;
-    let sub = TopicSubscriber::<T>::new(&node, name)?;
+    let mut sub = open(&node)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     let mut printed = 0u64;
@@ -74,6 +116,9 @@ where
         }
         sub.wait(Duration::from_millis(100))?;
         while let Some(sample) = sub.receive()? {
+            if sample.received_ns().is_some_and(|t| t < started_ns) {
+                continue;
+            }
             last_sample = Instant::now();
             let value = serde_json::to_value(sample)?;
             if csv {
@@ -123,7 +168,8 @@ pub fn run(topic: &str, count: Option<u64>, csv: bool, timeout_s: f64) -> Result
         names::RAW_AUX => echo_topic::<RawAux>(names::RAW_AUX, opts),
         names::FUSED_IMU => echo_topic::<FusedImu>(names::FUSED_IMU, opts),
         names::ALTITUDE => echo_topic::<Altitude>(names::ALTITUDE, opts),
-        names::NAV_STATE => echo_topic::<NavState>(names::NAV_STATE, opts),
+        // The stream consumers see: both navigator lanes through the lane selector.
+        names::NAV_STATE => echo_from::<NavState, _>(names::NAV_STATE, opts, NavSubscriber::new),
         names::TRUTH => echo_topic::<Truth>(names::TRUTH, opts),
         names::HEARTBEAT => echo_topic::<Health>(names::HEARTBEAT, opts),
         _ => echo_topic::<HealthReport>(names::HEALTH, opts),

@@ -17,7 +17,7 @@ pub fn channel_counts(cfg: &RinsConfig) -> Result<(usize, usize)> {
 /// Every scheduled fault of `args`, each checked against a block of `n_gyro` gyros and
 /// `n_accel` accelerometers; errors name the option or file and the offending token.
 pub fn schedule(args: &FaultArgs, n_gyro: usize, n_accel: usize) -> Result<Vec<ScheduledFault>> {
-    let fitted = |f: &ScheduledFault| f.command.channel.check_fitted(n_gyro, n_accel);
+    let fitted = |f: &ScheduledFault| f.command.check_fitted(n_gyro, n_accel);
     let mut faults = Vec::new();
     for spec in &args.inject {
         let fault = ScheduledFault::parse(spec)

@@ -1,12 +1,13 @@
-//! `rins inject CHANNEL FAULT [ARG]`: apply a fault to one channel of the running simulator and
-//! wait for the simulator to confirm the device time it took effect.
+//! `rins inject CHANNEL FAULT [ARG]`: apply a fault to one channel of the running simulator (or
+//! `rins inject disconnect --duration S`: unplug its serial device) and wait for the simulator to
+//! confirm the device time it took effect.
 
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow, bail};
 use ipc_types::{FaultApplied, FaultOutcome, SimControl, names};
 use rins_runtime::ipc::{IpcSettings, TopicSubscriber, create_node};
-use rins_sim::fault_command::FaultCommand;
+use rins_sim::sim_command::SimCommand;
 
 use crate::cli::InjectArgs;
 use crate::commands::control;
@@ -25,8 +26,13 @@ fn answers(event: &FaultApplied, sent: &SimControl) -> bool {
 }
 
 pub fn run(args: &InjectArgs) -> Result<()> {
-    let command = FaultCommand::parse(&args.channel, &args.fault, args.arg.as_deref())
-        .map_err(|e| anyhow!("{e}"))?;
+    let command = SimCommand::parse_inject(
+        &args.channel,
+        args.fault.as_deref(),
+        args.arg.as_deref(),
+        args.duration.as_deref(),
+    )
+    .map_err(|e| anyhow!("{e}"))?;
     let settings = IpcSettings::from_env();
     let node = create_node(&format!("inject-{}", std::process::id()), &settings)?;
     // Subscribe to the confirmations before sending, so the answer cannot be missed.
@@ -56,7 +62,7 @@ pub fn run(args: &InjectArgs) -> Result<()> {
                 }
                 Some(FaultOutcome::NoSuchChannel) => bail!(
                     "channel {:?}: the simulated sensor block has no such channel",
-                    command.channel.to_string()
+                    command.target()
                 ),
                 Some(FaultOutcome::InvalidParameter) => {
                     bail!("{command}: the simulator rejected the parameter")

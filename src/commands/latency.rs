@@ -4,9 +4,10 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Result, bail};
 use hdrhistogram::Histogram;
-use ipc_types::{Altitude, Header, NavState, Stage, names};
+use ipc_types::{Altitude, Header, Stage, names};
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{IpcSettings, TopicSubscriber, create_node};
+use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::shutdown::Shutdown;
 use serde::Serialize;
 
@@ -67,7 +68,8 @@ pub fn run(seconds: f64, json: bool) -> Result<()> {
     let shutdown = Shutdown::install()?;
     let settings = IpcSettings::from_env();
     let node = create_node(&format!("latency-{}", std::process::id()), &settings)?;
-    let nav = TopicSubscriber::<NavState>::new(&node, names::NAV_STATE)?;
+    // The stream consumers see: both navigator lanes through the lane selector.
+    let mut nav = NavSubscriber::new(&node)?;
     let alt = TopicSubscriber::<Altitude>::new(&node, names::ALTITUDE)?;
     let mut hops = [
         Hop::new("serial rx -> acquisition published")?,

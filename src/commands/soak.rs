@@ -1,15 +1,21 @@
 //! `rins soak --minutes N`: runs the whole pipeline (`rins up`) and kills a randomly chosen
-//! service with SIGKILL every few seconds, while watching the navigation output: how many samples
-//! never arrived (gaps in the frame sequence) and the longest silence. Prints a JSON summary.
+//! service with SIGKILL every few seconds, while watching the navigation output as consumers see it
+//! (both navigator lanes through the lane selector): how many samples never arrived (gaps in the
+//! frame sequence), the longest silence, and samples that were not navigating. Prints a JSON summary.
+//!
+//! Faults come one at a time, as the redundancy is designed for: a kill waits until every service
+//! is running again and, with two navigator lanes, until both lanes have settled solutions.
 
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
-use ipc_types::{HealthReport, NavState, ServiceKind, ServiceState, names};
+use ipc_types::{HealthReport, NavMode, ServiceKind, ServiceState, names};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rins_runtime::ipc::{IpcSettings, TopicSubscriber, create_node};
+use rins_runtime::lane_selector::{SelectorConfig, trusted};
+use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::shutdown::Shutdown;
 use serde::Serialize;
 
@@ -20,11 +26,12 @@ use crate::cli::SoakArgs;
 const SETTLE: Duration = Duration::from_secs(3);
 
 /// Services the soak kills (the watchdog and the simulator are the test harness here).
-const VICTIMS: [ServiceKind; 4] = [
+const VICTIMS: [ServiceKind; 5] = [
     ServiceKind::Acquisition,
     ServiceKind::Fusion,
     ServiceKind::Altimeter,
     ServiceKind::Navigator,
+    ServiceKind::NavigatorStandby,
 ];
 
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
@@ -40,6 +47,14 @@ pub struct SoakSummary {
     pub lost_nav_samples: u64,
     /// Longest wall-clock interval between two navigation samples, ms.
     pub max_gap_ms: f64,
+    /// Samples after the first navigating one that were aligning again (a lane that could not
+    /// recover its solution).
+    pub not_navigating_samples: u64,
+    /// Lane changes of the selector, and samples it took from the other lane to fill a hole.
+    pub lane_switches: u64,
+    pub lane_filled: u64,
+    /// Kills put off because the pipeline had not recovered from the previous one yet.
+    pub kills_deferred: u64,
     /// Shared-memory entries left after the pipeline stopped (from the watchdog's summary).
     pub shm_leaked: u64,
 }
@@ -52,9 +67,19 @@ struct NavWatch {
     samples: u64,
     lost: u64,
     max_gap: Duration,
+    navigated: bool,
+    not_navigating: u64,
 }
 
 impl NavWatch {
+    fn observe_mode(&mut self, mode: NavMode) {
+        if mode == NavMode::Aligning {
+            self.not_navigating += u64::from(self.navigated);
+        } else {
+            self.navigated = true;
+        }
+    }
+
     fn observe(&mut self, seq: u64, at: Instant) {
         if let Some(last) = self.last_seq
             && seq > last
@@ -68,6 +93,33 @@ impl NavWatch {
         self.last_at = Some(at);
         self.samples += 1;
     }
+}
+
+/// How often a deferred kill looks again whether the pipeline recovered.
+const RECHECK: Duration = Duration::from_millis(200);
+
+/// A lane whose newest sample is this far behind the output is not publishing (killed, restarting).
+const FRESH_SAMPLES: u64 = 100;
+
+/// Every supervised process running, and every navigator lane that publishes holds a settled
+/// solution: the pipeline is back to full redundancy and can take the next fault.
+fn recovered(report: Option<&HealthReport>, nav: &NavSubscriber, newest_seq: u64) -> bool {
+    let Some(report) = report else {
+        return false;
+    };
+    let count = usize::from(report.count).min(report.services.len());
+    let all_running = report.services[..count]
+        .iter()
+        .all(|s| ServiceState::from_u8(s.state) == Some(ServiceState::Running));
+    let settle = SelectorConfig::default().settle;
+    let lanes_settled = (0..ServiceKind::NAVIGATOR_LANES.len())
+        .filter(|&lane| nav.lane_totals()[lane] > 0)
+        .all(|lane| {
+            nav.lane_latest(lane).is_some_and(|s| {
+                trusted(s, settle) && s.header.origin_seq + FRESH_SAMPLES >= newest_seq
+            })
+        });
+    all_running && lanes_settled
 }
 
 /// The pid of `kind` when the report shows it running.
@@ -133,12 +185,13 @@ pub fn run(args: &SoakArgs) -> Result<()> {
     }
     let settings = IpcSettings::from_env();
     let node = create_node(&format!("soak-{}", std::process::id()), &settings)?;
-    let nav_in = TopicSubscriber::<NavState>::new(&node, names::NAV_STATE)?;
+    let mut nav_in = NavSubscriber::new(&node)?;
     let health_in = TopicSubscriber::<HealthReport>::new(&node, names::HEALTH)?;
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
     let mut nav = NavWatch::default();
     let mut report: Option<HealthReport> = None;
     let mut kills = [0u64; VICTIMS.len()];
+    let mut deferred = 0u64;
 
     // Wait for the pipeline to navigate before the clock starts.
     let ready_by = Instant::now() + Duration::from_secs(120);
@@ -149,6 +202,7 @@ pub fn run(args: &SoakArgs) -> Result<()> {
         nav_in.wait(Duration::from_millis(100))?;
         while let Some(n) = nav_in.receive()? {
             nav.observe(n.header.origin_seq, Instant::now());
+            nav.observe_mode(NavMode::from_u8(n.mode));
         }
     }
     let start = Instant::now();
@@ -160,6 +214,7 @@ pub fn run(args: &SoakArgs) -> Result<()> {
         nav_in.wait(Duration::from_millis(5))?;
         while let Some(n) = nav_in.receive()? {
             nav.observe(n.header.origin_seq, Instant::now());
+            nav.observe_mode(NavMode::from_u8(n.mode));
         }
         while let Some(r) = health_in.receive()? {
             report = Some(r);
@@ -167,6 +222,11 @@ pub fn run(args: &SoakArgs) -> Result<()> {
         let now = Instant::now();
         // No kill in the last seconds: every killed service must be back before the summary.
         if now >= next_kill && now + SETTLE < end {
+            if !recovered(report.as_ref(), &nav_in, nav.last_seq.unwrap_or(0)) {
+                deferred += 1;
+                next_kill = now + RECHECK;
+                continue;
+            }
             let i = rng.random_range(0..VICTIMS.len());
             if let Some(pid) = report.as_ref().and_then(|r| running_pid(r, VICTIMS[i])) {
                 // SAFETY: kill(2) on a pid the watchdog reports as one of its running children.
@@ -191,6 +251,7 @@ pub fn run(args: &SoakArgs) -> Result<()> {
             next_progress += Duration::from_secs(10);
         }
     }
+    let (lane_switches, lane_filled) = (nav_in.switches().0, nav_in.filled());
     drop(nav_in);
     drop(health_in);
     drop(node);
@@ -216,6 +277,10 @@ pub fn run(args: &SoakArgs) -> Result<()> {
         nav_samples: nav.samples,
         lost_nav_samples: nav.lost,
         max_gap_ms: nav.max_gap.as_secs_f64() * 1e3,
+        not_navigating_samples: nav.not_navigating,
+        lane_switches,
+        lane_filled,
+        kills_deferred: deferred,
         shm_leaked: number("shm_leaked"),
     };
     println!("{}", serde_json::to_string(&summary)?);

@@ -2,7 +2,7 @@
 //! child processes, restarts children that exit, prints a status line per second, and on shutdown
 //! stops everything and removes the deployment's shared memory.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
@@ -138,9 +138,11 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     let settings = IpcSettings::from_env();
     ensure_no_live_deployment(&settings)?;
 
-    let run_dir = PathBuf::from(&settings.root).join(format!("{}run", settings.prefix));
+    let run_dir = settings.run_dir();
     std::fs::create_dir_all(&run_dir)
         .with_context(|| format!("cannot create {}", run_dir.display()))?;
+    // A new deployment numbers its frames afresh: the last one's resume point does not apply.
+    let _ = std::fs::remove_file(rins_acquisition::resume_file::path_for(&settings));
     let simulate = cfg.acquisition.port.is_none();
     let link = run_dir.join("sim-tty");
     if simulate {

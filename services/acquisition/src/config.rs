@@ -10,8 +10,9 @@ pub struct AcquisitionConfig {
     pub baud: u32,
     /// Longest a read blocks before the loop looks at shutdown and heartbeats again.
     pub read_timeout_ms: u64,
-    /// First delay before reopening a lost port; doubles up to `reconnect_max_ms`.
+    /// First delay before reopening a missing or lost port; doubles up to `reconnect_max_ms`.
     pub reconnect_initial_ms: u64,
+    /// Longest delay between two attempts: a device that comes back is found at most this late.
     pub reconnect_max_ms: u64,
 }
 
@@ -21,8 +22,8 @@ impl Default for AcquisitionConfig {
             port: None,
             baud: 921_600,
             read_timeout_ms: 50,
-            reconnect_initial_ms: 20,
-            reconnect_max_ms: 2_000,
+            reconnect_initial_ms: 10,
+            reconnect_max_ms: 1_000,
         }
     }
 }

@@ -1,4 +1,6 @@
-//! The acquisition process: read the serial port, decode frames, publish raw samples.
+//! The acquisition process: read the serial port, decode frames, publish raw samples. A device that
+//! is missing at start-up or vanishes later (unplugged, re-enumerated) is waited for with
+//! exponential backoff ([`crate::backoff`]); the process never exits because of it.
 
 use std::io::Read;
 use std::time::Duration;
@@ -10,8 +12,11 @@ use rins_runtime::heartbeat::Heartbeat;
 use rins_runtime::ipc::{IpcNode, IpcSettings, TopicPublisher, create_node};
 use rins_runtime::shutdown::Shutdown;
 
+use crate::backoff::Backoff;
 use crate::config::AcquisitionConfig;
-use crate::protocol::{DecodedFrame, Decoder, Payload};
+use crate::presence::{Opened, Presence};
+use crate::protocol::{DecodedFrame, Decoder, FrameType, Payload};
+use crate::resume_file;
 use crate::to_ipc;
 
 struct Publishers {
@@ -43,15 +48,28 @@ impl Publishers {
     }
 }
 
-/// Sleeps `total`, waking early on shutdown.
-fn sleep_unless_shutdown(total: Duration, shutdown: &Shutdown) {
+/// Sleeps `total` between attempts to open the device, waking early on shutdown and keeping the
+/// heartbeat going: a process waiting for its device is not hung, and must not be restarted as if
+/// it were, however long the backoff.
+fn wait_for_retry(
+    total: Duration,
+    shutdown: &Shutdown,
+    heartbeat: &mut Heartbeat,
+    counters: &Health,
+) -> Result<()> {
     let step = Duration::from_millis(10);
     let mut left = total;
     while !left.is_zero() && !shutdown.requested() {
         let d = left.min(step);
         std::thread::sleep(d);
         left -= d;
+        heartbeat.tick(counters)?;
     }
+    Ok(())
+}
+
+fn millis(d: Duration) -> u64 {
+    u64::try_from(d.as_millis()).unwrap_or(u64::MAX)
 }
 
 fn open_port(path: &str, config: &AcquisitionConfig) -> Result<serialport::TTYPort> {
@@ -71,42 +89,89 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
     let publishers = Publishers::new(&node)?;
     let mut heartbeat = Heartbeat::new(&node, ServiceKind::Acquisition)?;
     let mut decoder = Decoder::new();
+    // Continue the numbering of the run this one replaces (see `resume_file`).
+    let resume_path = resume_file::path_for(settings);
+    if let Some(point) = resume_file::load(&resume_path) {
+        decoder.resume_from(&point);
+        tracing::info!(
+            imu_seq = point.seq[FrameType::Imu.index()],
+            "continuing the sequence numbers of the previous run"
+        );
+    }
+    let mut next_save_ns = 0u64;
     let mut counters = Health::default();
-    let initial_backoff = Duration::from_millis(config.reconnect_initial_ms);
-    let max_backoff = Duration::from_millis(config.reconnect_max_ms);
-    let mut backoff = initial_backoff;
+    let mut presence = Presence::new(Backoff::new(
+        Duration::from_millis(config.reconnect_initial_ms),
+        Duration::from_millis(config.reconnect_max_ms),
+    ));
     let mut buf = [0u8; 4096];
-    let mut opened_before = false;
 
     while !shutdown.requested() {
         let mut port = match open_port(&path, config) {
             Ok(port) => port,
             Err(e) => {
-                tracing::warn!(error = %e, retry_ms = backoff.as_millis() as u64, "serial device unavailable");
-                heartbeat.tick(&counters)?;
-                sleep_unless_shutdown(backoff, shutdown);
-                backoff = (backoff * 2).min(max_backoff);
+                let retry = presence.open_failed(monotonic_ns());
+                if retry.first {
+                    let backoff = presence.backoff();
+                    tracing::warn!(
+                        port = %path,
+                        error = %e,
+                        first_retry_ms = millis(backoff.initial()),
+                        max_retry_ms = millis(backoff.max()),
+                        "waiting for serial device {path}: retrying with backoff"
+                    );
+                } else {
+                    tracing::debug!(
+                        port = %path,
+                        error = %e,
+                        retry_ms = millis(retry.delay),
+                        "serial device still unavailable"
+                    );
+                }
+                wait_for_retry(retry.delay, shutdown, &mut heartbeat, &counters)?;
                 continue;
             }
         };
-        if opened_before {
-            counters.reconnects += 1;
+        match presence.opened(monotonic_ns()) {
+            Opened::First { waited, attempts } => {
+                tracing::info!(
+                    port = %path,
+                    waited_ms = millis(waited),
+                    attempts,
+                    "serial device open"
+                );
+            }
+            Opened::Reconnected { away, attempts } => {
+                counters.reconnects = presence.reconnects();
+                tracing::info!(
+                    port = %path,
+                    away_ms = millis(away),
+                    attempts,
+                    reconnects = counters.reconnects,
+                    "serial device back: resynchronising"
+                );
+            }
         }
-        opened_before = true;
-        tracing::info!(port = %path, "serial device open");
-        backoff = initial_backoff;
         // Bytes of a frame cut by the disconnect must not be glued to the next stream.
         decoder.reset();
 
+        // Allocation-free and lock-free until the device is lost.
+        let mut lost = None;
         while !shutdown.requested() {
             match port.read(&mut buf) {
+                // End of file: the other end hung up.
                 Ok(0) => {
-                    tracing::warn!(port = %path, "serial device closed");
+                    lost = Some(std::io::Error::from(std::io::ErrorKind::UnexpectedEof));
                     break;
                 }
                 Ok(n) => {
+                    presence.data_arrived();
                     // One receive time for every frame this read completed: the moment we had them whole.
                     let rx_ns = monotonic_ns();
+                    if rx_ns >= next_save_ns {
+                        next_save_ns = rx_ns + resume_file::SAVE_PERIOD_NS;
+                        save_resume_point(&resume_path, &decoder);
+                    }
                     let mut failed = None;
                     decoder.push(&buf[..n], |frame| {
                         if let Err(e) = publishers.publish(&frame, rx_ns) {
@@ -123,7 +188,7 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
                 Err(e) if e.kind() == std::io::ErrorKind::TimedOut => {}
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
                 Err(e) => {
-                    tracing::warn!(port = %path, error = %e, "serial device lost");
+                    lost = Some(e);
                     break;
                 }
             }
@@ -134,10 +199,30 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
             counters.resync_bytes = stats.resync_bytes;
             heartbeat.tick(&counters)?;
         }
-        if !shutdown.requested() {
-            sleep_unless_shutdown(backoff, shutdown);
+        drop(port);
+        if let Some(e) = lost
+            && !shutdown.requested()
+        {
+            let delay = presence.lost(monotonic_ns());
+            tracing::warn!(
+                port = %path,
+                error = %e,
+                first_retry_ms = millis(delay),
+                max_retry_ms = millis(presence.backoff().max()),
+                "serial device lost: reopening with backoff"
+            );
+            wait_for_retry(delay, shutdown, &mut heartbeat, &counters)?;
         }
     }
+    save_resume_point(&resume_path, &decoder);
     tracing::info!(frames = counters.received, "acquisition stopped");
     Ok(())
+}
+
+/// Saves where the numbering stands (once a second, off the per-frame path). A service started by
+/// hand without `rins up` has no run directory: nothing to continue, logged at debug level.
+fn save_resume_point(path: &std::path::Path, decoder: &Decoder) {
+    if let Err(e) = resume_file::save(path, &decoder.resume_point()) {
+        tracing::debug!(path = %path.display(), error = %e, "cannot save the resume point");
+    }
 }

@@ -38,6 +38,12 @@ impl IpcSettings {
         Self { prefix, root }
     }
 
+    /// The deployment's own directory under the root (the simulator's terminal link, the
+    /// acquisition's resume point), created by `rins up`.
+    pub fn run_dir(&self) -> std::path::PathBuf {
+        std::path::PathBuf::from(&self.root).join(format!("{}run", self.prefix))
+    }
+
     pub fn iceoryx_config(&self) -> Result<Config> {
         let mut config = Config::default();
         config.global.prefix = FileName::new(self.prefix.as_bytes()).map_err(|e| {
@@ -142,6 +148,20 @@ const MAX_PUBLISHERS: usize = 16;
 const MAX_SUBSCRIBERS: usize = 16;
 const MAX_NODES: usize = 64;
 
+/// Samples of the raw IMU topic its publisher keeps for subscribers that connect later: a fusion
+/// process restarted after a crash receives the frames it missed while it was down (up to 256 ms
+/// at 1 kHz) and the navigation output has no hole. Other topics keep none: a late consumer of
+/// them wants what comes next, not what was.
+const RAW_IMU_HISTORY: usize = 256;
+
+fn history_size(name: &str) -> usize {
+    if name == ipc_types::names::RAW_IMU {
+        RAW_IMU_HISTORY
+    } else {
+        0
+    }
+}
+
 fn service_name(name: &str) -> Result<ServiceName> {
     ServiceName::new(name).map_err(|e| anyhow!("service name {name:?}: {e:?}"))
 }
@@ -157,7 +177,7 @@ fn open_pubsub<T: Debug + ZeroCopySend + 'static>(
         .max_subscribers(MAX_SUBSCRIBERS)
         .max_nodes(MAX_NODES)
         .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
-        .history_size(0)
+        .history_size(history_size(name))
         .enable_safe_overflow(true)
         .open_or_create()
         .map_err(|e| anyhow!("cannot open topic {name:?}: {e:?}"))
@@ -263,4 +283,72 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
     pub fn name(&self) -> &'static str {
         self.name
     }
+
+    /// The descriptor that becomes readable when a publisher signals, for waiting on several
+    /// topics at once ([`wait_any`]).
+    fn signal_fd(&self) -> i32 {
+        // SAFETY: the descriptor is only polled, never closed or read; it lives as long as the
+        // listener, which `self` owns.
+        unsafe { self.listener.file_descriptor().native_handle() }
+    }
+
+    /// Consumes pending signals without sleeping.
+    fn clear_signals(&self) -> Result<()> {
+        self.listener
+            .try_wait(|_| {})
+            .map(|_| ())
+            .map_err(|e| anyhow!("wait on {:?} failed: {e:?}", self.name))
+    }
+}
+
+/// Something samples of `T` come from: one topic, or a merged stream such as the navigator lanes.
+pub trait SampleSource<T> {
+    /// Sleeps until data may be there or `timeout` passes.
+    fn wait(&self, timeout: Duration) -> Result<bool>;
+    /// The next sample, if one is there.
+    fn receive(&mut self) -> Result<Option<T>>;
+}
+
+impl<T: Debug + ZeroCopySend + Copy + 'static> SampleSource<T> for TopicSubscriber<T> {
+    fn wait(&self, timeout: Duration) -> Result<bool> {
+        TopicSubscriber::wait(self, timeout)
+    }
+
+    fn receive(&mut self) -> Result<Option<T>> {
+        TopicSubscriber::receive(self)
+    }
+}
+
+/// Sleeps until a publisher of any of `subs` signals or `timeout` passes; returns whether a signal
+/// came. One listener per topic cannot wait on two topics, and a poll(2) on their descriptors can.
+pub fn wait_any<T: Debug + ZeroCopySend + Copy + 'static>(
+    subs: &[&TopicSubscriber<T>],
+    timeout: Duration,
+) -> Result<bool> {
+    const MAX: usize = 4;
+    let mut fds = [libc::pollfd {
+        fd: -1,
+        events: 0,
+        revents: 0,
+    }; MAX];
+    let n = subs.len().min(MAX);
+    for (fd, sub) in fds.iter_mut().zip(subs) {
+        fd.fd = sub.signal_fd();
+        fd.events = libc::POLLIN;
+    }
+    let ms = libc::c_int::try_from(timeout.as_millis()).unwrap_or(libc::c_int::MAX);
+    // SAFETY: `fds[..n]` is a valid array of initialised pollfd structures for the call's duration.
+    let ready = unsafe { libc::poll(fds.as_mut_ptr(), n as libc::nfds_t, ms) };
+    if ready < 0 {
+        let err = std::io::Error::last_os_error();
+        // A signal (the termination request the caller polls for) cut the wait short.
+        if err.kind() == std::io::ErrorKind::Interrupted {
+            return Ok(false);
+        }
+        return Err(anyhow!("poll on {} topics failed: {err}", n));
+    }
+    for sub in &subs[..n] {
+        sub.clear_signals()?;
+    }
+    Ok(ready > 0)
 }

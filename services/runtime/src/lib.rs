@@ -6,6 +6,8 @@ pub mod config_error;
 pub mod heartbeat;
 pub mod input_watch;
 pub mod ipc;
+pub mod lane_selector;
 pub mod logging;
+pub mod nav_subscriber;
 pub mod shm_cleanup;
 pub mod shutdown;

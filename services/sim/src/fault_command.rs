@@ -16,6 +16,10 @@ pub const DEFAULT_INTERMITTENT_PERIOD_S: f64 = 0.2;
 /// Longest accepted intermittent period, s.
 const MAX_INTERMITTENT_PERIOD_S: f64 = 3600.0;
 
+/// Why a disconnect cannot be given a channel.
+pub const DISCONNECT_HAS_NO_CHANNEL: &str = "disconnect unplugs the whole device: give no channel (rins inject disconnect --duration S, \
+     --inject disconnect=S@TIME)";
+
 /// A fault command or schedule entry that could not be understood: `token` names the offending
 /// piece of input (e.g. `bias STEP "abc"`), `reason` says what it must be.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -151,6 +155,11 @@ fn arg_spec(fault: SimFault) -> Option<ArgSpec> {
             unit: "seconds; dead for the first half of each period",
             required: false,
         }),
+        SimFault::Disconnect => Some(ArgSpec {
+            name: "DURATION_S",
+            unit: "seconds the device stays unplugged, > 0 and <= 3600",
+            required: true,
+        }),
         SimFault::Clear | SimFault::Dead | SimFault::Stuck | SimFault::Saturate => None,
     }
 }
@@ -163,6 +172,7 @@ pub fn check_param(fault: SimFault, param: f64) -> Result<(), &'static str> {
         SimFault::Intermittent => {
             param.is_finite() && param > 0.0 && param <= MAX_INTERMITTENT_PERIOD_S
         }
+        SimFault::Disconnect => crate::device_fault::Disconnect::new(param).is_ok(),
         SimFault::Clear | SimFault::Dead | SimFault::Stuck | SimFault::Saturate => true,
     };
     if ok {
@@ -173,11 +183,12 @@ pub fn check_param(fault: SimFault, param: f64) -> Result<(), &'static str> {
             "must be a finite number >= 1 (it multiplies the configured white noise)"
         }
         SimFault::Intermittent => "must be > 0 and <= 3600 seconds",
+        SimFault::Disconnect => crate::device_fault::DURATION_RANGE,
         _ => "must be a finite number",
     })
 }
 
-/// Every fault kind's name, for messages.
+/// Every fault kind's name, for messages (the channel faults, then the whole-device one).
 fn kind_names() -> String {
     let names: Vec<&str> = [
         SimFault::Dead,
@@ -192,7 +203,11 @@ fn kind_names() -> String {
     .iter()
     .map(|f| f.name())
     .collect();
-    names.join(", ")
+    format!(
+        "{} (for a channel) or {} (the whole device)",
+        names.join(", "),
+        SimFault::Disconnect.name()
+    )
 }
 
 /// Parses a fault kind name (`dead`, `bias`, ...).
@@ -222,6 +237,12 @@ impl FaultCommand {
         fault: SimFault,
         param: Option<f64>,
     ) -> Result<Self, FaultParseError> {
+        if fault == SimFault::Disconnect {
+            return Err(FaultParseError::new(
+                format!("channel \"{channel}\""),
+                DISCONNECT_HAS_NO_CHANNEL,
+            ));
+        }
         let param = match (arg_spec(fault), param) {
             (None, None) => 0.0,
             (None, Some(p)) => {
@@ -280,7 +301,9 @@ impl FaultCommand {
             return Err(ControlError::Unknown);
         }
         let sensor = SensorType::from_u8(control.sensor).ok_or(ControlError::Unknown)?;
-        let fault = SimFault::from_u8(control.fault).ok_or(ControlError::Unknown)?;
+        let fault = SimFault::from_u8(control.fault)
+            .filter(|&f| f != SimFault::Disconnect)
+            .ok_or(ControlError::Unknown)?;
         if usize::from(control.channel) >= MAX_CHANNELS {
             return Err(ControlError::NoSuchChannel);
         }
@@ -314,6 +337,8 @@ impl FaultCommand {
                 period_s: p,
                 dropout_s: 0.5 * p,
             }),
+            // Never a channel's fault: `new` and `from_control` refuse it, so nothing to set.
+            SimFault::Disconnect => None,
         }
     }
 }

@@ -1,15 +1,18 @@
-//! Faults planned ahead: `gyro2:dead@5s` on the command line or `[[fault]]` entries of a scenario
-//! file, applied by the simulator at the first IMU tick at or after their device time.
+//! Faults planned ahead: `gyro2:dead@5s` or `disconnect=1.5@5s` on the command line or `[[fault]]`
+//! entries of a scenario file, applied by the simulator at the first IMU tick at or after their
+//! device time.
 
+use ipc_types::SimFault;
 use serde::Deserialize;
 
-use crate::fault_command::{ChannelId, FaultCommand, FaultParseError, parse_kind, parse_number};
+use crate::fault_command::{ChannelId, FaultParseError, parse_kind, parse_number};
+use crate::sim_command::SimCommand;
 
-/// A fault command and the device time (s since the simulator started) it takes effect.
+/// A command and the device time (s since the simulator started) it takes effect.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ScheduledFault {
     pub at_s: f64,
-    pub command: FaultCommand,
+    pub command: SimCommand,
 }
 
 fn check_time(token: impl FnOnce() -> String, at_s: f64) -> Result<f64, FaultParseError> {
@@ -40,35 +43,43 @@ pub fn parse_time_s(text: &str) -> Result<f64, FaultParseError> {
 }
 
 impl ScheduledFault {
-    /// Parses `CHANNEL:KIND[=PARAM]@TIME`, e.g. `gyro2:dead@5s`, `accel1:bias=0.5@3.2s`.
+    /// Parses `CHANNEL:KIND[=PARAM]@TIME`, e.g. `gyro2:dead@5s`, `accel1:bias=0.5@3.2s`, or
+    /// `disconnect=DURATION_S@TIME` for the whole device, e.g. `disconnect=1.5@5s`.
     pub fn parse(spec: &str) -> Result<Self, FaultParseError> {
         Self::parse_inner(spec).map_err(|e| e.within(&format!("{spec:?}")))
     }
 
     fn parse_inner(spec: &str) -> Result<Self, FaultParseError> {
-        const FORM: &str =
-            "expected CHANNEL:KIND[=PARAM]@TIME, e.g. gyro2:dead@5s or accel1:bias=0.5@3.2s";
+        const FORM: &str = "expected CHANNEL:KIND[=PARAM]@TIME or disconnect=SECONDS@TIME, e.g. \
+                            gyro2:dead@5s, accel1:bias=0.5@3.2s or disconnect=1.5@5s";
         let Some((what, time)) = spec.rsplit_once('@') else {
             return Err(FaultParseError::new("no \"@TIME\"", FORM));
         };
-        let Some((channel, fault)) = what.split_once(':') else {
-            return Err(FaultParseError::new("no \"CHANNEL:\"", FORM));
+        let (channel, fault) = match what.split_once(':') {
+            Some((channel, fault)) => (Some(ChannelId::parse(channel)?), fault),
+            None => (None, what),
         };
-        let channel = ChannelId::parse(channel)?;
         let (kind, param) = match fault.split_once('=') {
             Some((k, p)) => (k, Some(p)),
             None => (fault, None),
         };
+        // Only the whole-device fault goes without a channel; anything else without one is
+        // most likely a forgotten colon.
+        let is_device_fault = SimFault::from_name(kind) == Some(SimFault::Disconnect);
+        if channel.is_none() && !is_device_fault {
+            return Err(FaultParseError::new("no \"CHANNEL:\"", FORM));
+        }
         let kind = parse_kind(kind)?;
         let param = param.map(|p| parse_number(kind, p)).transpose()?;
         Ok(Self {
             at_s: parse_time_s(time)?,
-            command: FaultCommand::new(channel, kind, param)?,
+            command: SimCommand::new(channel, kind, param)?,
         })
     }
 }
 
-/// A scenario file: `[[fault]]` tables with `channel`, `kind`, `at_s` and optional `param`.
+/// A scenario file: `[[fault]]` tables with `channel` (none for `disconnect`), `kind`, `at_s` and
+/// optional `param`.
 #[derive(Debug, Clone, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FaultFile {
@@ -80,13 +91,16 @@ pub struct FaultFile {
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FaultFileEntry {
-    /// `gyro2`, `accel0`, ...
-    pub channel: String,
-    /// `dead`, `stuck`, `bias`, `ramp`, `noise`, `saturate`, `intermittent`, `clear`.
+    /// `gyro2`, `accel0`, ...; absent for `disconnect`, which unplugs the whole device.
+    #[serde(default)]
+    pub channel: Option<String>,
+    /// `dead`, `stuck`, `bias`, `ramp`, `noise`, `saturate`, `intermittent`, `clear`,
+    /// `disconnect`.
     pub kind: String,
     /// Device time, s since the simulator started.
     pub at_s: f64,
-    /// Bias step, ramp rate, noise factor or intermittent period (SI units).
+    /// Bias step, ramp rate, noise factor, intermittent period or disconnect duration (SI
+    /// units).
     pub param: Option<f64>,
 }
 
@@ -98,12 +112,12 @@ impl FaultFile {
             .enumerate()
             .map(|(i, e)| {
                 let entry = || -> Result<ScheduledFault, FaultParseError> {
-                    let channel = ChannelId::parse(&e.channel)?;
+                    let channel = e.channel.as_deref().map(ChannelId::parse).transpose()?;
                     let kind = parse_kind(&e.kind)?;
                     let at_s = check_time(|| format!("at_s = {}", e.at_s), e.at_s)?;
                     Ok(ScheduledFault {
                         at_s,
-                        command: FaultCommand::new(channel, kind, e.param)?,
+                        command: SimCommand::new(channel, kind, e.param)?,
                     })
                 };
                 entry().map_err(|err| err.within(&format!("fault[{i}]")))
@@ -122,7 +136,7 @@ pub fn tick_at(at_s: f64, imu_rate_hz: f64) -> u64 {
 /// The planned faults in tick order, consumed as the simulator advances.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct FaultSchedule {
-    entries: Vec<(u64, FaultCommand)>,
+    entries: Vec<(u64, SimCommand)>,
     next: usize,
 }
 
@@ -130,7 +144,7 @@ impl FaultSchedule {
     /// Orders `faults` by tick; faults due on the same tick keep their given order, so a later
     /// entry for the same channel wins.
     pub fn new(faults: &[ScheduledFault], imu_rate_hz: f64) -> Self {
-        let mut entries: Vec<(u64, FaultCommand)> = faults
+        let mut entries: Vec<(u64, SimCommand)> = faults
             .iter()
             .map(|f| (tick_at(f.at_s, imu_rate_hz), f.command))
             .collect();
@@ -140,7 +154,7 @@ impl FaultSchedule {
 
     /// The next command due at or before `tick`, if any; call until `None` each tick.
     /// Allocation-free.
-    pub fn next_due(&mut self, tick: u64) -> Option<FaultCommand> {
+    pub fn next_due(&mut self, tick: u64) -> Option<SimCommand> {
         let (due, command) = *self.entries.get(self.next)?;
         if due > tick {
             return None;
@@ -224,13 +238,23 @@ mod tests {
         ];
         for (spec, sensor, index, fault, param, at_s) in cases {
             let s = ScheduledFault::parse(spec).unwrap_or_else(|e| panic!("{spec}: {e}"));
-            assert_eq!(s.command.channel, ChannelId { sensor, index }, "{spec}");
-            assert_eq!(s.command.fault, fault, "{spec}");
-            assert_eq!(s.command.param, param, "{spec}");
+            assert_eq!(
+                s.command.channel(),
+                Some(ChannelId { sensor, index }),
+                "{spec}"
+            );
+            assert_eq!(s.command.fault(), fault, "{spec}");
+            assert_eq!(s.command.param(), param, "{spec}");
             assert!((s.at_s - at_s).abs() < 1e-12, "{spec}");
         }
         let neg = ScheduledFault::parse("gyro1:bias=-0.02@1s").unwrap();
-        assert_eq!(neg.command.param, -0.02);
+        assert_eq!(neg.command.param(), -0.02);
+        let d = ScheduledFault::parse("disconnect=1.5@5s").unwrap();
+        assert_eq!(
+            (d.command.fault(), d.command.param()),
+            (SimFault::Disconnect, 1.5)
+        );
+        assert_eq!((d.command.channel(), d.at_s), (None, 5.0));
     }
 
     #[test]
@@ -246,6 +270,13 @@ mod tests {
             ("gyro2:bias=abc@5s", "bias STEP \"abc\""),
             ("gyro2:noise=0.5@5s", "noise FACTOR = 0.5"),
             ("gyro2:dead=1@5s", "dead \"1\""),
+            ("disconnect@5s", "disconnect"),
+            ("disconnect=soon@5s", "disconnect DURATION_S \"soon\""),
+            ("disconnect=0@5s", "disconnect DURATION_S = 0"),
+            ("disconnect=1e9@5s", "disconnect DURATION_S = 1000000000"),
+            ("disconnect=1@never", "time \"never\""),
+            ("gyro2:disconnect=1@5s", "channel \"gyro2\""),
+            ("dead@5s", "no \"CHANNEL:\""),
         ];
         for (spec, token) in cases {
             let e = ScheduledFault::parse(spec).expect_err(spec);
@@ -271,8 +302,8 @@ mod tests {
         let file: FaultFile = toml::from_str(text).unwrap();
         let s = file.schedule().unwrap();
         assert_eq!(s.len(), 2);
-        assert_eq!(s[0].command.fault, SimFault::Dead);
-        assert_eq!(s[1].command.param, 0.5);
+        assert_eq!(s[0].command.fault(), SimFault::Dead);
+        assert_eq!(s[1].command.param(), 0.5);
         assert_eq!(s[1].at_s, 3.2);
 
         let bad = FaultFile {
@@ -300,6 +331,44 @@ mod tests {
             }],
         };
         assert!(bad.schedule().unwrap_err().reason.contains("STEP"));
+
+        let device: FaultFile =
+            toml::from_str("[[fault]]\nkind = \"disconnect\"\nat_s = 2\nparam = 0.5\n").unwrap();
+        let s = device.schedule().unwrap();
+        assert_eq!(
+            (s[0].command.fault(), s[0].command.param()),
+            (SimFault::Disconnect, 0.5)
+        );
+        let cases = [
+            (
+                "kind = \"disconnect\"\nat_s = 2\n",
+                "fault[0]: disconnect",
+                "DURATION_S",
+            ),
+            (
+                "kind = \"disconnect\"\nat_s = 2\nparam = -1.0\n",
+                "fault[0]: disconnect DURATION_S = -1",
+                "> 0",
+            ),
+            (
+                "channel = \"gyro1\"\nkind = \"disconnect\"\nat_s = 2\nparam = 1.0\n",
+                "fault[0]: channel \"gyro1\"",
+                "whole device",
+            ),
+            (
+                "kind = \"dead\"\nat_s = 2\n",
+                "fault[0]: fault \"dead\"",
+                "CHANNEL",
+            ),
+        ];
+        for (entry, token, reason) in cases {
+            let file: FaultFile = toml::from_str(&format!("[[fault]]\n{entry}")).unwrap();
+            let e = file.schedule().unwrap_err();
+            assert!(
+                e.token.starts_with(token) && e.reason.contains(reason),
+                "{entry}: {e}"
+            );
+        }
 
         assert!(
             toml::from_str::<FaultFile>(
@@ -351,12 +420,15 @@ mod tests {
         let a = s.next_due(1000).unwrap();
         let b = s.next_due(1000).unwrap();
         // Same tick: given order kept, so the clear comes last.
-        assert_eq!((a.fault, b.fault), (SimFault::BiasStep, SimFault::Clear));
+        assert_eq!(
+            (a.fault(), b.fault()),
+            (SimFault::BiasStep, SimFault::Clear)
+        );
         assert_eq!(s.next_due(1000), None);
         assert_eq!(s.next_due(2000), None);
-        assert_eq!(s.next_due(2001).unwrap().fault, SimFault::Stuck);
+        assert_eq!(s.next_due(2001).unwrap().fault(), SimFault::Stuck);
         // A late call still delivers what is overdue.
-        assert_eq!(s.next_due(9000).unwrap().fault, SimFault::Dead);
+        assert_eq!(s.next_due(9000).unwrap().fault(), SimFault::Dead);
         assert_eq!(s.next_due(9000), None);
         assert_eq!(s.remaining(), 0);
     }

@@ -4,11 +4,15 @@
 //! The Earth is modelled as non-rotating with constant gravity [`GRAVITY_MPS2`]; see [`trajectory`].
 
 pub mod config;
+pub mod device_fault;
 pub mod error;
 pub mod fault_command;
 pub mod fault_schedule;
+pub mod outage;
 pub mod sensor_model;
+pub mod serial_line;
 pub mod service;
+pub mod sim_command;
 pub mod simulator;
 pub mod trajectory;
 

@@ -1,11 +1,11 @@
 //! The simulator process: a pseudo-terminal that behaves like the sensor block's serial line, fed in
-//! real time, plus the truth topic for accuracy checks.
+//! real time, plus the truth topic for accuracy checks. The line can be unplugged for a while on
+//! command ([`SimCommand::Disconnect`]).
 
 use std::io::Write;
 use std::path::PathBuf;
-use std::time::Duration;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use ipc_types::{
     FaultApplied, FaultOutcome, Header, Health, PAYLOAD_VERSION, ServiceKind, SimControl, Truth,
     names,
@@ -15,19 +15,19 @@ use rins_runtime::clock::monotonic_ns;
 use rins_runtime::heartbeat::Heartbeat;
 use rins_runtime::ipc::{IpcSettings, TopicPublisher, TopicSubscriber, create_node};
 use rins_runtime::shutdown::Shutdown;
-use serialport::{SerialPort, TTYPort};
 
+use crate::device_fault::Disconnect;
 use crate::fault_command::{ControlError, FaultCommand, WhiteNoise};
 use crate::fault_schedule::{FaultSchedule, ScheduledFault};
+use crate::outage::Outage;
+use crate::serial_line::SerialLine;
+use crate::sim_command::SimCommand;
 use crate::simulator::{Simulator, TickOutput, TruthSample};
 
 /// Frames of one tick at most: IMU, baro, mag, aux.
 const FRAMES_PER_TICK: usize = 4;
-/// How long a write may wait for the reader before the tick's bytes are dropped. The pty holds
-/// about 40 ms of frames; past that a real line would overrun the receiver. The simulator waits
-/// longer than a real device would, because it shares the processor with the pipeline it feeds: a
-/// stalled reader on a loaded machine delays frames (the sleeps catch up) instead of losing them.
-const WRITE_TIMEOUT: Duration = Duration::from_millis(100);
+/// When a new pseudo-terminal cannot be made, the next try comes this much device time later.
+const PLUG_RETRY_S: f64 = 0.1;
 
 pub struct SimOptions {
     /// Also expose the pseudo-terminal under this path (a stable name for acquisition).
@@ -98,7 +98,7 @@ fn next_sample_time_us(sim: &Simulator) -> u64 {
     (sim.tick() as f64 * sim.imu_period_s() * 1e6).round() as u64
 }
 
-/// Applies one fault command before the next step, so it affects that step's sample, and
+/// Applies one channel fault before the next step, so it affects that step's sample, and
 /// describes what happened for [`names::SIM_FAULT_APPLIED`].
 fn apply_fault(sim: &mut Simulator, command: &FaultCommand, noise: &WhiteNoise) -> FaultApplied {
     let channel = usize::from(command.channel.index);
@@ -142,31 +142,106 @@ fn fault_event(control: &SimControl) -> FaultApplied {
     }
 }
 
-/// Applies a command received on [`names::SIM_CONTROL`]; malformed ones are logged and ignored.
-fn handle_control(sim: &mut Simulator, control: &SimControl, noise: &WhiteNoise) -> FaultApplied {
-    match FaultCommand::from_control(control) {
-        Ok(command) => apply_fault(sim, &command, noise),
-        Err(e) => {
-            let outcome = match e {
-                ControlError::Unknown => FaultOutcome::UnknownCommand,
-                ControlError::NoSuchChannel => FaultOutcome::NoSuchChannel,
-                ControlError::InvalidParameter => FaultOutcome::InvalidParameter,
-            };
-            tracing::warn!(
-                version = control.version,
-                sensor = control.sensor,
-                channel = control.channel,
-                fault = control.fault,
-                param = control.param,
-                outcome = outcome.name(),
-                "simulator control command ignored"
-            );
-            FaultApplied {
-                outcome: outcome as u8,
-                device_time_us: next_sample_time_us(sim),
-                ..fault_event(control)
+/// The device's side of the simulation: its serial line and when an unplugged line comes back.
+struct Device {
+    line: SerialLine,
+    outage: Outage,
+    imu_rate_hz: f64,
+}
+
+impl Device {
+    /// Unplugs the line before the next step, so that step's frames are the first lost.
+    fn disconnect(&mut self, sim: &Simulator, command: &Disconnect) -> FaultApplied {
+        if self
+            .outage
+            .begin(sim.tick(), command.ticks(self.imu_rate_hz))
+        {
+            self.line.unplug();
+            tracing::info!(fault = %command, time_s = sim.time_s(), "serial line unplugged");
+        } else {
+            tracing::info!(fault = %command, time_s = sim.time_s(), "serial line outage extended");
+        }
+        FaultApplied {
+            outcome: FaultOutcome::Applied as u8,
+            device_time_us: next_sample_time_us(sim),
+            ..fault_event(&SimCommand::Disconnect(*command).to_control())
+        }
+    }
+
+    /// Plugs the line back in when its outage is over; a failure is logged and retried.
+    fn reconnect_if_due(&mut self, sim: &Simulator) {
+        if !self.outage.due(sim.tick()) {
+            return;
+        }
+        match self.line.plug() {
+            Ok(tty) => {
+                tracing::info!(port = %tty, time_s = sim.time_s(), "serial line plugged back in");
+                // Whoever started a stand-alone simulator reads the device path here; nobody
+                // reading it is no reason to stop.
+                let mut out = std::io::stdout().lock();
+                let _ = writeln!(out, "{tty}").and_then(|()| out.flush());
+                self.outage.end();
+            }
+            Err(e) => {
+                let retry = (PLUG_RETRY_S * self.imu_rate_hz).ceil() as u64;
+                tracing::error!(
+                    error = %e,
+                    retry_s = PLUG_RETRY_S,
+                    "cannot plug the serial line back in"
+                );
+                self.outage.retry_at(sim.tick() + retry.max(1));
             }
         }
+    }
+
+    /// Applies any command before the next step.
+    fn apply(
+        &mut self,
+        sim: &mut Simulator,
+        command: &SimCommand,
+        noise: &WhiteNoise,
+    ) -> FaultApplied {
+        match command {
+            SimCommand::Channel(c) => apply_fault(sim, c, noise),
+            SimCommand::Disconnect(d) => self.disconnect(sim, d),
+        }
+    }
+
+    /// Applies a command received on [`names::SIM_CONTROL`]; malformed ones are logged and
+    /// ignored.
+    fn handle_control(
+        &mut self,
+        sim: &mut Simulator,
+        control: &SimControl,
+        noise: &WhiteNoise,
+    ) -> FaultApplied {
+        match SimCommand::from_control(control) {
+            Ok(command) => self.apply(sim, &command, noise),
+            Err(e) => rejected(sim, control, e),
+        }
+    }
+}
+
+/// Logs a command the simulator refused and describes the refusal.
+fn rejected(sim: &Simulator, control: &SimControl, e: ControlError) -> FaultApplied {
+    let outcome = match e {
+        ControlError::Unknown => FaultOutcome::UnknownCommand,
+        ControlError::NoSuchChannel => FaultOutcome::NoSuchChannel,
+        ControlError::InvalidParameter => FaultOutcome::InvalidParameter,
+    };
+    tracing::warn!(
+        version = control.version,
+        sensor = control.sensor,
+        channel = control.channel,
+        fault = control.fault,
+        param = control.param,
+        outcome = outcome.name(),
+        "simulator control command ignored"
+    );
+    FaultApplied {
+        outcome: outcome as u8,
+        device_time_us: next_sample_time_us(sim),
+        ..fault_event(control)
     }
 }
 
@@ -176,16 +251,8 @@ pub fn run(
     settings: &IpcSettings,
     shutdown: &Shutdown,
 ) -> Result<()> {
-    let (mut master, slave) = TTYPort::pair().context("cannot create a pseudo-terminal")?;
-    let tty = slave
-        .name()
-        .context("the pseudo-terminal has no device name")?;
-    master.set_timeout(WRITE_TIMEOUT)?;
-    if let Some(link) = &options.link {
-        let _ = std::fs::remove_file(link);
-        std::os::unix::fs::symlink(&tty, link)
-            .with_context(|| format!("cannot link {} to {tty}", link.display()))?;
-    }
+    let line = SerialLine::open(options.link.clone())?;
+    let tty = line.tty().unwrap_or_default();
     println!("{tty}");
     let _ = std::io::stdout().flush();
     tracing::info!(port = %tty, link = ?options.link, "simulated sensor block streaming");
@@ -198,7 +265,13 @@ pub fn run(
     let truth = TopicPublisher::<Truth>::new(&node, names::TRUTH)?;
     let fault_events = TopicPublisher::<FaultApplied>::new(&node, names::SIM_FAULT_APPLIED)?;
     let control = TopicSubscriber::<SimControl>::new(&node, names::SIM_CONTROL)?;
-    let mut schedule = FaultSchedule::new(&options.faults, 1.0 / sim.imu_period_s());
+    let imu_rate_hz = 1.0 / sim.imu_period_s();
+    let mut schedule = FaultSchedule::new(&options.faults, imu_rate_hz);
+    let mut device = Device {
+        line,
+        outage: Outage::default(),
+        imu_rate_hz,
+    };
     let mut heartbeat = Heartbeat::new(&node, ServiceKind::Simulator)?;
     let mut counters = Health::default();
     let mut out = TickOutput::default();
@@ -211,28 +284,29 @@ pub fn run(
 
     while !shutdown.requested() && end_tick.is_none_or(|end| sim.tick() < end) {
         sleep_until(start_ns + sim.tick() * period_ns);
+        device.reconnect_if_due(&sim);
         // Faults first, announced before the frame leaves: whoever measures detection delays
         // must know of a fault before any output derived from the faulty sample.
         while let Some(command) = schedule.next_due(sim.tick()) {
-            fault_events.publish(apply_fault(&mut sim, &command, &options.noise))?;
+            fault_events.publish(device.apply(&mut sim, &command, &options.noise))?;
         }
         while let Some(command) = control.receive()? {
-            fault_events.publish(handle_control(&mut sim, &command, &options.noise))?;
+            fault_events.publish(device.handle_control(&mut sim, &command, &options.noise))?;
         }
         sim.step(&mut out);
         // Truth first: whoever compares against it must find it before the frame's navigation output.
         truth.publish(truth_message(&out.truth))?;
         let len = encode_tick(&out, &mut buf);
-        match master.write_all(&buf[..len]) {
-            Ok(()) => counters.published += 1,
-            // Nobody reads the line (acquisition restarting): the device's frames are lost.
-            Err(_) => counters.lost += 1,
+        // Unplugged, or nobody reads the line (acquisition restarting): the frames are lost, and
+        // the device's time and sequence numbers go on regardless.
+        if device.line.send(&buf[..len]) {
+            counters.published += 1;
+        } else {
+            counters.lost += 1;
         }
         heartbeat.tick(&counters)?;
     }
-    drop(slave);
-    if let Some(link) = &options.link {
-        let _ = std::fs::remove_file(link);
-    }
+    // Dropping the line removes the link.
+    drop(device);
     Ok(())
 }

@@ -21,7 +21,7 @@ fn output_topic(kind: ServiceKind) -> Option<usize> {
         ServiceKind::Acquisition => "imu",
         ServiceKind::Fusion => "fused",
         ServiceKind::Altimeter => "alt",
-        ServiceKind::Navigator => "nav",
+        ServiceKind::Navigator | ServiceKind::NavigatorStandby => "nav",
         ServiceKind::Simulator | ServiceKind::Watchdog => return None,
     };
     COUNTED.iter().position(|c| *c == name)

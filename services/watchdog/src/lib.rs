@@ -8,6 +8,7 @@ pub mod health_publisher;
 pub mod health_report;
 pub mod monitor;
 pub mod restart_policy;
+pub mod restart_timing;
 pub mod seq_gaps;
 pub mod status;
 pub mod summary;

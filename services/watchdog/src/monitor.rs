@@ -7,6 +7,7 @@ use ipc_types::{
     ServiceKind, Truth, names,
 };
 use rins_runtime::ipc::{IpcNode, TopicSubscriber};
+use rins_runtime::nav_subscriber::NavSubscriber;
 
 use crate::accuracy::Accuracy;
 use crate::fault_tracking::FaultTracker;
@@ -42,7 +43,8 @@ pub struct Monitor {
     mag: TopicSubscriber<RawMag>,
     fused: TopicSubscriber<FusedImu>,
     alt: TopicSubscriber<Altitude>,
-    nav: TopicSubscriber<NavState>,
+    /// Both navigator lanes, merged into the stream consumers see.
+    nav: NavSubscriber,
     truth: TopicSubscriber<Truth>,
     health: TopicSubscriber<Health>,
     fault_events: TopicSubscriber<FaultApplied>,
@@ -68,7 +70,7 @@ impl Monitor {
             mag: TopicSubscriber::new(node, names::RAW_MAG)?,
             fused: TopicSubscriber::new(node, names::FUSED_IMU)?,
             alt: TopicSubscriber::new(node, names::ALTITUDE)?,
-            nav: TopicSubscriber::new(node, names::NAV_STATE)?,
+            nav: NavSubscriber::new(node)?,
             truth: TopicSubscriber::new(node, names::TRUTH)?,
             health: TopicSubscriber::new(node, names::HEARTBEAT)?,
             fault_events: TopicSubscriber::new(node, names::SIM_FAULT_APPLIED)?,
@@ -89,6 +91,30 @@ impl Monitor {
             acquisition: Vec::new(),
             heartbeats: [None; ServiceKind::ALL.len()],
         })
+    }
+
+    /// Samples seen so far on the output topic of `kind` (each navigator lane on its own topic);
+    /// `None` for a process without an output the monitor counts.
+    pub fn output_count(&self, kind: ServiceKind) -> Option<u64> {
+        let topic = |name: &str| {
+            COUNTED
+                .iter()
+                .position(|c| *c == name)
+                .map(|i| self.totals[i])
+        };
+        match kind {
+            ServiceKind::Acquisition => topic("imu"),
+            ServiceKind::Fusion => topic("fused"),
+            ServiceKind::Altimeter => topic("alt"),
+            ServiceKind::Navigator => Some(self.nav.lane_totals()[0]),
+            ServiceKind::NavigatorStandby => Some(self.nav.lane_totals()[1]),
+            ServiceKind::Simulator | ServiceKind::Watchdog => None,
+        }
+    }
+
+    /// The navigation stream's reader: lane totals and switches.
+    pub fn nav_lanes(&self) -> &NavSubscriber {
+        &self.nav
     }
 
     /// Takes everything queued on every topic.

@@ -38,6 +38,15 @@ pub struct DecoderStats {
 /// and searches again, so a sync word inside garbage or inside a corrupt frame can never hide a
 /// real frame that starts within the bytes it claimed. A real frame is delivered at the latest
 /// once `MAX_FRAME_LEN` bytes from its first byte have arrived.
+/// The last extended sequence number of each frame type (indexed by [`FrameType::index`]) and
+/// the last extended device time. A restarted acquisition continues from the point its previous
+/// run saved, so the sequence numbers consumers see never run backwards.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ResumePoint {
+    pub seq: [Option<u64>; FrameType::COUNT],
+    pub time_us: Option<u64>,
+}
+
 #[derive(Debug, Clone)]
 pub struct Decoder {
     buf: [u8; BUF_LEN],
@@ -87,14 +96,34 @@ impl Decoder {
         self.len
     }
 
-    /// Starts afresh after a reconnect: drops buffered bytes (counted in `resync_bytes`) and the
-    /// sequence and device-time references, so that the next frame of each type sets them again
-    /// and no loss is counted across the reconnect. Counters are kept.
+    /// Starts afresh after a reconnect: drops buffered bytes (counted in `resync_bytes`). The
+    /// sequence numbers go on from the last ones, so that they never run backwards downstream,
+    /// and the frames the device sent while it was away are counted lost, from the step of its
+    /// sequence number (meaningless only if the device restarted its counter meanwhile).
+    /// Counters are kept.
     pub fn reset(&mut self) {
         self.stats.resync_bytes += self.len as u64;
         self.len = 0;
-        self.seq.iter_mut().for_each(SeqExtender::reset);
-        self.time.reset();
+    }
+
+    /// Where the extended sequence numbers (per frame type) and device time stand.
+    pub fn resume_point(&self) -> ResumePoint {
+        ResumePoint {
+            seq: self.seq.map(|s| s.last()),
+            time_us: self.time.last(),
+        }
+    }
+
+    /// Continues the extended numbering of an earlier run (see [`ResumePoint`]).
+    pub fn resume_from(&mut self, point: &ResumePoint) {
+        for (extender, last) in self.seq.iter_mut().zip(point.seq) {
+            if let Some(last) = last {
+                extender.resume_from(last);
+            }
+        }
+        if let Some(t) = point.time_us {
+            self.time.resume_from(t);
+        }
     }
 
     /// Decodes every complete frame in the buffer and moves the unconsumed tail to the front.

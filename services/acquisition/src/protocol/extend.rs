@@ -4,6 +4,8 @@
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct SeqExtender {
     last: Option<u64>,
+    /// The next step is taken without counting losses (after a resume).
+    uncounted: bool,
 }
 
 impl SeqExtender {
@@ -25,12 +27,29 @@ impl SeqExtender {
         }
         let extended = last.wrapping_add(u64::from(step));
         self.last = Some(extended);
+        if std::mem::take(&mut self.uncounted) {
+            return (extended, 0);
+        }
         (extended, u64::from(step) - 1)
+    }
+
+    /// Continues after `last`, the extended number of a frame published earlier by a previous run
+    /// of this process, so that the numbers never run backwards downstream. The step to the next
+    /// frame is not counted as lost: `last` may be up to a second old, and the frames in between
+    /// were published by that run.
+    pub fn resume_from(&mut self, last: u64) {
+        self.last = Some(last);
+        self.uncounted = true;
+    }
+
+    /// The extended number of the last frame.
+    pub fn last(&self) -> Option<u64> {
+        self.last
     }
 
     /// Forgets the reference; the next frame sets it again.
     pub fn reset(&mut self) {
-        self.last = None;
+        *self = Self::default();
     }
 }
 
@@ -68,6 +87,16 @@ impl TimeExtender {
     pub fn reset(&mut self) {
         self.last = None;
     }
+
+    /// Continues from `last_us`, the extended time of a frame published earlier.
+    pub fn resume_from(&mut self, last_us: u64) {
+        self.last = i64::try_from(last_us).ok();
+    }
+
+    /// The extended time of the last frame, µs.
+    pub fn last(&self) -> Option<u64> {
+        self.last.and_then(|t| u64::try_from(t).ok())
+    }
 }
 
 #[cfg(test)]
@@ -86,6 +115,20 @@ mod tests {
         assert_eq!(s.extend(2), (65539 + 65535, 0));
         s.reset();
         assert_eq!(s.extend(100), (100, 0));
+    }
+
+    #[test]
+    fn a_resume_continues_forward_without_counting_the_step() {
+        // A previous run published up to 200_005 (wire 200_005 mod 2^16 = 3_397).
+        let mut r = SeqExtender::default();
+        r.resume_from(200_005);
+        assert_eq!(r.last(), Some(200_005));
+        assert_eq!(r.extend(3_400), (200_008, 0));
+        assert_eq!(r.extend(3_402), (200_010, 1));
+        let mut t = TimeExtender::default();
+        t.resume_from(5 << 32);
+        assert_eq!(t.extend(10), (5 << 32) + 10);
+        assert_eq!(t.last(), Some((5 << 32) + 10));
     }
 
     #[test]

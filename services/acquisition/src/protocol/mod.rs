@@ -9,7 +9,7 @@ pub mod frame;
 pub mod layout;
 
 pub use codec::{decode_frame, encode, peek_frame_len};
-pub use decoder::{Decoder, DecoderStats};
+pub use decoder::{Decoder, DecoderStats, ResumePoint};
 pub use error::{DecodeError, EncodeError};
 pub use extend::{SeqExtender, TimeExtender};
 pub use frame::*;

@@ -1,0 +1,471 @@
+//! Choosing between the two navigator lanes: one contiguous navigation stream out of two.
+//!
+//! Both lanes run the same filter on the same fused IMU samples and stamp each solution with the
+//! sequence number of its IMU sample, so the lanes' outputs are interchangeable sample by sample. The
+//! selector delivers every sequence number once, in order, from the lane it has selected, and keeps
+//! the other lane's samples that are ahead of the output so that a switch continues exactly at the
+//! next sequence number: killing the selected lane loses no sample.
+//!
+//! Switching rule, built against the known failure modes of lane switching:
+//! - **Dead lane** (liveness): the selected lane has delivered nothing beyond the output while the
+//!   other lane is [`SelectorConfig::switch_lag`] samples ahead. One late sample is not a failure
+//!   (no switch on a glitch): the lag has to build up first, which bounds the output gap to
+//!   `switch_lag` sample periods.
+//! - **Untrusted lane** (quality): the selected lane is aligning or its solution is younger than
+//!   [`SelectorConfig::settle`] samples (it just reset or took over), while the other lane is trusted
+//!   and has the next sample. A lane that just reset is never chosen for quality: only a dead
+//!   selected lane makes the selector take an untrusted one, since anything beats no output.
+//! - **Holes** in the selected lane (a sample it skipped while the other lane has it) are filled
+//!   from the other lane without switching.
+//! - **No flip-flop**: nothing else switches. A healthy selected lane stays selected however the
+//!   other lane does (there is no preferred lane to return to), and a quality switch needs
+//!   [`SelectorConfig::min_dwell`] samples since the last switch.
+//!
+//! Allocation-free after construction: each lane's pending samples sit in a fixed ring.
+
+use std::collections::VecDeque;
+
+use ipc_types::{NavMode, NavState};
+
+/// Number of navigator lanes.
+pub const LANES: usize = 2;
+
+/// Pending samples kept per lane; more than any switch lag, so a switch always finds the next one.
+const PENDING: usize = 64;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SelectorConfig {
+    /// Samples the other lane must be ahead of the output before the selected lane counts as dead.
+    pub switch_lag: u64,
+    /// Samples a solution must have run (since alignment or takeover) before it is trusted.
+    pub settle: u64,
+    /// Samples between a switch and a quality switch.
+    pub min_dwell: u64,
+}
+
+impl Default for SelectorConfig {
+    /// At 400 Hz: a dead lane is left after 20 ms, a solution trusted after 2 s, at most one quality
+    /// switch per second.
+    fn default() -> Self {
+        Self {
+            switch_lag: 8,
+            settle: 800,
+            min_dwell: 400,
+        }
+    }
+}
+
+/// Why the selector changed lanes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SwitchReason {
+    /// The selected lane stopped delivering.
+    Dead,
+    /// The selected lane was aligning or too young, the other one trusted.
+    Untrusted,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Switch {
+    pub from: usize,
+    pub to: usize,
+    pub reason: SwitchReason,
+    /// Sequence number of the first sample delivered from the new lane.
+    pub at_seq: u64,
+}
+
+/// See the module documentation.
+#[derive(Debug, Clone)]
+pub struct LaneSelector {
+    config: SelectorConfig,
+    pending: [VecDeque<NavState>; LANES],
+    selected: usize,
+    last_delivered: Option<u64>,
+    last_switch_seq: Option<u64>,
+    switches: u64,
+    last_switch: Option<Switch>,
+    filled: u64,
+}
+
+/// A solution the selector may choose for quality.
+pub fn trusted(s: &NavState, settle: u64) -> bool {
+    NavMode::from_u8(s.mode) != NavMode::Aligning
+        && s.solution_start_seq != 0
+        && s.header.origin_seq.saturating_sub(s.solution_start_seq) >= settle
+        && s.quaternion.iter().all(|q| q.is_finite())
+}
+
+impl LaneSelector {
+    pub fn new(config: SelectorConfig) -> Self {
+        Self {
+            config,
+            pending: std::array::from_fn(|_| VecDeque::with_capacity(PENDING)),
+            selected: 0,
+            last_delivered: None,
+            last_switch_seq: None,
+            switches: 0,
+            last_switch: None,
+            filled: 0,
+        }
+    }
+
+    /// The lane delivering now.
+    pub fn selected(&self) -> usize {
+        self.selected
+    }
+
+    /// Lane changes since start.
+    pub fn switches(&self) -> u64 {
+        self.switches
+    }
+
+    /// The most recent lane change.
+    pub fn last_switch(&self) -> Option<Switch> {
+        self.last_switch
+    }
+
+    /// Takes one sample of `lane` (samples of a lane arrive in sequence order). Samples at or before
+    /// the output are useless and dropped; when the ring is full the oldest pending one goes.
+    pub fn push(&mut self, lane: usize, sample: NavState) {
+        let Some(queue) = self.pending.get_mut(lane) else {
+            return;
+        };
+        if self
+            .last_delivered
+            .is_some_and(|d| sample.header.origin_seq <= d)
+        {
+            return;
+        }
+        // A lane that restarted begins again below what it had pending: its old samples are stale.
+        while queue
+            .back()
+            .is_some_and(|b| b.header.origin_seq >= sample.header.origin_seq)
+        {
+            queue.pop_back();
+        }
+        if queue.len() == PENDING {
+            queue.pop_front();
+        }
+        queue.push_back(sample);
+    }
+
+    /// The next sample of the output stream, or `None` until one is due.
+    pub fn pop(&mut self) -> Option<NavState> {
+        self.discard_delivered();
+        let other = 1 - self.selected;
+        if self.should_switch(other) {
+            self.switch_to(other);
+        }
+        let next = self.pending[self.selected].front()?.header.origin_seq;
+        // A sample the selected lane skipped but the other lane has fills the hole; the selection
+        // stays (one missing sample is a glitch, not a failure).
+        let lane = if self.pending[other]
+            .front()
+            .is_some_and(|s| s.header.origin_seq < next)
+        {
+            self.filled += 1;
+            other
+        } else {
+            self.selected
+        };
+        let sample = self.pending[lane].pop_front()?;
+        self.last_delivered = Some(sample.header.origin_seq);
+        Some(sample)
+    }
+
+    /// Samples taken from the other lane to fill a hole in the selected lane's output.
+    pub fn filled(&self) -> u64 {
+        self.filled
+    }
+
+    fn discard_delivered(&mut self) {
+        let Some(d) = self.last_delivered else {
+            return;
+        };
+        for queue in &mut self.pending {
+            while queue.front().is_some_and(|s| s.header.origin_seq <= d) {
+                queue.pop_front();
+            }
+        }
+    }
+
+    fn should_switch(&self, other: usize) -> bool {
+        let Some(candidate) = self.pending[other].front() else {
+            return false;
+        };
+        let selected = &self.pending[self.selected];
+        let Some(next) = selected.front() else {
+            // Dead: nothing from the selected lane while the other has delivered `switch_lag`
+            // samples ahead of the output. Counted in samples, not in sequence numbers, so that a
+            // hole in the input (both lanes skip the same numbers) is no reason to switch.
+            return self.pending[other].len() as u64 >= self.config.switch_lag;
+        };
+        // Untrusted: only towards a trusted lane that has the next sample (not behind the
+        // selected one), and not within the dwell time of the last switch.
+        let dwelt = self
+            .last_switch_seq
+            .is_none_or(|at| next.header.origin_seq.saturating_sub(at) >= self.config.min_dwell);
+        dwelt
+            && !trusted(next, self.config.settle)
+            && trusted(candidate, self.config.settle)
+            && candidate.header.origin_seq <= next.header.origin_seq
+    }
+
+    fn switch_to(&mut self, lane: usize) {
+        let at_seq = self.pending[lane]
+            .front()
+            .map_or(0, |s| s.header.origin_seq);
+        let reason = if self.pending[self.selected].is_empty() {
+            SwitchReason::Dead
+        } else {
+            SwitchReason::Untrusted
+        };
+        self.last_switch = Some(Switch {
+            from: self.selected,
+            to: lane,
+            reason,
+            at_seq,
+        });
+        self.selected = lane;
+        self.last_switch_seq = Some(at_seq);
+        self.switches += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SETTLE: u64 = 100;
+
+    fn cfg() -> SelectorConfig {
+        SelectorConfig {
+            switch_lag: 8,
+            settle: SETTLE,
+            min_dwell: 50,
+        }
+    }
+
+    /// A navigating solution of `lane` at `seq` that started at `start`.
+    fn nav(lane: u8, seq: u64, start: u64) -> NavState {
+        let mut s = NavState {
+            mode: NavMode::Navigating as u8,
+            lane,
+            solution_start_seq: start,
+            ..NavState::default()
+        };
+        s.header.origin_seq = seq;
+        s
+    }
+
+    fn aligning(lane: u8, seq: u64) -> NavState {
+        let mut s = nav(lane, seq, 0);
+        s.mode = NavMode::Aligning as u8;
+        s
+    }
+
+    fn drain(sel: &mut LaneSelector, out: &mut Vec<(u64, u8)>) {
+        while let Some(s) = sel.pop() {
+            out.push((s.header.origin_seq, s.lane));
+        }
+    }
+
+    #[test]
+    fn healthy_lanes_deliver_the_selected_lane_once_in_order() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        for seq in 1..=1000 {
+            // The standby is sometimes first: its samples are never taken while lane 0 is healthy.
+            sel.push(1, nav(1, seq, 1));
+            sel.push(0, nav(0, seq, 1));
+            drain(&mut sel, &mut out);
+        }
+        assert_eq!(out.len(), 1000);
+        assert!(
+            out.iter()
+                .enumerate()
+                .all(|(i, &(s, l))| s == i as u64 + 1 && l == 0)
+        );
+        assert_eq!(sel.switches(), 0);
+    }
+
+    #[test]
+    fn a_killed_lane_loses_no_sample_and_the_gap_is_the_switch_lag() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        let mut stall = 0;
+        for seq in 1..=500 {
+            sel.push(1, nav(1, seq, 1));
+            if seq <= 200 {
+                sel.push(0, nav(0, seq, 1));
+            }
+            let before = out.len();
+            drain(&mut sel, &mut out);
+            if out.len() == before {
+                stall += 1;
+            }
+        }
+        let seqs: Vec<u64> = out.iter().map(|o| o.0).collect();
+        assert_eq!(seqs, (1..=500).collect::<Vec<_>>());
+        // Lane 1 needs to be `switch_lag` ahead of the output (seq 200): 207 arrives without
+        // output, 208 switches.
+        assert_eq!(stall, 7);
+        assert_eq!(
+            sel.last_switch(),
+            Some(Switch {
+                from: 0,
+                to: 1,
+                reason: SwitchReason::Dead,
+                at_seq: 201
+            })
+        );
+        assert!(out[200..].iter().all(|o| o.1 == 1));
+    }
+
+    #[test]
+    fn a_late_sample_is_not_a_failure() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        for seq in 1..=300 {
+            sel.push(1, nav(1, seq, 1));
+            // Lane 0 delivers samples 100..=106 late, in one burst after 106 of lane 1.
+            if !(100..=106).contains(&seq) {
+                if seq == 107 {
+                    for late in 100..=106 {
+                        sel.push(0, nav(0, late, 1));
+                    }
+                }
+                sel.push(0, nav(0, seq, 1));
+            }
+            drain(&mut sel, &mut out);
+        }
+        assert_eq!(sel.switches(), 0);
+        assert!(out.iter().all(|o| o.1 == 0));
+        assert_eq!(out.len(), 300);
+    }
+
+    #[test]
+    fn a_restarted_lane_is_not_chosen_until_it_settled_and_then_only_when_needed() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        // Lane 0 dies at 200; lane 1 carries on. Lane 0 restarts at 300 by taking over (its
+        // solution starts at 300), is trusted from 400, but lane 1 stays selected: no flip-flop.
+        for seq in 1..=1000 {
+            sel.push(1, nav(1, seq, 1));
+            if seq <= 200 {
+                sel.push(0, nav(0, seq, 1));
+            } else if seq >= 300 {
+                sel.push(0, nav(0, seq, 300));
+            }
+            drain(&mut sel, &mut out);
+        }
+        assert_eq!(sel.switches(), 1);
+        assert_eq!(out.len(), 1000);
+        assert!(out[200..].iter().all(|o| o.1 == 1));
+    }
+
+    #[test]
+    fn a_selected_lane_that_resets_is_left_for_a_trusted_one_after_the_dwell() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        // Lane 0 restarts its alignment at 500 (aligning from then on); lane 1 is trusted.
+        for seq in 1..=700 {
+            sel.push(
+                0,
+                if seq < 500 {
+                    nav(0, seq, 1)
+                } else {
+                    aligning(0, seq)
+                },
+            );
+            sel.push(1, nav(1, seq, 1));
+            drain(&mut sel, &mut out);
+        }
+        assert_eq!(
+            sel.last_switch().map(|s| (s.to, s.reason, s.at_seq)),
+            Some((1, SwitchReason::Untrusted, 500))
+        );
+        let seqs: Vec<u64> = out.iter().map(|o| o.0).collect();
+        assert_eq!(seqs, (1..=700).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn an_untrusted_lane_is_taken_only_when_the_selected_one_is_dead() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        // Both aligning at first: no quality switch between two untrusted lanes.
+        for seq in 1..=50 {
+            sel.push(1, aligning(1, seq));
+            sel.push(0, aligning(0, seq));
+            drain(&mut sel, &mut out);
+        }
+        assert_eq!(sel.switches(), 0);
+        // Lane 0 dies while lane 1 still aligns: lane 1 is taken (no output would be worse).
+        for seq in 51..=80 {
+            sel.push(1, aligning(1, seq));
+            drain(&mut sel, &mut out);
+        }
+        assert_eq!(sel.selected(), 1);
+        assert_eq!(out.len(), 80);
+    }
+
+    #[test]
+    fn a_sample_the_selected_lane_skipped_is_filled_from_the_other() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        for seq in 1..=30 {
+            if seq != 11 {
+                sel.push(0, nav(0, seq, 1));
+            }
+            sel.push(1, nav(1, seq, 1));
+            drain(&mut sel, &mut out);
+        }
+        assert_eq!(out.len(), 30);
+        assert_eq!(out[10], (11, 1));
+        assert!(out.iter().filter(|o| o.0 != 11).all(|o| o.1 == 0));
+        assert_eq!((sel.filled(), sel.switches()), (1, 0));
+    }
+
+    #[test]
+    fn gaps_in_both_lanes_pass_through_without_a_switch() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        // The device was unplugged: both lanes miss 101..=150 (the input never existed), and the
+        // standby is first to publish after the hole.
+        for seq in (1..=100).chain(151..=300) {
+            sel.push(1, nav(1, seq, 1));
+            drain(&mut sel, &mut out);
+            sel.push(0, nav(0, seq, 1));
+            drain(&mut sel, &mut out);
+        }
+        assert_eq!(sel.switches(), 0);
+        assert_eq!(out.len(), 250);
+    }
+
+    #[test]
+    fn quality_switches_respect_the_dwell_time() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        // Lane 0 dies at 200 (dead switch at 201), comes back trusted; lane 1 resets at 220,
+        // within the 50-sample dwell: the quality switch back waits until 251.
+        for seq in 1..=400 {
+            if seq <= 200 || seq >= 209 {
+                sel.push(0, nav(0, seq, 1));
+            }
+            sel.push(
+                1,
+                if seq < 220 {
+                    nav(1, seq, 1)
+                } else {
+                    aligning(1, seq)
+                },
+            );
+            drain(&mut sel, &mut out);
+        }
+        assert_eq!(sel.switches(), 2);
+        assert_eq!(
+            sel.last_switch().map(|s| (s.to, s.reason, s.at_seq)),
+            Some((0, SwitchReason::Untrusted, 251))
+        );
+        assert_eq!(out.len(), 400);
+    }
+}

@@ -1,0 +1,301 @@
+//! Every command the simulator takes: a fault of one channel ([`FaultCommand`]) or of the whole
+//! device ([`Disconnect`]), as typed (`rins inject`, `--inject`, fault files) and as it travels on
+//! [`ipc_types::names::SIM_CONTROL`]. Pure parsing and conversion.
+
+use std::fmt;
+
+use ipc_types::{PAYLOAD_VERSION, SimControl, SimFault};
+
+use crate::device_fault::Disconnect;
+use crate::fault_command::{ChannelId, ControlError, FaultCommand, FaultParseError};
+
+/// A validated simulator command.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SimCommand {
+    /// A fault (or its clearing) on one inertial channel.
+    Channel(FaultCommand),
+    /// The serial line unplugged for a while.
+    Disconnect(Disconnect),
+}
+
+impl SimCommand {
+    /// Builds a command from its parts as a schedule gives them: a channel for channel faults,
+    /// none for the whole device. Errors name the missing or superfluous piece.
+    pub fn new(
+        channel: Option<ChannelId>,
+        fault: SimFault,
+        param: Option<f64>,
+    ) -> Result<Self, FaultParseError> {
+        match (channel, fault) {
+            (Some(channel), _) => FaultCommand::new(channel, fault, param).map(Self::Channel),
+            (None, SimFault::Disconnect) => {
+                let Some(duration_s) = param else {
+                    return Err(FaultParseError::new(
+                        fault.name(),
+                        "needs DURATION_S (seconds the device stays unplugged)",
+                    ));
+                };
+                Disconnect::new(duration_s)
+                    .map(Self::Disconnect)
+                    .map_err(|reason| {
+                        FaultParseError::new(
+                            format!("disconnect DURATION_S = {duration_s}"),
+                            reason,
+                        )
+                    })
+            }
+            (None, _) => Err(FaultParseError::new(
+                format!("fault {:?}", fault.name()),
+                "needs a CHANNEL (gyro or accel followed by its 0-based index, e.g. gyro2)",
+            )),
+        }
+    }
+
+    /// Parses the arguments of `rins inject`: `CHANNEL FAULT [ARG]`, or `disconnect` with
+    /// `--duration SECONDS`.
+    pub fn parse_inject(
+        target: &str,
+        fault: Option<&str>,
+        arg: Option<&str>,
+        duration: Option<&str>,
+    ) -> Result<Self, FaultParseError> {
+        if target == SimFault::Disconnect.name() {
+            if let Some(extra) = fault.or(arg) {
+                return Err(FaultParseError::new(
+                    format!("disconnect {extra:?}"),
+                    "takes no channel or fault: rins inject disconnect --duration SECONDS",
+                ));
+            }
+            let Some(text) = duration else {
+                return Err(FaultParseError::new(
+                    "disconnect",
+                    "needs --duration SECONDS (how long the device stays unplugged)",
+                ));
+            };
+            return Disconnect::parse("disconnect --duration", text).map(Self::Disconnect);
+        }
+        let channel = ChannelId::parse(target)?;
+        if let Some(text) = duration {
+            return Err(FaultParseError::new(
+                format!("--duration {text:?}"),
+                "only the disconnect fault takes a duration (rins inject disconnect --duration S)",
+            ));
+        }
+        let Some(kind) = fault else {
+            return Err(FaultParseError::new(
+                format!("channel \"{channel}\""),
+                "needs a FAULT: dead, stuck, bias, ramp, noise, saturate, intermittent or clear",
+            ));
+        };
+        // A disconnect given a channel is refused by `FaultCommand::new`, naming the channel.
+        FaultCommand::parse(target, kind, arg).map(Self::Channel)
+    }
+
+    /// The fault kind.
+    pub fn fault(&self) -> SimFault {
+        match self {
+            Self::Channel(c) => c.fault,
+            Self::Disconnect(_) => SimFault::Disconnect,
+        }
+    }
+
+    /// The SI parameter (0 for faults without one).
+    pub fn param(&self) -> f64 {
+        match self {
+            Self::Channel(c) => c.param,
+            Self::Disconnect(d) => d.duration_s,
+        }
+    }
+
+    /// The channel addressed, `None` for the whole device.
+    pub fn channel(&self) -> Option<ChannelId> {
+        match self {
+            Self::Channel(c) => Some(c.channel),
+            Self::Disconnect(_) => None,
+        }
+    }
+
+    /// What the command addresses, for messages: the channel's name or `device`.
+    pub fn target(&self) -> String {
+        self.channel()
+            .map_or_else(|| "device".to_string(), |c| c.to_string())
+    }
+
+    /// Checks a channel against the block's channels; a device fault fits any block.
+    pub fn check_fitted(&self, n_gyro: usize, n_accel: usize) -> Result<(), FaultParseError> {
+        match self {
+            Self::Channel(c) => c.channel.check_fitted(n_gyro, n_accel),
+            Self::Disconnect(_) => Ok(()),
+        }
+    }
+
+    /// The IPC command.
+    pub fn to_control(&self) -> SimControl {
+        match self {
+            Self::Channel(c) => c.to_control(),
+            Self::Disconnect(d) => SimControl {
+                version: PAYLOAD_VERSION,
+                sensor: SimControl::WHOLE_DEVICE,
+                channel: 0,
+                fault: SimFault::Disconnect as u8,
+                _pad: [0; 3],
+                param: d.duration_s,
+            },
+        }
+    }
+
+    /// Decodes and validates an IPC command.
+    pub fn from_control(control: &SimControl) -> Result<Self, ControlError> {
+        if control.fault != SimFault::Disconnect as u8 {
+            return FaultCommand::from_control(control).map(Self::Channel);
+        }
+        if control.version != PAYLOAD_VERSION
+            || control.sensor != SimControl::WHOLE_DEVICE
+            || control.channel != 0
+        {
+            return Err(ControlError::Unknown);
+        }
+        Disconnect::new(control.param)
+            .map(Self::Disconnect)
+            .map_err(|_| ControlError::InvalidParameter)
+    }
+}
+
+impl fmt::Display for SimCommand {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Channel(c) => c.fmt(f),
+            Self::Disconnect(d) => d.fmt(f),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn inject(
+        target: &str,
+        fault: Option<&str>,
+        arg: Option<&str>,
+        duration: Option<&str>,
+    ) -> Result<SimCommand, FaultParseError> {
+        SimCommand::parse_inject(target, fault, arg, duration)
+    }
+
+    #[test]
+    fn every_fault_kind_round_trips_through_its_number_and_name() {
+        for (i, f) in SimFault::ALL.iter().enumerate() {
+            assert_eq!(*f as usize, i, "{f:?}");
+            assert_eq!(SimFault::from_u8(*f as u8), Some(*f));
+            assert_eq!(SimFault::from_name(f.name()), Some(*f));
+        }
+        assert_eq!(
+            SimFault::from_name("disconnect"),
+            Some(SimFault::Disconnect)
+        );
+    }
+
+    #[test]
+    fn inject_parses_a_disconnect_and_channel_faults() {
+        let d = inject("disconnect", None, None, Some("2")).unwrap();
+        assert_eq!(d, SimCommand::Disconnect(Disconnect { duration_s: 2.0 }));
+        assert_eq!(
+            (d.fault(), d.param(), d.channel()),
+            (SimFault::Disconnect, 2.0, None)
+        );
+        assert_eq!(d.target(), "device");
+        assert_eq!(d.to_string(), "disconnect 2 s");
+        assert!(d.check_fitted(0, 0).is_ok());
+        let c = inject("gyro2", Some("bias"), Some("0.5"), None).unwrap();
+        assert_eq!((c.fault(), c.param()), (SimFault::BiasStep, 0.5));
+        assert_eq!(c.target(), "gyro2");
+        assert!(c.check_fitted(2, 4).is_err());
+    }
+
+    #[test]
+    fn inject_errors_name_the_offending_piece() {
+        let e = |t, f, a, d| inject(t, f, a, d).expect_err("should be rejected");
+        let err = e("disconnect", None, None, None);
+        assert!(err.reason.contains("--duration"), "{err}");
+        let err = e("disconnect", None, None, Some("abc"));
+        assert_eq!(err.token, "disconnect --duration \"abc\"");
+        let err = e("disconnect", None, None, Some("0"));
+        assert_eq!(err.token, "disconnect --duration = 0");
+        assert!(err.reason.contains("> 0"), "{err}");
+        let err = e("disconnect", Some("gyro2"), None, Some("1"));
+        assert!(
+            err.token.contains("\"gyro2\"") && err.reason.contains("no channel"),
+            "{err}"
+        );
+        let err = e("gyro2", Some("dead"), None, Some("1"));
+        assert_eq!(err.token, "--duration \"1\"");
+        let err = e("gyro2", Some("disconnect"), None, None);
+        assert!(
+            err.token.contains("gyro2") && err.reason.contains("whole device"),
+            "{err}"
+        );
+        let err = e("gyro2", None, None, None);
+        assert!(err.reason.contains("needs a FAULT"), "{err}");
+        let err = e("gyro", Some("dead"), None, None);
+        assert!(err.token.contains("channel \"gyro\""), "{err}");
+    }
+
+    #[test]
+    fn schedule_parts_need_a_channel_exactly_for_channel_faults() {
+        let gyro2 = ChannelId::parse("gyro2").ok();
+        let d = SimCommand::new(None, SimFault::Disconnect, Some(1.5)).unwrap();
+        assert_eq!(d.param(), 1.5);
+        let err = SimCommand::new(None, SimFault::Disconnect, None).unwrap_err();
+        assert!(err.reason.contains("DURATION_S"), "{err}");
+        let err = SimCommand::new(None, SimFault::Disconnect, Some(-1.0)).unwrap_err();
+        assert_eq!(err.token, "disconnect DURATION_S = -1");
+        let err = SimCommand::new(gyro2, SimFault::Disconnect, Some(1.0)).unwrap_err();
+        assert!(err.reason.contains("whole device"), "{err}");
+        let err = SimCommand::new(None, SimFault::Dead, None).unwrap_err();
+        assert!(
+            err.token.contains("\"dead\"") && err.reason.contains("CHANNEL"),
+            "{err}"
+        );
+        assert!(SimCommand::new(gyro2, SimFault::Dead, None).is_ok());
+    }
+
+    #[test]
+    fn control_round_trips_and_rejects_malformed_disconnects() {
+        let d = SimCommand::new(None, SimFault::Disconnect, Some(0.75)).unwrap();
+        let ctl = d.to_control();
+        assert_eq!(ctl.sensor, SimControl::WHOLE_DEVICE);
+        assert_eq!(SimCommand::from_control(&ctl), Ok(d));
+        let c = inject("accel1", Some("dead"), None, None).unwrap();
+        assert_eq!(SimCommand::from_control(&c.to_control()), Ok(c));
+        let bad = [
+            (
+                SimControl { param: 0.0, ..ctl },
+                ControlError::InvalidParameter,
+            ),
+            (
+                SimControl {
+                    param: f64::NAN,
+                    ..ctl
+                },
+                ControlError::InvalidParameter,
+            ),
+            (SimControl { sensor: 0, ..ctl }, ControlError::Unknown),
+            (SimControl { channel: 3, ..ctl }, ControlError::Unknown),
+            (SimControl { version: 0, ..ctl }, ControlError::Unknown),
+        ];
+        for (control, expected) in bad {
+            assert_eq!(
+                SimCommand::from_control(&control),
+                Err(expected),
+                "{control:?}"
+            );
+        }
+        // A disconnect is never a channel's fault, whatever the sensor field says.
+        let as_channel = SimControl { sensor: 0, ..ctl };
+        assert_eq!(
+            FaultCommand::from_control(&as_channel),
+            Err(ControlError::Unknown)
+        );
+    }
+}
