@@ -207,6 +207,20 @@ pub enum ServiceName {
     Fusion,
     Altimeter,
     Navigator,
+    /// The hot-standby navigator lane.
+    NavigatorStandby,
+}
+
+impl ServiceName {
+    pub fn kind(self) -> ipc_types::ServiceKind {
+        match self {
+            ServiceName::Acquisition => ipc_types::ServiceKind::Acquisition,
+            ServiceName::Fusion => ipc_types::ServiceKind::Fusion,
+            ServiceName::Altimeter => ipc_types::ServiceKind::Altimeter,
+            ServiceName::Navigator => ipc_types::ServiceKind::Navigator,
+            ServiceName::NavigatorStandby => ipc_types::ServiceKind::NavigatorStandby,
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

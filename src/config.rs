@@ -74,6 +74,32 @@ impl DeviceConfig {
     }
 }
 
+/// Which processes `rins up` runs.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DeploymentConfig {
+    /// 1: one navigator; 2: a primary and a hot standby.
+    pub navigator_lanes: u8,
+}
+
+impl Default for DeploymentConfig {
+    fn default() -> Self {
+        Self { navigator_lanes: 2 }
+    }
+}
+
+impl DeploymentConfig {
+    pub fn validate(&self) -> Result<(), String> {
+        if !(1..=2).contains(&self.navigator_lanes) {
+            return Err(format!(
+                "deployment.navigator_lanes = {}: must be 1 or 2",
+                self.navigator_lanes
+            ));
+        }
+        Ok(())
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, Deserialize, Default)]
 #[serde(deny_unknown_fields, default)]
 pub struct RinsConfig {
@@ -84,6 +110,7 @@ pub struct RinsConfig {
     pub altimeter: AltimeterConfig,
     pub navigator: NavigatorConfig,
     pub watchdog: WatchdogConfig,
+    pub deployment: DeploymentConfig,
 }
 
 impl RinsConfig {
@@ -109,6 +136,7 @@ impl RinsConfig {
             .map_err(|e| e.within("altimeter").to_string())?;
         self.navigator.validate().map_err(|e| e.to_string())?;
         self.watchdog.validate()?;
+        self.deployment.validate()?;
         Ok(())
     }
 
@@ -212,6 +240,11 @@ mod tests {
         .unwrap_err();
         assert!(
             format!("{err}").contains("fusion.geometry.gyro.alpha_deg = 95"),
+            "{err}"
+        );
+        let err = RinsConfig::parse("[deployment]\nnavigator_lanes = 3\n", "t").unwrap_err();
+        assert!(
+            format!("{err}").contains("deployment.navigator_lanes = 3: must be 1 or 2"),
             "{err}"
         );
     }

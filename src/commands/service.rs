@@ -10,8 +10,8 @@ use crate::cli::ServiceName;
 use crate::config;
 
 pub fn run(name: ServiceName, config_path: Option<&Path>, port: Option<String>) -> Result<()> {
-    let process = format!("{name:?}").to_lowercase();
-    rins_runtime::logging::init(&process);
+    let process = name.kind().name();
+    rins_runtime::logging::init(process);
     let mut cfg = config::load(config_path)?;
     if let Some(port) = port {
         cfg.acquisition.port = Some(port);
@@ -38,8 +38,15 @@ pub fn run(name: ServiceName, config_path: Option<&Path>, port: Option<String>) 
                 .map_err(|e| anyhow!("{}", e.within("altimeter")))?;
             rins_altimeter::service::run(estimator, &settings, &shutdown)
         }
-        ServiceName::Navigator => {
-            rins_navigator::service::run(&cfg.navigator, &settings, &shutdown)
+        ServiceName::Navigator | ServiceName::NavigatorStandby => {
+            let lane = u8::from(name == ServiceName::NavigatorStandby);
+            rins_navigator::service::run(
+                &cfg.navigator,
+                &settings,
+                &shutdown,
+                lane,
+                cfg.deployment.navigator_lanes,
+            )
         }
     };
     tracing::info!(service = %process, ok = result.is_ok(), "stopped");

@@ -11,6 +11,7 @@ use rins_runtime::shm_cleanup;
 use rins_runtime::shutdown::Shutdown;
 use rins_watchdog::health_publisher::HealthPublisher;
 use rins_watchdog::monitor::{COUNTED, Monitor};
+use rins_watchdog::restart_timing::RestartTiming;
 use rins_watchdog::status::status_line;
 use rins_watchdog::summary::Summary;
 use rins_watchdog::supervisor::{ChildEvent, ChildSpec, Supervisor};
@@ -19,8 +20,16 @@ use crate::cli::UpArgs;
 use crate::commands::fault_args;
 use crate::config::{self, RinsConfig};
 
-/// Services in start order: consumers first, so that no sample is published before its subscriber exists.
-const SERVICES: [&str; 4] = ["navigator", "altimeter", "fusion", "acquisition"];
+/// Services in start order: consumers first, so that no sample is published before its subscriber
+/// exists. The hot-standby navigator lane runs when the deployment asks for two lanes.
+fn services(cfg: &RinsConfig) -> Vec<&'static str> {
+    let mut names = vec!["navigator"];
+    if cfg.deployment.navigator_lanes == 2 {
+        names.push("navigator-standby");
+    }
+    names.extend(["altimeter", "fusion", "acquisition"]);
+    names
+}
 
 /// How long the simulator may take to create its pseudo-terminal.
 const SIM_START_TIMEOUT: Duration = Duration::from_secs(10);
@@ -168,8 +177,9 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
         s => Duration::from_secs_f64(s),
     };
     let mut health = HealthPublisher::new(&node, started, silent_after)?;
+    let mut timing = RestartTiming::default();
     let outcome = (|| -> Result<()> {
-        for name in SERVICES {
+        for name in services(&cfg) {
             let mut child_args = vec!["service".to_string(), name.to_string()];
             child_args.extend(config_args.iter().cloned());
             if name == "acquisition" {
@@ -198,6 +208,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
                 supervisor: &mut supervisor,
                 monitor: &mut monitor,
                 health: &mut health,
+                timing: &mut timing,
             },
             started,
         )
@@ -206,7 +217,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     supervisor.stop_all(Duration::from_millis(cfg.watchdog.stop_grace_ms));
     // Drain what the children published while stopping, then release our own ports.
     let _ = monitor.drain();
-    let summary = summarise(&monitor, &supervisor, started.elapsed(), simulate);
+    let summary = summarise(&monitor, &supervisor, &timing, started.elapsed(), simulate);
     drop(health);
     drop(monitor);
     drop(node);
@@ -268,6 +279,7 @@ struct Watch<'a> {
     supervisor: &'a mut Supervisor,
     monitor: &'a mut Monitor,
     health: &'a mut HealthPublisher,
+    timing: &'a mut RestartTiming,
 }
 
 fn supervise(
@@ -282,6 +294,7 @@ fn supervise(
         supervisor,
         monitor,
         health,
+        timing,
     } = watch;
     let end = args.duration.map(|d| started + Duration::from_secs_f64(d));
     let period = (cfg.watchdog.status_period_s > 0.0)
@@ -292,6 +305,7 @@ fn supervise(
     let mut events = Vec::new();
     while !shutdown.requested() && end.is_none_or(|e| Instant::now() < e) {
         monitor.drain()?;
+        timing.observe(Instant::now(), |kind| monitor.output_count(kind));
         supervisor.poll(&mut events);
         if let Some(report) = health.tick(supervisor, monitor)?
             && cfg.watchdog.heartbeat_timeout_s > 0.0
@@ -306,6 +320,11 @@ fn supervise(
                     restart_in,
                 } => {
                     tracing::warn!(child = %name, %status, restart_in_ms = restart_in.as_millis() as u64, "child exited");
+                    if let Some(kind) = ipc_types::ServiceKind::from_name(&name)
+                        && let Some(count) = monitor.output_count(kind)
+                    {
+                        timing.on_exit(kind, Instant::now(), count);
+                    }
                     // Its node is dead now: free its shared memory before the restart.
                     match rins_runtime::ipc::remove_dead_nodes(settings) {
                         Ok(n) if n > 0 => {
@@ -350,9 +369,11 @@ fn supervise(
 fn summarise(
     monitor: &Monitor,
     supervisor: &Supervisor,
+    timing: &RestartTiming,
     elapsed: Duration,
     simulate: bool,
 ) -> Summary {
+    let (restart_worst, restart_measurements) = timing.worst();
     let device = monitor.device_counters();
     let acc = &monitor.accuracy;
     let sim = |v: Option<f64>| if simulate { v } else { None };
@@ -366,6 +387,16 @@ fn summarise(
         lost_frames: device.lost_frames,
         nav_samples: monitor.totals[5],
         restarts: supervisor.restarts(),
+        restart_to_publish_ms_max: restart_worst.as_secs_f64() * 1e3,
+        restart_measurements,
+        restart_to_publish_ms_by_service: timing
+            .by_kind()
+            .into_iter()
+            .map(|(kind, worst, n)| (kind.name().to_string(), worst.as_secs_f64() * 1e3, n))
+            .collect(),
+        nav_lane_samples: monitor.nav_lanes().lane_totals(),
+        nav_lane_switches: monitor.nav_lanes().switches().0,
+        nav_lane_filled: monitor.nav_lanes().filled(),
         att_err_deg_rms: sim(acc.attitude_deg.rms()),
         att_err_deg_max: sim(acc.attitude_deg.max()),
         alt_err_m_rms: sim(acc.altitude_m.rms()),

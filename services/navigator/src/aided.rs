@@ -107,6 +107,9 @@ pub struct AidedNavigator {
     pub(crate) last_reading_us: [Option<u64>; AidingSource::COUNT],
     /// Device time navigation started, µs.
     pub(crate) navigating_since_us: Option<u64>,
+    /// The magnetometer reference comes from the first sample after a takeover (there was no
+    /// alignment window of our own to take it from).
+    pub(crate) reference_from_next_mag: bool,
 }
 
 impl AidedNavigator {
@@ -127,7 +130,32 @@ impl AidedNavigator {
             last_mag_update_us: None,
             last_reading_us: [None; AidingSource::COUNT],
             navigating_since_us: None,
+            reference_from_next_mag: false,
         }
+    }
+
+    /// Navigates from now on from another filter's solution at device time `t_us`: its nominal
+    /// state, bias estimates and error variances (`covariance_diag`, correlations unknown). The
+    /// altitude is already baro-aided, so no baro reading re-sets it; the magnetometer reference
+    /// is taken from the next magnetometer sample at the taken-over attitude.
+    pub fn take_over(
+        &mut self,
+        t_us: u64,
+        state: NominalState,
+        bias: ImuBias,
+        covariance_diag: &[f64; crate::ekf::STATES],
+    ) {
+        let mut ekf = ErrorStateEkf::new(state, bias, self.config.strapdown, self.config.noise);
+        ekf.set_covariance_diagonal(covariance_diag);
+        self.stance = StanceDetector::new(self.config.stance);
+        self.alignment = None;
+        self.last_align_error = None;
+        self.last_time_us = Some(t_us);
+        self.initial_height_m = Some(state.alt);
+        self.field_reference = None;
+        self.reference_from_next_mag = true;
+        self.navigating_since_us = Some(t_us);
+        self.phase = Phase::Navigating(ekf);
     }
 
     /// True when `source` is in use but has gone quiet: no valid reading for `stale_after_s`

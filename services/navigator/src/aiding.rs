@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::aided::AidedNavigator;
 use crate::ekf::{AidingSource, POS, UpdateOutcome};
-use crate::mag_heading::{adaptive_sigma, measured_heading};
+use crate::mag_heading::{FieldReference, adaptive_sigma, measured_heading};
 
 /// Settings of the barometric height aiding (`[navigator.baro]`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -148,6 +148,14 @@ impl AidedNavigator {
             && (t_us.saturating_sub(last) as f64) < 1e6 / c.max_rate_hz
         {
             return AidingOutcome::Skipped;
+        }
+        if self.field_reference.is_none()
+            && self.reference_from_next_mag
+            && let Some(ekf) = self.ekf()
+        {
+            let attitude = ekf.state().attitude;
+            self.field_reference = FieldReference::from_field(&Vector3::from(field), &attitude);
+            self.reference_from_next_mag = false;
         }
         let Some(reference) = self.field_reference else {
             return AidingOutcome::Skipped;

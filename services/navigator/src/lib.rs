@@ -18,6 +18,7 @@ pub mod mechanisation;
 pub mod navigator;
 pub mod service;
 pub mod stance;
+pub mod takeover;
 
 pub use alignment::{AlignConfig, AlignError, Alignment, StaticAligner};
 pub use config::{ConfigError, NavigatorConfig};

@@ -21,6 +21,7 @@ use crate::attitude::quaternion_to_array;
 use crate::config::{ConfigError, NavigatorConfig};
 use crate::ekf::{AidingCounts, AidingSource, ErrorStateEkf};
 use crate::mechanisation::{NominalState, StepOutcome};
+use crate::takeover::{TakeOverError, peer_solution};
 
 /// One navigation solution.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -47,6 +48,9 @@ pub struct NavOutput {
     pub covariance_diag: [f64; NAV_STATES],
     /// Accepted and gated-out updates per [`AidingSource`] since alignment.
     pub counts: [AidingCounts; AidingSource::COUNT],
+    /// Estimated gyro bias (rad/s) and accelerometer bias (m/s²), body FRD.
+    pub gyro_bias_rps: [f64; 3],
+    pub accel_bias_mps2: [f64; 3],
 }
 
 impl NavOutput {
@@ -60,6 +64,8 @@ impl NavOutput {
         out.longitude_rad = self.lon;
         out.altitude_m = self.alt;
         out.covariance_diag = self.covariance_diag;
+        out.gyro_bias_rps = self.gyro_bias_rps;
+        out.accel_bias_mps2 = self.accel_bias_mps2;
         for (k, c) in self.counts.iter().enumerate() {
             out.aiding_accepted[k] = u32::try_from(c.accepted).unwrap_or(u32::MAX);
             out.aiding_rejected[k] = u32::try_from(c.rejected).unwrap_or(u32::MAX);
@@ -102,6 +108,20 @@ impl Navigator {
             rejected_imu_samples: 0,
             config,
         })
+    }
+
+    /// Navigates from now on from the other lane's solution in `peer` (see [`crate::takeover`]);
+    /// the next IMU sample propagates from the peer's device time.
+    pub fn take_over(&mut self, peer: &NavState) -> Result<(), TakeOverError> {
+        let sol = peer_solution(peer)?;
+        self.core.take_over(
+            sol.device_time_us,
+            sol.state,
+            sol.bias,
+            &sol.covariance_diag,
+        );
+        self.state_time_us = sol.device_time_us;
+        Ok(())
     }
 
     /// Drops the solution and starts a new alignment window.
@@ -204,7 +224,10 @@ impl Navigator {
         let mut aiding_bits = 0;
         let mut counts = [AidingCounts::default(); AidingSource::COUNT];
         let mut covariance_diag = [0.0; NAV_STATES];
+        let (mut gyro_bias_rps, mut accel_bias_mps2) = ([0.0; 3], [0.0; 3]);
         if let Some(ekf) = ekf {
+            let b = ekf.bias();
+            (gyro_bias_rps, accel_bias_mps2) = (b.gyro_rps.into(), b.accel_mps2.into());
             for (source, bit) in SOURCE_BITS {
                 let recent = self.core.last_accepted_us(source).is_some_and(|t| {
                     self.state_time_us <= t.saturating_add(self.aiding_timeout_us)
@@ -247,6 +270,8 @@ impl Navigator {
             aiding: aiding_bits,
             covariance_diag,
             counts,
+            gyro_bias_rps,
+            accel_bias_mps2,
         }
     }
 }

@@ -4,9 +4,10 @@
 
 use std::time::Duration;
 
-use anyhow::{Result, anyhow};
+use anyhow::{Result, anyhow, bail};
 use ipc_types::{
-    Altitude, FusedImu, Health, NavState, PAYLOAD_VERSION, RawMag, ServiceKind, Stage, names,
+    Altitude, FusedImu, Health, NavMode, NavState, PAYLOAD_VERSION, RawMag, ServiceKind, Stage,
+    names,
 };
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::heartbeat::Heartbeat;
@@ -15,6 +16,7 @@ use rins_runtime::shutdown::Shutdown;
 
 use crate::config::NavigatorConfig;
 use crate::navigator::{Navigator, fused_sample_usable};
+use crate::takeover::Handover;
 
 const WAIT: Duration = Duration::from_millis(100);
 
@@ -36,19 +38,84 @@ pub fn step(nav: &mut Navigator, imu: &FusedImu, last: &NavState) -> NavState {
     } else {
         out.mode = nav.mode() as u8;
     }
+    // The first sample of a solution marks its start; aligning has none.
+    out.solution_start_seq = match NavMode::from_u8(out.mode) {
+        NavMode::Aligning => 0,
+        _ if last.solution_start_seq == 0 => imu.header.origin_seq,
+        _ => last.solution_start_seq,
+    };
     out
 }
 
-pub fn run(config: &NavigatorConfig, settings: &IpcSettings, shutdown: &Shutdown) -> Result<()> {
+/// Runs navigator lane `lane` of `lanes` (lane 0 is the primary, lane 1 the hot standby); each
+/// lane publishes on its own topic, [`names::NAV_LANES`].
+/// When the handover has a peer solution to take over: takes it, integrates the fused IMU samples
+/// kept since, and returns `Some(state of the newest kept sample)` — or `Some(None)` when the peer
+/// is ahead of every kept sample (`last` then stands at the peer's sequence number, so samples up
+/// to it are skipped). `None` while no takeover is possible.
+fn take_over_if_ready(
+    nav: &mut Navigator,
+    handover: &mut Handover,
+    last: &mut NavState,
+) -> Option<Option<NavState>> {
+    let peer = handover.ready()?;
+    nav.take_over(&peer).ok()?;
+    let seq = peer.header.origin_seq;
+    tracing::info!(
+        peer_seq = seq,
+        peer_lane = peer.lane,
+        "took over the other lane's solution"
+    );
+    *last = NavState {
+        header: peer.header,
+        lane: last.lane,
+        solution_start_seq: 0,
+        ..peer
+    };
+    let mut newest = None;
+    for imu in handover.replay(seq) {
+        let state = step(nav, imu, last);
+        *last = state;
+        newest = Some(state);
+    }
+    handover.clear();
+    Some(newest)
+}
+
+pub fn run(
+    config: &NavigatorConfig,
+    settings: &IpcSettings,
+    shutdown: &Shutdown,
+    lane: u8,
+    lanes: u8,
+) -> Result<()> {
+    let kind = match (lane, lanes) {
+        (0, 1 | 2) => ServiceKind::Navigator,
+        (1, 2) => ServiceKind::NavigatorStandby,
+        _ => bail!("navigator lane {lane} of {lanes}: lanes must be 1 or 2 and lane below it"),
+    };
     let mut nav = Navigator::new(config.clone()).map_err(|e| anyhow!("{e}"))?;
-    let node = create_node("navigator", settings)?;
+    let node = create_node(kind.name(), settings)?;
     let imu_in = TopicSubscriber::<FusedImu>::new(&node, names::FUSED_IMU)?;
     let alt_in = TopicSubscriber::<Altitude>::new(&node, names::ALTITUDE)?;
     let mag_in = TopicSubscriber::<RawMag>::new(&node, names::RAW_MAG)?;
-    let output = TopicPublisher::<NavState>::new(&node, names::NAV_STATE)?;
-    let mut heartbeat = Heartbeat::new(&node, ServiceKind::Navigator)?;
+    let output = TopicPublisher::<NavState>::new(&node, names::NAV_LANES[usize::from(lane)])?;
+    let mut heartbeat = Heartbeat::new(&node, kind)?;
     let mut counters = Health::default();
-    let mut last = NavState::default();
+    let mut last = NavState {
+        lane,
+        ..NavState::default()
+    };
+    // With two lanes, a lane that aligns listens to its peer: restarted in flight, it takes the
+    // peer's solution over instead of waiting for a rest it will not get (see `takeover`).
+    let peer_in = match lanes {
+        2 => Some(TopicSubscriber::<NavState>::new(
+            &node,
+            names::NAV_LANES[usize::from(1 - lane)],
+        )?),
+        _ => None,
+    };
+    let mut handover = Handover::default();
 
     while !shutdown.requested() {
         imu_in.wait(WAIT)?;
@@ -75,13 +142,36 @@ pub fn run(config: &NavigatorConfig, settings: &IpcSettings, shutdown: &Shutdown
                 counters.rejected += 1;
             }
         }
+        let listening = peer_in.as_ref().filter(|_| nav.mode() == NavMode::Aligning);
+        if let Some(peer_in) = listening {
+            while let Some(peer) = peer_in.receive()? {
+                handover.push_peer(peer);
+            }
+        }
         while let Some(imu) = imu_in.receive()? {
             counters.received += 1;
             if imu.version != PAYLOAD_VERSION {
                 counters.rejected += 1;
                 continue;
             }
-            let mut state = step(&mut nav, &imu, &last);
+            // A restarted fusion replays the raw IMU history it missed, starting before its last
+            // output: samples already integrated are skipped, not integrated twice.
+            if last.header.origin_seq != 0 && imu.header.origin_seq <= last.header.origin_seq {
+                continue;
+            }
+            let taken_over = match listening {
+                Some(_) if nav.mode() == NavMode::Aligning => {
+                    handover.push_imu(imu);
+                    take_over_if_ready(&mut nav, &mut handover, &mut last)
+                }
+                _ => None,
+            };
+            let mut state = match taken_over {
+                Some(Some(state)) => state,
+                // The peer's solution is ahead of this sample: nothing to publish for it.
+                Some(None) => continue,
+                None => step(&mut nav, &imu, &last),
+            };
             state.version = PAYLOAD_VERSION;
             state.header.stamp(Stage::Navigator, monotonic_ns());
             output.publish(state)?;

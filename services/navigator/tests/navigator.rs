@@ -260,9 +260,13 @@ fn output_fills_the_ipc_payload() {
             },
             AidingCounts::default(),
         ],
+        gyro_bias_rps: [1e-3, -2e-3, 3e-3],
+        accel_bias_mps2: [0.1, 0.2, -0.3],
     };
     let mut state = NavState::default();
     out.write_nav_state(&mut state);
+    assert_eq!(state.gyro_bias_rps, [1e-3, -2e-3, 3e-3]);
+    assert_eq!(state.accel_bias_mps2, [0.1, 0.2, -0.3]);
     assert_eq!(state.mode, NavMode::Navigating as u8);
     assert_eq!(state.aiding, aiding::BARO | aiding::ZUPT);
     assert_eq!(state.covariance_diag, out.covariance_diag);

@@ -44,13 +44,13 @@ pub struct SelectorConfig {
 }
 
 impl Default for SelectorConfig {
-    /// At 400 Hz: a dead lane is left after 20 ms, a solution trusted after 2 s, at most one quality
-    /// switch per second.
+    /// At the block's 1 kHz: a dead lane is left after 8 ms, a solution trusted after 2 s, at most
+    /// one quality switch per second.
     fn default() -> Self {
         Self {
             switch_lag: 8,
-            settle: 800,
-            min_dwell: 400,
+            settle: 2000,
+            min_dwell: 1000,
         }
     }
 }

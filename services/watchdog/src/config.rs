@@ -11,7 +11,9 @@ use crate::restart_policy::RestartPolicy;
 pub struct WatchdogConfig {
     pub restart_initial_backoff_ms: u64,
     pub restart_max_backoff_ms: u64,
-    /// A child that ran this long has its failure count reset.
+    /// A child that ran this long has its failure count reset. A crash loop (a child dying within
+    /// this time of its start) backs off exponentially; a child that ran for a while and was killed
+    /// comes back after the initial backoff, which keeps a killed service's outage short.
     pub restart_stable_after_s: f64,
     /// How long children get to stop after SIGTERM before they are killed.
     pub stop_grace_ms: u64,
@@ -27,7 +29,7 @@ impl Default for WatchdogConfig {
         Self {
             restart_initial_backoff_ms: 10,
             restart_max_backoff_ms: 5_000,
-            restart_stable_after_s: 10.0,
+            restart_stable_after_s: 1.0,
             stop_grace_ms: 2_000,
             status_period_s: 1.0,
             heartbeat_timeout_s: 3.0,

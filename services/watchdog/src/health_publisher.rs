@@ -9,23 +9,11 @@ use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{IpcNode, TopicPublisher};
 
 use crate::health_report::{ProcessView, build_report};
-use crate::monitor::{COUNTED, HeartbeatSeen, Monitor};
+use crate::monitor::{HeartbeatSeen, Monitor};
 use crate::supervisor::Supervisor;
 
 /// Report period.
 pub const PERIOD: Duration = Duration::from_millis(250);
-
-/// The topic of [`COUNTED`] each process publishes (`None`: none the monitor counts).
-fn output_topic(kind: ServiceKind) -> Option<usize> {
-    let name = match kind {
-        ServiceKind::Acquisition => "imu",
-        ServiceKind::Fusion => "fused",
-        ServiceKind::Altimeter => "alt",
-        ServiceKind::Navigator | ServiceKind::NavigatorStandby => "nav",
-        ServiceKind::Simulator | ServiceKind::Watchdog => return None,
-    };
-    COUNTED.iter().position(|c| *c == name)
-}
 
 pub struct HealthPublisher {
     publisher: TopicPublisher<HealthReport>,
@@ -34,7 +22,8 @@ pub struct HealthPublisher {
     started: Instant,
     next_due: Instant,
     last_at: Instant,
-    last_totals: [u64; COUNTED.len()],
+    /// Output counts per [`ServiceKind`] at the previous report.
+    last_outputs: [u64; ServiceKind::ALL.len()],
 }
 
 impl HealthPublisher {
@@ -46,7 +35,7 @@ impl HealthPublisher {
             started,
             next_due: now,
             last_at: now,
-            last_totals: [0; COUNTED.len()],
+            last_outputs: [0; ServiceKind::ALL.len()],
         })
     }
 
@@ -63,7 +52,6 @@ impl HealthPublisher {
         self.next_due = now + PERIOD;
         let dt = now.duration_since(self.last_at).as_secs_f64().max(1e-3);
         self.last_at = now;
-        let totals = monitor.totals;
         let me = std::process::id();
         let watchdog = ProcessView {
             kind: ServiceKind::Watchdog,
@@ -79,8 +67,8 @@ impl HealthPublisher {
         let views: Vec<ProcessView> = std::iter::once(watchdog)
             .chain(supervisor.children().into_iter().filter_map(|child| {
                 let kind = ServiceKind::from_name(&child.name)?;
-                let output_rate_hz = output_topic(kind).map_or(f64::NAN, |i| {
-                    totals[i].saturating_sub(self.last_totals[i]) as f64 / dt
+                let output_rate_hz = monitor.output_count(kind).map_or(f64::NAN, |n| {
+                    n.saturating_sub(self.last_outputs[kind as usize]) as f64 / dt
                 });
                 Some(ProcessView {
                     kind,
@@ -91,7 +79,11 @@ impl HealthPublisher {
                 })
             }))
             .collect();
-        self.last_totals = totals;
+        for kind in ServiceKind::ALL {
+            if let Some(n) = monitor.output_count(kind) {
+                self.last_outputs[kind as usize] = n;
+            }
+        }
         let report = build_report(
             monotonic_ns(),
             self.started.elapsed().as_millis() as u64,

@@ -18,7 +18,7 @@ impl Default for RestartPolicy {
         Self {
             initial_backoff: Duration::from_millis(10),
             max_backoff: Duration::from_secs(5),
-            stable_after: Duration::from_secs(10),
+            stable_after: Duration::from_secs(1),
         }
     }
 }

@@ -19,6 +19,17 @@ pub struct Summary {
     pub lost_frames: u64,
     pub nav_samples: u64,
     pub restarts: u64,
+    /// Longest time from a child's exit to the first sample of its output topic from its
+    /// successor, ms, and how many restarts were timed so (0 and 0 without restarts).
+    pub restart_to_publish_ms_max: f64,
+    pub restart_measurements: u64,
+    /// Per service: name, longest exit-to-publish time (ms), restarts timed.
+    pub restart_to_publish_ms_by_service: Vec<(String, f64, u64)>,
+    /// Samples received from each navigator lane; lane changes of the selector and samples it took
+    /// from the other lane to fill a hole of the delivering one.
+    pub nav_lane_samples: [u64; 2],
+    pub nav_lane_switches: u64,
+    pub nav_lane_filled: u64,
     /// Attitude error against simulator truth after alignment, degrees (simulator mode only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub att_err_deg_rms: Option<f64>,

@@ -199,6 +199,8 @@ mod tests {
             aiding: ipc_types::aiding::BARO | ipc_types::aiding::MAG,
             covariance_diag: [0.0; ipc_types::NAV_STATES],
             counts: Default::default(),
+            gyro_bias_rps: [0.0; 3],
+            accel_bias_mps2: [0.0; 3],
         }
     }
 

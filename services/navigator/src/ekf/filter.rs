@@ -162,6 +162,12 @@ impl ErrorStateEkf {
         self.p[(i, i)] = variance;
     }
 
+    /// Replaces the covariance by the diagonal `variances` (correlations dropped): a filter that
+    /// takes over another's solution knows its uncertainties but not their correlations.
+    pub fn set_covariance_diagonal(&mut self, variances: &[f64; STATES]) {
+        self.p = Covariance::from_diagonal(&SVector::<f64, STATES>::from_column_slice(variances));
+    }
+
     /// Standard deviation of error component `i`.
     pub fn sigma(&self, i: usize) -> f64 {
         self.p[(i, i)].max(0.0).sqrt()

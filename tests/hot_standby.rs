@@ -1,0 +1,132 @@
+//! The hot-standby navigator in flight: SIGKILL the navigator lane that delivers, and the stream
+//! consumers read stays contiguous (no sequence number missing), switches to the other lane, and
+//! keeps navigating; the killed lane comes back by taking over its peer's solution, so the peer can
+//! be killed next and the stream goes on, still navigating.
+
+mod common;
+
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Stdio};
+use std::sync::mpsc::{Receiver, channel};
+use std::time::{Duration, Instant};
+
+use common::{Isolated, PipelineSlot, last_json, num, spawn_up, stop_up};
+use serde_json::Value;
+
+/// One navigation sample as `rins echo nav` prints it.
+#[derive(Debug, Clone, Copy)]
+struct Sample {
+    seq: u64,
+    lane: u64,
+    mode: u64,
+}
+
+/// `rins echo nav` in the background, its samples on a channel.
+fn echo_nav(ipc: &Isolated) -> (Child, Receiver<Sample>) {
+    let mut child = ipc
+        .command()
+        .args(["echo", "nav", "--timeout", "60"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("cannot start rins echo");
+    let stdout = child.stdout.take().expect("echo stdout");
+    let (tx, rx) = channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+            let v: Value = serde_json::from_str(&line).expect("echo prints JSON");
+            let sample = Sample {
+                seq: v["header"]["origin_seq"].as_u64().expect("origin_seq"),
+                lane: v["lane"].as_u64().expect("lane"),
+                mode: v["mode"].as_u64().expect("mode"),
+            };
+            if tx.send(sample).is_err() {
+                break;
+            }
+        }
+    });
+    (child, rx)
+}
+
+fn pid_of(ipc: &Isolated, name: &str) -> libc::pid_t {
+    let out = ipc.run(&["status", "--json", "--timeout", "10"]);
+    assert!(out.status.success());
+    let report = last_json(&out);
+    let service = report["services"]
+        .as_array()
+        .expect("services")
+        .iter()
+        .find(|s| s["service"] == name && s["state"] == "running")
+        .unwrap_or_else(|| panic!("{name} not running: {report}"))
+        .clone();
+    libc::pid_t::try_from(service["pid"].as_u64().expect("pid")).expect("pid fits")
+}
+
+/// Takes samples for `span`, checking that each one follows the previous without a gap.
+fn follow(rx: &Receiver<Sample>, last: &mut u64, span: Duration) -> Vec<Sample> {
+    let end = Instant::now() + span;
+    let mut got = Vec::new();
+    while Instant::now() < end {
+        let s = rx
+            .recv_timeout(Duration::from_secs(5))
+            .expect("navigation stream stopped");
+        assert_eq!(s.seq, *last + 1, "gap or repeat after {last}: {s:?}");
+        *last = s.seq;
+        got.push(s);
+    }
+    got
+}
+
+const NAVIGATING: u64 = 1;
+
+#[test]
+fn killing_either_navigator_lane_loses_no_sample_and_navigation_goes_on() {
+    let _slot = PipelineSlot::take();
+    let ipc = Isolated::new("standby");
+    let up = spawn_up(&ipc, &["--scenario", "uav", "--duration", "300", "--json"]);
+    let (mut echo, rx) = echo_nav(&ipc);
+    // Alignment (3 s at rest in the scenario) and the lane selector's 2 s settling time.
+    let first = rx
+        .recv_timeout(Duration::from_secs(120))
+        .expect("no navigation output");
+    let mut last = first.seq;
+    let warm = follow(&rx, &mut last, Duration::from_secs(8));
+    assert!(
+        warm.iter()
+            .rev()
+            .take(100)
+            .all(|s| s.mode == NAVIGATING && s.lane == 0)
+    );
+
+    // Kill the primary: the standby delivers from the next sequence number on.
+    let primary = pid_of(&ipc, "navigator");
+    // SAFETY: a signal to a process of this test's own pipeline.
+    assert_eq!(unsafe { libc::kill(primary, libc::SIGKILL) }, 0);
+    let after_first = follow(&rx, &mut last, Duration::from_secs(6));
+    assert!(
+        after_first.iter().all(|s| s.mode == NAVIGATING),
+        "stopped navigating"
+    );
+    assert_eq!(after_first.last().map(|s| s.lane), Some(1));
+
+    // The primary was restarted in flight: it took over the standby's solution (a static
+    // alignment is impossible while flying) and has settled by now. Kill the standby.
+    let standby = pid_of(&ipc, "navigator-standby");
+    assert_ne!(pid_of(&ipc, "navigator"), primary);
+    // SAFETY: as above.
+    assert_eq!(unsafe { libc::kill(standby, libc::SIGKILL) }, 0);
+    let after_second = follow(&rx, &mut last, Duration::from_secs(4));
+    assert!(
+        after_second.iter().all(|s| s.mode == NAVIGATING),
+        "the restarted primary is not navigating"
+    );
+    assert_eq!(after_second.last().map(|s| s.lane), Some(0));
+
+    // SAFETY: our own child.
+    unsafe { libc::kill(echo.id() as libc::pid_t, libc::SIGTERM) };
+    let _ = echo.wait();
+    let summary = stop_up(&ipc, up);
+    assert_eq!(num(&summary, "restarts"), 2.0, "{summary}");
+    // The taken-over solution is as good as the one it came from (same bound as the uav run).
+    assert!(num(&summary, "att_err_deg_max") < 3.0, "{summary}");
+}

@@ -1,0 +1,145 @@
+//! Fifty SIGKILLs under a running pipeline, one service after the other: every service comes back
+//! and publishes within 100 ms of its death, the watchdog survives, no zombie is left, and the
+//! shared memory of the deployment does not grow.
+
+mod common;
+
+use std::time::{Duration, Instant};
+
+use common::{Isolated, PipelineSlot, last_json, num, spawn_up, stop_up};
+use serde_json::Value;
+
+const KILLS: usize = 50;
+const VICTIMS: [&str; 5] = [
+    "fusion",
+    "altimeter",
+    "acquisition",
+    "navigator",
+    "navigator-standby",
+];
+
+fn report(ipc: &Isolated) -> Value {
+    let out = ipc.run(&["status", "--json", "--timeout", "10"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    last_json(&out)
+}
+
+/// (name, pid) of every service the report shows running; `None` until all of them are.
+fn all_running(report: &Value) -> Option<Vec<(String, u64)>> {
+    let services = report["services"].as_array()?;
+    services
+        .iter()
+        .map(|s| {
+            (s["state"] == "running").then(|| {
+                (
+                    s["service"].as_str().unwrap_or_default().to_string(),
+                    s["pid"].as_u64().unwrap_or(0),
+                )
+            })
+        })
+        .collect()
+}
+
+fn wait_all_running(ipc: &Isolated, limit: Duration) -> Vec<(String, u64)> {
+    let start = Instant::now();
+    loop {
+        let r = report(ipc);
+        if let Some(pids) = all_running(&r) {
+            return pids;
+        }
+        assert!(start.elapsed() < limit, "not everything came back: {r}");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+/// Children of `parent` in state Z (exited, not reaped).
+fn zombies_of(parent: u64) -> Vec<u64> {
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir("/proc").expect("/proc").flatten() {
+        let Ok(pid) = entry.file_name().to_string_lossy().parse::<u64>() else {
+            continue;
+        };
+        let Ok(stat) = std::fs::read_to_string(format!("/proc/{pid}/stat")) else {
+            continue;
+        };
+        // "pid (comm) state ppid ...": the command may hold spaces, so split after the ')'.
+        let Some(rest) = stat.rsplit_once(')').map(|(_, r)| r) else {
+            continue;
+        };
+        let mut fields = rest.split_whitespace();
+        let (state, ppid) = (fields.next(), fields.next().and_then(|p| p.parse().ok()));
+        if state == Some("Z") && ppid == Some(parent) {
+            found.push(pid);
+        }
+    }
+    found
+}
+
+#[test]
+fn fifty_kills_leave_no_zombie_no_shared_memory_growth_and_a_live_watchdog() {
+    let _slot = PipelineSlot::take();
+    let ipc = Isolated::new("storm");
+    let up = spawn_up(
+        &ipc,
+        &["--scenario", "static", "--duration", "600", "--json"],
+    );
+    let first = ipc.run(&["echo", "nav", "--count", "1", "--timeout", "120"]);
+    assert!(first.status.success());
+    let pids = wait_all_running(&ipc, Duration::from_secs(30));
+    let watchdog = pids
+        .iter()
+        .find(|(n, _)| n == "watchdog")
+        .map(|p| p.1)
+        .expect("watchdog");
+    let shm_before = ipc.shm_entries().len();
+
+    let mut killed = Vec::new();
+    for k in 0..KILLS {
+        let victim = VICTIMS[k % VICTIMS.len()];
+        let pids = wait_all_running(&ipc, Duration::from_secs(20));
+        let (_, pid) = pids
+            .iter()
+            .find(|(n, _)| n == victim)
+            .unwrap_or_else(|| panic!("no {victim} in {pids:?}"));
+        let pid = libc::pid_t::try_from(*pid).expect("pid fits");
+        // SAFETY: a signal to a process of this test's own pipeline.
+        assert_eq!(unsafe { libc::kill(pid, libc::SIGKILL) }, 0, "{victim}");
+        killed.push(pid);
+    }
+    let after = wait_all_running(&ipc, Duration::from_secs(20));
+    let watchdog_after = after.iter().find(|(n, _)| n == "watchdog").map(|p| p.1);
+    assert_eq!(watchdog_after, Some(watchdog), "the watchdog changed");
+    assert_eq!(zombies_of(watchdog), Vec::<u64>::new());
+    for pid in killed {
+        // Reaped: the pid no longer names a process of ours (kill with signal 0 fails), or it
+        // was reused by an unrelated process, which /proc shows without our watchdog as parent.
+        let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap_or_default();
+        let ppid = stat
+            .rsplit_once(')')
+            .and_then(|(_, r)| r.split_whitespace().nth(1))
+            .and_then(|p| p.parse::<u64>().ok());
+        assert_ne!(ppid, Some(watchdog), "pid {pid} still a child: {stat}");
+    }
+    // Restarted processes create their ports anew and the dead ones' are removed: the count of
+    // shared-memory entries is what it was before the first kill.
+    assert_eq!(
+        ipc.shm_entries().len(),
+        shm_before,
+        "{:?}",
+        ipc.shm_entries()
+    );
+
+    let summary = stop_up(&ipc, up);
+    // The figures for the record (`cargo test --test kill_storm -- --nocapture`).
+    eprintln!("{summary}");
+    assert_eq!(num(&summary, "restarts"), KILLS as f64, "{summary}");
+    assert!(
+        num(&summary, "restart_to_publish_ms_max") <= 100.0,
+        "{summary}"
+    );
+    assert_eq!(num(&summary, "restart_measurements"), KILLS as f64);
+}
