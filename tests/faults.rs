@@ -5,15 +5,11 @@
 mod common;
 
 use std::io::{BufRead, BufReader, Write};
-use std::process::{Child, Output, Stdio};
+use std::process::{Child, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use common::{Isolated, last_json, num};
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+use common::{Isolated, last_json, num, stderr};
 
 fn fails_with(ipc: &Isolated, args: &[&str], expected: &[&str]) {
     let out = ipc.run(args);
@@ -22,30 +18,6 @@ fn fails_with(ipc: &Isolated, args: &[&str], expected: &[&str]) {
     for e in expected {
         assert!(err.contains(e), "{args:?}: stderr lacks {e:?}:\n{err}");
     }
-}
-
-/// Runs `rins args` and kills it if it has not finished within `limit`.
-fn run_with_timeout(ipc: &Isolated, args: &[&str], limit: Duration) -> Output {
-    let mut child = ipc
-        .command()
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("cannot run rins");
-    let deadline = Instant::now() + limit;
-    while child.try_wait().expect("cannot poll child").is_none() {
-        if Instant::now() >= deadline {
-            let _ = child.kill();
-            let out = child.wait_with_output().expect("cannot collect output");
-            panic!(
-                "rins {args:?} did not finish within {limit:?}\nstderr:\n{}",
-                stderr(&out)
-            );
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    child.wait_with_output().expect("cannot collect output")
 }
 
 #[test]
@@ -279,8 +251,7 @@ impl Pipeline {
 
 /// Valid-mask bit of gyro `i` in the last of a few raw IMU frames.
 fn gyro_valid(ipc: &Isolated, i: u32) -> bool {
-    let out = run_with_timeout(
-        ipc,
+    let out = ipc.run_with_timeout(
         &["echo", "raw-imu", "--count", "3"],
         Duration::from_secs(10),
     );
@@ -302,7 +273,7 @@ fn runtime_inject_kills_and_revives_a_channel() {
     up.wait_running(Duration::from_secs(30));
 
     assert!(gyro_valid(&ipc, 2), "gyro2 must start valid");
-    let out = run_with_timeout(&ipc, &["inject", "gyro2", "dead"], Duration::from_secs(10));
+    let out = ipc.run_with_timeout(&["inject", "gyro2", "dead"], Duration::from_secs(10));
     assert!(out.status.success(), "inject failed:\n{}", stderr(&out));
     let said = String::from_utf8_lossy(&out.stdout);
     assert!(
@@ -315,12 +286,12 @@ fn runtime_inject_kills_and_revives_a_channel() {
     );
     assert!(gyro_valid(&ipc, 1), "other gyros stay valid");
 
-    let out = run_with_timeout(&ipc, &["inject", "gyro2", "clear"], Duration::from_secs(10));
+    let out = ipc.run_with_timeout(&["inject", "gyro2", "clear"], Duration::from_secs(10));
     assert!(out.status.success(), "clear failed:\n{}", stderr(&out));
     assert!(gyro_valid(&ipc, 2), "gyro2 must be valid after clear");
 
     // The block has 4 gyros: the simulator refuses gyro9, and says so.
-    let out = run_with_timeout(&ipc, &["inject", "gyro9", "dead"], Duration::from_secs(10));
+    let out = ipc.run_with_timeout(&["inject", "gyro9", "dead"], Duration::from_secs(10));
     assert!(!out.status.success(), "gyro9 must be refused");
     assert!(
         stderr(&out).contains("channel \"gyro9\": the simulated sensor block has no such channel"),

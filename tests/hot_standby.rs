@@ -10,7 +10,7 @@ use std::process::{Child, Stdio};
 use std::sync::mpsc::{Receiver, channel};
 use std::time::{Duration, Instant};
 
-use common::{Isolated, PipelineSlot, last_json, num, spawn_up, stop_up};
+use common::{Isolated, PipelineSlot, num, spawn_up, stop_up};
 use serde_json::Value;
 
 /// One navigation sample as `rins echo nav` prints it.
@@ -49,9 +49,7 @@ fn echo_nav(ipc: &Isolated) -> (Child, Receiver<Sample>) {
 }
 
 fn pid_of(ipc: &Isolated, name: &str) -> libc::pid_t {
-    let out = ipc.run(&["status", "--json", "--timeout", "10"]);
-    assert!(out.status.success());
-    let report = last_json(&out);
+    let report = ipc.status();
     let service = report["services"]
         .as_array()
         .expect("services")

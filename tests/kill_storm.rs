@@ -6,7 +6,7 @@ mod common;
 
 use std::time::{Duration, Instant};
 
-use common::{Isolated, PipelineSlot, last_json, num, spawn_up, stop_up};
+use common::{Isolated, PipelineSlot, num, spawn_up, stop_up};
 use serde_json::Value;
 
 const KILLS: usize = 50;
@@ -17,16 +17,6 @@ const VICTIMS: [&str; 5] = [
     "navigator",
     "navigator-standby",
 ];
-
-fn report(ipc: &Isolated) -> Value {
-    let out = ipc.run(&["status", "--json", "--timeout", "10"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    last_json(&out)
-}
 
 /// (name, pid) of every service the report shows running; `None` until all of them are.
 fn all_running(report: &Value) -> Option<Vec<(String, u64)>> {
@@ -47,7 +37,7 @@ fn all_running(report: &Value) -> Option<Vec<(String, u64)>> {
 fn wait_all_running(ipc: &Isolated, limit: Duration) -> Vec<(String, u64)> {
     let start = Instant::now();
     loop {
-        let r = report(ipc);
+        let r = ipc.status();
         if let Some(pids) = all_running(&r) {
             return pids;
         }
@@ -142,4 +132,49 @@ fn fifty_kills_leave_no_zombie_no_shared_memory_growth_and_a_live_watchdog() {
         "{summary}"
     );
     assert_eq!(num(&summary, "restart_measurements"), KILLS as f64);
+}
+
+#[test]
+fn the_watchdog_frees_the_shared_memory_of_a_killed_process_it_did_not_start() {
+    let _slot = PipelineSlot::take();
+    let ipc = Isolated::new("deadnode");
+    let up = spawn_up(
+        &ipc,
+        &["--scenario", "static", "--duration", "120", "--json"],
+    );
+    let first = ipc.run(&["echo", "nav", "--count", "1", "--timeout", "120"]);
+    assert!(first.status.success());
+    wait_all_running(&ipc, Duration::from_secs(30));
+    let before = ipc.shm_entries().len();
+    // A consumer on the deployment's prefix, killed without a chance to clean up: its node and
+    // subscriber ports stay in /dev/shm until someone notices the node is dead.
+    let mut echo = ipc
+        .command()
+        .args(["echo", "nav", "--timeout", "60"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("cannot start rins echo");
+    let start = Instant::now();
+    while ipc.shm_entries().len() <= before {
+        assert!(
+            start.elapsed() < Duration::from_secs(10),
+            "echo created nothing"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    echo.kill().expect("SIGKILL echo");
+    echo.wait().expect("reap echo");
+    // The watchdog's dead-node sweep (every 250 ms) removes them; nothing else here creates a node.
+    let start = Instant::now();
+    while ipc.shm_entries().len() > before {
+        assert!(
+            start.elapsed() < Duration::from_secs(2),
+            "{:?}",
+            ipc.shm_entries()
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let summary = stop_up(&ipc, up);
+    assert_eq!(num(&summary, "restarts"), 0.0, "{summary}");
 }

@@ -6,12 +6,12 @@
 mod common;
 
 use std::io::Read;
-use std::process::{Child, Output, Stdio};
+use std::process::{Child, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use common::{Isolated, PipelineSlot, fails_with, last_json, num, spawn_up, stop_up};
+use common::{Isolated, PipelineSlot, fails_with, last_json, num, spawn_up, stderr, stop_up};
 use ipc_types::{Health, NavMode, NavState, RawImu, ServiceKind, names};
 use rins_runtime::ipc::{IpcSettings, TopicSubscriber, create_node};
 use serde_json::Value;
@@ -135,12 +135,6 @@ impl Collector {
     }
 }
 
-fn status(ipc: &Isolated) -> Value {
-    let out = ipc.run(&["status", "--json", "--timeout", "10"]);
-    assert!(out.status.success(), "{}", stderr(&out));
-    last_json(&out)
-}
-
 fn acquisition(report: &Value) -> (u64, u64, String) {
     let a = report["services"]
         .as_array()
@@ -151,34 +145,6 @@ fn acquisition(report: &Value) -> (u64, u64, String) {
         a["restarts"].as_u64().expect("restarts"),
         a["state"].as_str().unwrap_or_default().to_string(),
     )
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-/// Runs `rins ARGS`, killing it (and failing) after `limit`.
-fn run_with_timeout(ipc: &Isolated, args: &[&str], limit: Duration) -> Output {
-    let mut child = ipc
-        .command()
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("cannot run rins");
-    let deadline = Instant::now() + limit;
-    while child.try_wait().expect("cannot poll child").is_none() {
-        if Instant::now() >= deadline {
-            let _ = child.kill();
-            let out = child.wait_with_output().expect("cannot collect output");
-            panic!(
-                "rins {args:?} did not finish within {limit:?}:\n{}",
-                stderr(&out)
-            );
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    child.wait_with_output().expect("cannot collect output")
 }
 
 /// The longest pause between consecutive arrivals at or after `from`: (index of the sample
@@ -212,14 +178,13 @@ fn acquisition_rides_out_a_disconnect_under_a_running_pipeline() {
     collector.wait_for("navigation and a heartbeat", Duration::from_secs(30), |s| {
         !s.acquisition.is_empty() && s.nav.last().is_some_and(|n| n.1 != NavMode::Aligning as u8)
     });
-    let (pid, restarts, state) = acquisition(&status(&ipc));
+    let (pid, restarts, state) = acquisition(&ipc.status());
     assert_eq!((restarts, state.as_str()), (0, "running"));
     let reconnects_before = collector.seen.lock().expect("lock").acquisition[0].reconnects;
     assert_eq!(reconnects_before, 0);
 
     let sent = Instant::now();
-    let out = run_with_timeout(
-        &ipc,
+    let out = ipc.run_with_timeout(
         &["inject", "disconnect", "--duration", &OUTAGE_S.to_string()],
         Duration::from_secs(10),
     );
@@ -320,7 +285,7 @@ fn acquisition_rides_out_a_disconnect_under_a_running_pipeline() {
         .collect();
     assert!(other_gaps.is_empty(), "other gaps: {other_gaps:?}");
 
-    let (pid_after, restarts, state) = acquisition(&status(&ipc));
+    let (pid_after, restarts, state) = acquisition(&ipc.status());
     assert_eq!((pid_after, restarts, state.as_str()), (pid, 0, "running"));
     let summary = stop_up(&ipc, up.release());
     assert_eq!(summary["restarts"], 0, "{summary}");

@@ -5,18 +5,8 @@ mod common;
 
 use std::time::{Duration, Instant};
 
-use common::{Isolated, PipelineSlot, last_json, spawn_up, stop_up};
+use common::{Isolated, PipelineSlot, spawn_up, stop_up};
 use serde_json::Value;
-
-fn status(ipc: &Isolated) -> Value {
-    let out = ipc.run(&["status", "--json", "--timeout", "10"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    last_json(&out)
-}
 
 fn service<'a>(report: &'a Value, name: &str) -> &'a Value {
     report["services"]
@@ -31,7 +21,7 @@ fn service<'a>(report: &'a Value, name: &str) -> &'a Value {
 fn wait_for(ipc: &Isolated, limit: Duration, done: impl Fn(&Value) -> bool) -> Value {
     let start = Instant::now();
     loop {
-        let report = status(ipc);
+        let report = ipc.status();
         if done(&report) {
             return report;
         }

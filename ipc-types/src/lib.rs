@@ -738,14 +738,17 @@ pub enum ServiceState {
     Restarting = 2,
     /// Its heartbeat is overdue although the process is still there (hung or starved).
     Silent = 3,
+    /// It died more often than its restart limit allows; the watchdog no longer restarts it.
+    GivenUp = 4,
 }
 
 impl ServiceState {
-    pub const ALL: [ServiceState; 4] = [
+    pub const ALL: [ServiceState; 5] = [
         ServiceState::Starting,
         ServiceState::Running,
         ServiceState::Restarting,
         ServiceState::Silent,
+        ServiceState::GivenUp,
     ];
 
     pub fn name(self) -> &'static str {
@@ -754,6 +757,7 @@ impl ServiceState {
             ServiceState::Running => "running",
             ServiceState::Restarting => "restarting",
             ServiceState::Silent => "silent",
+            ServiceState::GivenUp => "given-up",
         }
     }
 

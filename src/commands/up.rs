@@ -11,6 +11,7 @@ use rins_runtime::shm_cleanup;
 use rins_runtime::shutdown::Shutdown;
 use rins_watchdog::health_publisher::HealthPublisher;
 use rins_watchdog::monitor::{COUNTED, Monitor};
+use rins_watchdog::restart_policy::GiveUp;
 use rins_watchdog::restart_timing::RestartTiming;
 use rins_watchdog::status::status_line;
 use rins_watchdog::summary::Summary;
@@ -169,7 +170,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     let exe = std::env::current_exe().context("cannot locate the rins executable")?;
     let node = create_node("watchdog", &settings)?;
     let mut monitor = Monitor::new(&node)?;
-    let mut supervisor = Supervisor::new(cfg.watchdog.restart_policy());
+    let mut supervisor = Supervisor::new();
     let started = Instant::now();
     // With the check off, a silent process is still reported, after an hour.
     let silent_after = match cfg.watchdog.heartbeat_timeout_s {
@@ -189,6 +190,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
                 name: name.to_string(),
                 program: exe.clone(),
                 args: child_args,
+                policy: cfg.watchdog.policy_for(name),
             })?;
         }
         if simulate {
@@ -196,6 +198,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
                 name: "sim".into(),
                 program: exe.clone(),
                 args: sim_args(&cfg, &config_args, &link, args),
+                policy: cfg.watchdog.policy_for("sim"),
             })?;
             wait_for_path(&link, &mut supervisor, &shutdown)?;
         }
@@ -274,6 +277,28 @@ fn kill_hung(report: &ipc_types::HealthReport, supervisor: &mut Supervisor) {
     }
 }
 
+/// The third way a death is seen, besides the child's exit and its heartbeat: iceoryx2 finds its
+/// node dead. Every dead node's resources are freed; a child the supervisor still counts as
+/// running under that pid is killed, so that it is reaped and restarted like any exit.
+fn sweep_dead_nodes(settings: &IpcSettings, supervisor: &mut Supervisor) {
+    let result = rins_runtime::ipc::for_each_dead_node(settings, |name, pid| {
+        let child = pid.filter(|&p| supervisor.kill(p));
+        match child {
+            Some(pid) => {
+                tracing::warn!(
+                    node = name,
+                    pid,
+                    "iceoryx2 node dead: killed, will be restarted"
+                )
+            }
+            None => tracing::info!(node = name, ?pid, "removed the resources of a dead node"),
+        }
+    });
+    if let Err(e) = result {
+        tracing::warn!(error = %e, "cannot sweep dead nodes");
+    }
+}
+
 /// What the supervision loop drives.
 struct Watch<'a> {
     supervisor: &'a mut Supervisor,
@@ -307,10 +332,11 @@ fn supervise(
         monitor.drain()?;
         timing.observe(Instant::now(), |kind| monitor.output_count(kind));
         supervisor.poll(&mut events);
-        if let Some(report) = health.tick(supervisor, monitor)?
-            && cfg.watchdog.heartbeat_timeout_s > 0.0
-        {
-            kill_hung(&report, supervisor);
+        if let Some(report) = health.tick(supervisor, monitor)? {
+            sweep_dead_nodes(settings, supervisor);
+            if cfg.watchdog.heartbeat_timeout_s > 0.0 {
+                kill_hung(&report, supervisor);
+            }
         }
         for event in events.drain(..) {
             match event {
@@ -336,6 +362,28 @@ fn supervise(
                 }
                 ChildEvent::Restarted { name, pid } => {
                     tracing::info!(child = %name, pid, "child restarted")
+                }
+                ChildEvent::GaveUp {
+                    name,
+                    status,
+                    exits,
+                    window,
+                    action,
+                } => {
+                    let why = format!(
+                        "{name} exited ({status}) {exits} times within {:.0} s, more than \
+                         watchdog.max_restarts allows (watchdog.services.{name} may raise it)",
+                        window.as_secs_f64()
+                    );
+                    if let Err(e) = rins_runtime::ipc::remove_dead_nodes(settings) {
+                        tracing::warn!(error = %e, "cannot clean up dead nodes");
+                    }
+                    match action {
+                        GiveUp::Shutdown => bail!("{why}: stopping the pipeline"),
+                        GiveUp::LeaveDown => {
+                            tracing::error!("{why}: left down, the other services go on")
+                        }
+                    }
                 }
             }
         }

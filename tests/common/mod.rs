@@ -39,6 +39,37 @@ impl Isolated {
         self.command().args(args).output().expect("cannot run rins")
     }
 
+    /// Runs `rins ARGS`, killing it (and failing) if it has not finished within `limit`.
+    pub fn run_with_timeout(&self, args: &[&str], limit: std::time::Duration) -> Output {
+        let mut child = self
+            .command()
+            .args(args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("cannot run rins");
+        let deadline = std::time::Instant::now() + limit;
+        while child.try_wait().expect("cannot poll child").is_none() {
+            if std::time::Instant::now() >= deadline {
+                let _ = child.kill();
+                let out = child.wait_with_output().expect("cannot collect output");
+                panic!(
+                    "rins {args:?} did not finish within {limit:?}:\n{}",
+                    stderr(&out)
+                );
+            }
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+        child.wait_with_output().expect("cannot collect output")
+    }
+
+    /// The watchdog's health report as `rins status --json` prints it.
+    pub fn status(&self) -> serde_json::Value {
+        let out = self.run(&["status", "--json", "--timeout", "10"]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        last_json(&out)
+    }
+
     /// Shared-memory entries of this namespace still present.
     pub fn shm_entries(&self) -> Vec<String> {
         std::fs::read_dir("/dev/shm")
@@ -86,6 +117,10 @@ impl Drop for Isolated {
         }
         let _ = std::fs::remove_dir_all(&self.root);
     }
+}
+
+pub fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
 /// The JSON object on the last line of stdout.

@@ -88,18 +88,39 @@ fn install_global_config(settings: &IpcSettings, config: &Config) -> Result<()> 
 /// Removes the shared memory and other resources of every dead node of this deployment (a
 /// process that was killed without dropping its node); returns how many nodes were cleaned.
 pub fn remove_dead_nodes(settings: &IpcSettings) -> Result<usize> {
-    let config = settings.iceoryx_config()?;
     let mut removed = 0;
+    for_each_dead_node(settings, |_, _| removed += 1)?;
+    Ok(removed)
+}
+
+/// Like [`remove_dead_nodes`], and calls `on_removed` with the name (empty when its details are
+/// gone) and the process id of each node cleaned: iceoryx2's own view of which processes died.
+pub fn for_each_dead_node(
+    settings: &IpcSettings,
+    mut on_removed: impl FnMut(&str, Option<u32>),
+) -> Result<()> {
+    let config = settings.iceoryx_config()?;
     Node::<ipc::Service>::list(&config, |state| {
-        if let NodeState::Dead(view) = state
-            && view.try_remove_stale_resources().is_ok()
-        {
-            removed += 1;
+        if let NodeState::Dead(view) = state {
+            use iceoryx2::node::NodeView;
+            let name = view
+                .details()
+                .as_ref()
+                .map(|d| d.name().as_str().to_string())
+                .unwrap_or_default();
+            let pid = view
+                .id()
+                .pid::<ipc::Service>()
+                .ok()
+                .and_then(|p| u32::try_from(p.value()).ok());
+            if view.try_remove_stale_resources().is_ok() {
+                on_removed(&name, pid);
+            }
         }
         CallbackProgression::Continue
     })
     .map_err(|e| anyhow!("cannot list iceoryx2 nodes: {e:?}"))?;
-    Ok(removed)
+    Ok(())
 }
 
 /// Creates this process's node. Signal handling is left to [`crate::shutdown::Shutdown`].

@@ -1,10 +1,33 @@
 //! `[watchdog]` configuration.
 
+use std::collections::BTreeMap;
 use std::time::Duration;
 
 use serde::Deserialize;
 
-use crate::restart_policy::RestartPolicy;
+use crate::restart_policy::{GiveUp, RestartPolicy};
+
+/// Services `[watchdog.services.NAME]` may name.
+pub const SUPERVISED: [&str; 6] = [
+    "acquisition",
+    "fusion",
+    "altimeter",
+    "navigator",
+    "navigator-standby",
+    "sim",
+];
+
+/// Per-service restart settings; what is not given comes from `[watchdog]`.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ServiceRestartConfig {
+    pub restart_initial_backoff_ms: Option<u64>,
+    pub restart_max_backoff_ms: Option<u64>,
+    pub restart_stable_after_s: Option<f64>,
+    pub max_restarts: Option<u32>,
+    pub restart_window_s: Option<f64>,
+    pub give_up: Option<GiveUp>,
+}
 
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -22,6 +45,14 @@ pub struct WatchdogConfig {
     /// A child whose heartbeat (once a second) is older than this is hung: it is killed and
     /// restarted. 0 turns the check off.
     pub heartbeat_timeout_s: f64,
+    /// At most this many restarts of one child within `restart_window_s`; one more and the
+    /// watchdog gives up on it (`give_up`). 0: never restart.
+    pub max_restarts: u32,
+    pub restart_window_s: f64,
+    /// `shutdown` (stop everything, `rins up` fails naming the child) or `leave-down`.
+    pub give_up: GiveUp,
+    /// Overrides per service, `[watchdog.services.NAME]`.
+    pub services: BTreeMap<String, ServiceRestartConfig>,
 }
 
 impl Default for WatchdogConfig {
@@ -33,23 +64,39 @@ impl Default for WatchdogConfig {
             stop_grace_ms: 2_000,
             status_period_s: 1.0,
             heartbeat_timeout_s: 3.0,
+            max_restarts: 20,
+            restart_window_s: 60.0,
+            give_up: GiveUp::Shutdown,
+            services: BTreeMap::new(),
         }
     }
 }
 
 impl WatchdogConfig {
     pub fn validate(&self) -> Result<(), String> {
-        if self.restart_initial_backoff_ms > self.restart_max_backoff_ms {
-            return Err(format!(
-                "watchdog.restart_initial_backoff_ms = {}: must be <= restart_max_backoff_ms ({})",
-                self.restart_initial_backoff_ms, self.restart_max_backoff_ms
-            ));
-        }
-        if !(self.restart_stable_after_s.is_finite() && self.restart_stable_after_s >= 0.0) {
-            return Err(format!(
-                "watchdog.restart_stable_after_s = {}: must be a non-negative number",
-                self.restart_stable_after_s
-            ));
+        validate_restart(
+            "watchdog",
+            self.restart_initial_backoff_ms,
+            self.restart_max_backoff_ms,
+            self.restart_stable_after_s,
+            self.restart_window_s,
+        )?;
+        for (name, o) in &self.services {
+            if !SUPERVISED.contains(&name.as_str()) {
+                return Err(format!(
+                    "watchdog.services.{name}: no such service (expected one of {})",
+                    SUPERVISED.join(", ")
+                ));
+            }
+            let p = self.policy_for(name);
+            validate_restart(
+                &format!("watchdog.services.{name}"),
+                p.initial_backoff.as_millis() as u64,
+                p.max_backoff.as_millis() as u64,
+                o.restart_stable_after_s
+                    .unwrap_or(self.restart_stable_after_s),
+                o.restart_window_s.unwrap_or(self.restart_window_s),
+            )?;
         }
         if !(self.status_period_s.is_finite() && self.status_period_s >= 0.0) {
             return Err(format!(
@@ -72,13 +119,60 @@ impl WatchdogConfig {
         Ok(())
     }
 
-    pub fn restart_policy(&self) -> RestartPolicy {
+    /// The restart policy of service `name`: its overrides over the `[watchdog]` values. Call on
+    /// a validated configuration (durations are then finite and non-negative).
+    pub fn policy_for(&self, name: &str) -> RestartPolicy {
+        let o = self.services.get(name).cloned().unwrap_or_default();
+        let seconds = |s: f64| Duration::try_from_secs_f64(s).unwrap_or(Duration::MAX);
         RestartPolicy {
-            initial_backoff: Duration::from_millis(self.restart_initial_backoff_ms),
-            max_backoff: Duration::from_millis(self.restart_max_backoff_ms),
-            stable_after: Duration::from_secs_f64(self.restart_stable_after_s),
+            initial_backoff: Duration::from_millis(
+                o.restart_initial_backoff_ms
+                    .unwrap_or(self.restart_initial_backoff_ms),
+            ),
+            max_backoff: Duration::from_millis(
+                o.restart_max_backoff_ms
+                    .unwrap_or(self.restart_max_backoff_ms),
+            ),
+            stable_after: seconds(
+                o.restart_stable_after_s
+                    .unwrap_or(self.restart_stable_after_s),
+            ),
+            max_restarts: o.max_restarts.unwrap_or(self.max_restarts),
+            window: seconds(o.restart_window_s.unwrap_or(self.restart_window_s)),
+            give_up: o.give_up.unwrap_or(self.give_up),
         }
     }
+}
+
+/// Range checks shared by `[watchdog]` and every `[watchdog.services.NAME]`.
+fn validate_restart(
+    section: &str,
+    initial_ms: u64,
+    max_ms: u64,
+    stable_after_s: f64,
+    window_s: f64,
+) -> Result<(), String> {
+    if initial_ms > max_ms {
+        return Err(format!(
+            "{section}.restart_initial_backoff_ms = {initial_ms}: must be <= restart_max_backoff_ms ({max_ms})"
+        ));
+    }
+    if max_ms > 3_600_000 {
+        return Err(format!(
+            "{section}.restart_max_backoff_ms = {max_ms}: must be <= 3600000 (an hour)"
+        ));
+    }
+    for (field, value) in [
+        ("restart_stable_after_s", stable_after_s),
+        ("restart_window_s", window_s),
+    ] {
+        if !(value.is_finite() && (0.0..=86_400.0).contains(&value)) {
+            return Err(format!(
+                "{section}.{field} = {value}: must be a number of seconds in [0, 86400]"
+            ));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -96,6 +190,57 @@ mod tests {
             bad.validate()
                 .unwrap_err()
                 .contains("watchdog.status_period_s = NaN")
+        );
+    }
+
+    fn parse(text: &str) -> WatchdogConfig {
+        toml::from_str(text).unwrap()
+    }
+
+    #[test]
+    fn service_overrides_fall_back_to_the_watchdog_values() {
+        let c = parse(
+            "max_restarts = 7\nrestart_window_s = 30\n\
+             [services.altimeter]\nmax_restarts = 2\ngive_up = \"leave-down\"\n",
+        );
+        assert!(c.validate().is_ok());
+        let alt = c.policy_for("altimeter");
+        assert_eq!(
+            (alt.max_restarts, alt.window, alt.give_up),
+            (2, Duration::from_secs(30), GiveUp::LeaveDown)
+        );
+        let fusion = c.policy_for("fusion");
+        assert_eq!(
+            (fusion.max_restarts, fusion.give_up, fusion.initial_backoff),
+            (7, GiveUp::Shutdown, Duration::from_millis(10))
+        );
+    }
+
+    #[test]
+    fn bad_overrides_name_the_key() {
+        let err = parse("[services.gps]\nmax_restarts = 1\n")
+            .validate()
+            .unwrap_err();
+        assert!(
+            err.starts_with("watchdog.services.gps: no such service"),
+            "{err}"
+        );
+        let err = parse("[services.fusion]\nrestart_window_s = -1\n")
+            .validate()
+            .unwrap_err();
+        assert!(
+            err.contains("watchdog.services.fusion.restart_window_s = -1"),
+            "{err}"
+        );
+        let err = parse("[services.fusion]\nrestart_initial_backoff_ms = 9000\n")
+            .validate()
+            .unwrap_err();
+        assert!(
+            err.contains("watchdog.services.fusion.restart_initial_backoff_ms = 9000"),
+            "{err}"
+        );
+        assert!(
+            toml::from_str::<WatchdogConfig>("[services.fusion]\ngive_up = \"pray\"\n").is_err()
         );
     }
 }

@@ -56,6 +56,7 @@ impl HealthPublisher {
         let watchdog = ProcessView {
             kind: ServiceKind::Watchdog,
             pid: Some(me),
+            given_up: false,
             restarts: 0,
             heartbeat: Some(HeartbeatSeen {
                 pid: me,
@@ -73,6 +74,7 @@ impl HealthPublisher {
                 Some(ProcessView {
                     kind,
                     pid: child.pid,
+                    given_up: child.given_up,
                     restarts: child.restarts,
                     heartbeat: monitor.heartbeats[kind as usize],
                     output_rate_hz,

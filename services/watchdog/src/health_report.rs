@@ -11,8 +11,10 @@ use crate::monitor::HeartbeatSeen;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ProcessView {
     pub kind: ServiceKind,
-    /// Current pid; `None` while it waits out its restart backoff.
+    /// Current pid; `None` while it waits out its restart backoff or was given up.
     pub pid: Option<u32>,
+    /// Exceeded its restart limit: no longer restarted.
+    pub given_up: bool,
     pub restarts: u64,
     /// The last heartbeat of this kind of process.
     pub heartbeat: Option<HeartbeatSeen>,
@@ -24,7 +26,12 @@ pub struct ProcessView {
 /// restart the previous incarnation's heartbeat says nothing about the new one.
 pub fn state_of(view: &ProcessView, now_ns: u64, silent_after_ns: u64) -> (ServiceState, u32) {
     let Some(pid) = view.pid else {
-        return (ServiceState::Restarting, u32::MAX);
+        let state = if view.given_up {
+            ServiceState::GivenUp
+        } else {
+            ServiceState::Restarting
+        };
+        return (state, u32::MAX);
     };
     match view.heartbeat {
         Some(h) if h.pid == pid => {
@@ -82,6 +89,7 @@ mod tests {
         ProcessView {
             kind: ServiceKind::Fusion,
             pid,
+            given_up: false,
             restarts: 2,
             heartbeat: heartbeat.map(|(pid, at_ns)| HeartbeatSeen {
                 pid,
@@ -98,6 +106,14 @@ mod tests {
         assert_eq!(
             state_of(&view(None, Some((7, now))), now, SILENT_NS),
             (ServiceState::Restarting, u32::MAX)
+        );
+        let given_up = ProcessView {
+            given_up: true,
+            ..view(None, None)
+        };
+        assert_eq!(
+            state_of(&given_up, now, SILENT_NS),
+            (ServiceState::GivenUp, u32::MAX)
         );
         // A heartbeat from the previous incarnation does not count.
         assert_eq!(

@@ -1,6 +1,31 @@
-//! When to restart a child that exited: exponential backoff, reset after a stable run.
+//! When to restart a child that exited: exponential backoff, reset after a stable run, and a limit
+//! on restarts within a sliding window after which the watchdog gives up on the child.
 
-use std::time::Duration;
+use std::collections::VecDeque;
+use std::time::{Duration, Instant};
+
+use serde::Deserialize;
+
+/// What the watchdog does with a child that exceeded its restart limit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GiveUp {
+    /// Stop the whole pipeline; `rins up` exits with an error naming the child, and the service
+    /// manager (`Restart=on-failure`) starts the deployment afresh.
+    #[default]
+    Shutdown,
+    /// Leave the child down, keep the others running, and report it `given-up`.
+    LeaveDown,
+}
+
+impl GiveUp {
+    pub fn name(self) -> &'static str {
+        match self {
+            GiveUp::Shutdown => "shutdown",
+            GiveUp::LeaveDown => "leave-down",
+        }
+    }
+}
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RestartPolicy {
@@ -11,6 +36,10 @@ pub struct RestartPolicy {
     /// A child that ran this long is considered healthy again: the next failure starts from
     /// `initial_backoff`.
     pub stable_after: Duration,
+    /// At most this many restarts within `window`; one more and the watchdog gives up.
+    pub max_restarts: u32,
+    pub window: Duration,
+    pub give_up: GiveUp,
 }
 
 impl Default for RestartPolicy {
@@ -19,6 +48,9 @@ impl Default for RestartPolicy {
             initial_backoff: Duration::from_millis(10),
             max_backoff: Duration::from_secs(5),
             stable_after: Duration::from_secs(1),
+            max_restarts: 20,
+            window: Duration::from_secs(60),
+            give_up: GiveUp::Shutdown,
         }
     }
 }
@@ -43,6 +75,47 @@ impl RestartPolicy {
     }
 }
 
+/// The exits of one child within the policy's window. Holds at most `max_restarts + 1` instants,
+/// allocated once.
+#[derive(Debug, Clone)]
+pub struct RestartWindow {
+    exits: VecDeque<Instant>,
+    max_restarts: u32,
+    window: Duration,
+}
+
+impl RestartWindow {
+    pub fn new(policy: &RestartPolicy) -> Self {
+        let capacity = usize::try_from(policy.max_restarts).unwrap_or(usize::MAX - 1) + 1;
+        Self {
+            exits: VecDeque::with_capacity(capacity.min(4096)),
+            max_restarts: policy.max_restarts,
+            window: policy.window,
+        }
+    }
+
+    /// Records an exit at `now`; true when a restart is still within the limit.
+    pub fn allow_restart(&mut self, now: Instant) -> bool {
+        while self
+            .exits
+            .front()
+            .is_some_and(|&t| now.saturating_duration_since(t) > self.window)
+        {
+            self.exits.pop_front();
+        }
+        if self.exits.len() > self.max_restarts as usize {
+            self.exits.pop_front();
+        }
+        self.exits.push_back(now);
+        self.exits.len() <= self.max_restarts as usize
+    }
+
+    /// Exits within the window, as of the last record.
+    pub fn exits(&self) -> usize {
+        self.exits.len()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -53,6 +126,7 @@ mod tests {
             initial_backoff: Duration::from_millis(10),
             max_backoff: Duration::from_millis(100),
             stable_after: Duration::from_secs(1),
+            ..RestartPolicy::default()
         };
         assert_eq!(p.backoff(1), Duration::from_millis(10));
         assert_eq!(p.backoff(2), Duration::from_millis(20));
@@ -66,5 +140,41 @@ mod tests {
         let p = RestartPolicy::default();
         assert_eq!(p.failures_after_exit(7, Duration::from_secs(60)), 1);
         assert_eq!(p.failures_after_exit(7, Duration::from_millis(5)), 8);
+    }
+
+    #[test]
+    fn the_limit_counts_exits_within_the_sliding_window() {
+        let p = RestartPolicy {
+            max_restarts: 3,
+            window: Duration::from_secs(10),
+            ..RestartPolicy::default()
+        };
+        let t0 = Instant::now();
+        let s = |secs: u64| t0 + Duration::from_secs(secs);
+        let mut w = RestartWindow::new(&p);
+        // Three exits in 10 s are restarted, the fourth within the window is one too many.
+        assert!(w.allow_restart(s(0)));
+        assert!(w.allow_restart(s(4)));
+        assert!(w.allow_restart(s(8)));
+        assert!(!w.allow_restart(s(9)));
+        // Spread out, exits leave the window: 11 s after the first, three remain in it.
+        let mut w = RestartWindow::new(&p);
+        for t in [0, 4, 8] {
+            assert!(w.allow_restart(s(t)));
+        }
+        assert!(w.allow_restart(s(11)));
+        assert_eq!(w.exits(), 3);
+        assert!(w.allow_restart(s(15)));
+        assert!(!w.allow_restart(s(16)));
+    }
+
+    #[test]
+    fn a_zero_limit_never_restarts() {
+        let p = RestartPolicy {
+            max_restarts: 0,
+            ..RestartPolicy::default()
+        };
+        let mut w = RestartWindow::new(&p);
+        assert!(!w.allow_restart(Instant::now()));
     }
 }

@@ -1,4 +1,5 @@
-//! Child processes of the watchdog: start, notice exits, restart with backoff, stop cleanly.
+//! Child processes of the watchdog: start, notice exits, restart with backoff within each child's
+//! restart limit (then give up on it), stop cleanly.
 
 use std::os::unix::process::CommandExt;
 use std::path::PathBuf;
@@ -7,14 +8,15 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 
-use crate::restart_policy::RestartPolicy;
+use crate::restart_policy::{GiveUp, RestartPolicy, RestartWindow};
 
-/// How to start one child.
+/// How to start one child, and how to restart it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChildSpec {
     pub name: String,
     pub program: PathBuf,
     pub args: Vec<String>,
+    pub policy: RestartPolicy,
 }
 
 struct Managed {
@@ -24,20 +26,24 @@ struct Managed {
     failures: u32,
     restart_at: Option<Instant>,
     restarts: u64,
+    window: RestartWindow,
+    given_up: bool,
 }
 
+#[derive(Default)]
 pub struct Supervisor {
     children: Vec<Managed>,
-    policy: RestartPolicy,
 }
 
 /// One child as [`Supervisor::children`] reports it.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ChildStatus {
     pub name: String,
-    /// `None` while the child waits out its restart backoff.
+    /// `None` while the child waits out its restart backoff or was given up.
     pub pid: Option<u32>,
     pub restarts: u64,
+    /// It exceeded its restart limit and is no longer restarted.
+    pub given_up: bool,
 }
 
 /// What happened to a child during [`Supervisor::poll`].
@@ -51,6 +57,14 @@ pub enum ChildEvent {
     Restarted {
         name: String,
         pid: u32,
+    },
+    /// The child exited more often than its limit allows within its window: it is not restarted.
+    GaveUp {
+        name: String,
+        status: String,
+        exits: usize,
+        window: Duration,
+        action: GiveUp,
     },
 }
 
@@ -74,11 +88,8 @@ fn spawn(spec: &ChildSpec) -> Result<Child> {
 }
 
 impl Supervisor {
-    pub fn new(policy: RestartPolicy) -> Self {
-        Self {
-            children: Vec::new(),
-            policy,
-        }
+    pub fn new() -> Self {
+        Self::default()
     }
 
     /// Starts a child now and supervises it from then on.
@@ -87,12 +98,14 @@ impl Supervisor {
         let pid = child.id();
         tracing::info!(child = %spec.name, pid, "started");
         self.children.push(Managed {
+            window: RestartWindow::new(&spec.policy),
             spec,
             child: Some(child),
             started_at: Instant::now(),
             failures: 0,
             restart_at: None,
             restarts: 0,
+            given_up: false,
         });
         Ok(pid)
     }
@@ -104,11 +117,21 @@ impl Supervisor {
             if let Some(child) = &mut m.child {
                 match child.try_wait() {
                     Ok(Some(status)) => {
-                        m.failures = self
-                            .policy
-                            .failures_after_exit(m.failures, now - m.started_at);
-                        let delay = self.policy.backoff(m.failures);
                         m.child = None;
+                        let policy = &m.spec.policy;
+                        if !m.window.allow_restart(now) {
+                            m.given_up = true;
+                            events.push(ChildEvent::GaveUp {
+                                name: m.spec.name.clone(),
+                                status: status.to_string(),
+                                exits: m.window.exits(),
+                                window: policy.window,
+                                action: policy.give_up,
+                            });
+                            continue;
+                        }
+                        m.failures = policy.failures_after_exit(m.failures, now - m.started_at);
+                        let delay = policy.backoff(m.failures);
                         m.restart_at = Some(now + delay);
                         events.push(ChildEvent::Exited {
                             name: m.spec.name.clone(),
@@ -136,7 +159,7 @@ impl Supervisor {
                     }
                     Err(e) => {
                         m.failures = m.failures.saturating_add(1);
-                        m.restart_at = Some(now + self.policy.backoff(m.failures));
+                        m.restart_at = Some(now + m.spec.policy.backoff(m.failures));
                         tracing::error!(child = %m.spec.name, error = %e, "restart failed");
                     }
                 }
@@ -178,6 +201,7 @@ impl Supervisor {
                 name: m.spec.name.clone(),
                 pid: m.child.as_ref().map(Child::id),
                 restarts: m.restarts,
+                given_up: m.given_up,
             })
             .collect()
     }
