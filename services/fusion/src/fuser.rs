@@ -60,14 +60,30 @@ pub enum ChannelNoise {
     PerChannel(Vec<f64>),
 }
 
+/// Range of a channel noise σ (rad/s or m/s²).
+const SIGMA_MIN: f64 = 1e-9;
+const SIGMA_MAX: f64 = 1e3;
+
 impl ChannelNoise {
     /// Per-channel variances σ_i² for `n` channels. Errors name `[i]` or the whole field.
     pub fn variances(&self, n: usize) -> Result<[f64; MAX_CHANNELS], ConfigError> {
+        // Bounded so that σ² and the weights 1/σ² stay ordinary numbers: beyond them the
+        // weighted least squares loses its solution (1e308² overflows, 1e-300² underflows).
         let check = |field: String, s: f64| {
-            if s.is_finite() && s > 0.0 {
+            if (SIGMA_MIN..=SIGMA_MAX).contains(&s) {
                 Ok(s * s)
             } else {
-                Err(ConfigError::new(field, s, "must be finite and > 0"))
+                // Very large or small values as written (1e308), not in 300 digits.
+                let shown = if s != 0.0 && !(1e-4..1e6).contains(&s.abs()) {
+                    format!("{s:e}")
+                } else {
+                    s.to_string()
+                };
+                Err(ConfigError::new(
+                    field,
+                    shown,
+                    format!("must be in [{SIGMA_MIN:e}, {SIGMA_MAX:e}]"),
+                ))
             }
         };
         let mut out = [0.0; MAX_CHANNELS];

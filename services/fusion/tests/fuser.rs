@@ -250,11 +250,16 @@ fn config_parses_from_toml_and_errors_name_fields() {
     );
     assert_eq!(
         err("[noise]\naccel_sigma_mps2 = [0.1, -0.1, 0.1, 0.1]"),
-        "noise.accel_sigma_mps2[1] = -0.1: must be finite and > 0"
+        "noise.accel_sigma_mps2[1] = -0.1: must be in [1e-9, 1e3]"
     );
     assert_eq!(
         err("[noise]\ngyro_sigma_rps = 0"),
-        "noise.gyro_sigma_rps = 0: must be finite and > 0"
+        "noise.gyro_sigma_rps = 0: must be in [1e-9, 1e3]"
+    );
+    // So large that σ² overflows and the least squares loses its solution.
+    assert_eq!(
+        err("[noise]\ngyro_sigma_rps = 1e308"),
+        "noise.gyro_sigma_rps = 1e308: must be in [1e-9, 1e3]"
     );
     assert_eq!(
         err("[calibration.accel]\nscale = [1, 0, 1, 1]"),
