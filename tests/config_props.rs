@@ -7,22 +7,11 @@ use proptest::prelude::*;
 use rins::config::{BUILT_IN, RinsConfig};
 use rins_watchdog::config::SUPERVISED;
 
-/// Builds what `rins up` builds from an accepted configuration.
+/// Builds what `rins up` builds from an accepted configuration, and the restart policies.
 fn build_everything(cfg: &RinsConfig) {
-    let (gyro, accel) = cfg
-        .geometries()
-        .expect("an accepted configuration builds its geometries");
-    assert!(gyro.n() >= 3 && accel.n() >= 3);
-    rins_fusion::ImuFuser::new(
-        &cfg.fusion,
-        cfg.device.gyro_lsb_rps(),
-        cfg.device.accel_lsb_mps2(),
-    )
-    .expect("an accepted configuration builds the fuser");
-    rins_altimeter::AltitudeEstimator::new(cfg.altimeter.clone())
-        .expect("an accepted configuration builds the altimeter");
-    rins_navigator::Navigator::new(cfg.navigator.clone())
-        .expect("an accepted configuration builds the navigator");
+    if let Err(e) = cfg.build_services() {
+        panic!("an accepted configuration must build every service: {e}");
+    }
     for name in SUPERVISED {
         let p = cfg.watchdog.policy_for(name);
         assert!(p.initial_backoff <= p.max_backoff, "{name}: {p:?}");

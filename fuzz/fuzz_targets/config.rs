@@ -17,18 +17,7 @@ fuzz_target!(|data: &[u8]| {
     let Ok(cfg) = RinsConfig::parse(text, "fuzz") else {
         return;
     };
-    let (gyro, accel) = cfg
-        .geometries()
-        .expect("an accepted configuration builds its geometries");
-    assert!(gyro.n() >= 3 && accel.n() >= 3);
-    rins_fusion::ImuFuser::new(
-        &cfg.fusion,
-        cfg.device.gyro_lsb_rps(),
-        cfg.device.accel_lsb_mps2(),
-    )
-    .expect("an accepted configuration builds the fuser");
-    rins_altimeter::AltitudeEstimator::new(cfg.altimeter.clone())
-        .expect("an accepted configuration builds the altimeter");
-    rins_navigator::Navigator::new(cfg.navigator.clone())
-        .expect("an accepted configuration builds the navigator");
+    if let Err(e) = cfg.build_services() {
+        panic!("an accepted configuration must build every service: {e}");
+    }
 });

@@ -144,6 +144,8 @@ fn apply_overrides(cfg: &mut RinsConfig, args: &UpArgs) -> Result<()> {
 pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     let mut cfg = config::load(args.config.as_deref())?;
     apply_overrides(&mut cfg, args)?;
+    // Refused here, before any child runs, rather than by a child in a restart loop.
+    cfg.build_services()?;
     let shutdown = Shutdown::install()?;
     let settings = IpcSettings::from_env();
     ensure_no_live_deployment(&settings)?;
