@@ -3,11 +3,15 @@
 //! panics, and whatever it accepts every service it configures accepts too, so nothing is refused
 //! only once a process has started.
 
+use std::time::Duration;
+
 use proptest::prelude::*;
 use rins::config::{BUILT_IN, RinsConfig};
 use rins_watchdog::config::SUPERVISED;
+use rins_watchdog::restart_policy::{MAX_RESTARTS_LIMIT, RestartWindow};
 
-/// Builds what `rins up` builds from an accepted configuration, and the restart policies.
+/// Builds what `rins up` builds from an accepted configuration, and the restart policy (with its
+/// ring of exit instants) of every supervised service.
 fn build_everything(cfg: &RinsConfig) {
     if let Err(e) = cfg.build_services() {
         panic!("an accepted configuration must build every service: {e}");
@@ -15,7 +19,62 @@ fn build_everything(cfg: &RinsConfig) {
     for name in SUPERVISED {
         let p = cfg.watchdog.policy_for(name);
         assert!(p.initial_backoff <= p.max_backoff, "{name}: {p:?}");
+        assert!(p.max_backoff <= Duration::from_secs(3600), "{name}: {p:?}");
+        assert!(p.max_restarts <= MAX_RESTARTS_LIMIT, "{name}: {p:?}");
+        assert!(
+            p.window >= Duration::from_millis(1) && p.window <= Duration::from_secs(86_400),
+            "{name}: {p:?}"
+        );
+        assert!(
+            p.stable_after <= Duration::from_secs(86_400),
+            "{name}: {p:?}"
+        );
+        let _ = RestartWindow::new(&p);
     }
+}
+
+/// The keys of a `[watchdog.services.NAME]` section, and one it does not have.
+const RESTART_KEYS: [&str; 7] = [
+    "restart_initial_backoff_ms",
+    "restart_max_backoff_ms",
+    "restart_stable_after_s",
+    "max_restarts",
+    "restart_window_s",
+    "give_up",
+    "max_restart",
+];
+
+/// Names that are not supervised services (near misses included).
+const NOT_SERVICES: [&str; 5] = ["gps", "Navigator", "navigator_standby", "", "watchdog"];
+
+/// Values for the restart keys: valid ones, and ones that break naive range checks.
+const RESTART_VALUES: [&str; 17] = [
+    "0",
+    "1",
+    "10000",
+    "10001",
+    "3600000",
+    "3600001",
+    "86400",
+    "86400.5",
+    "-1",
+    "-0.0",
+    "nan",
+    "inf",
+    "1e-300",
+    "18446744073709551615",
+    "\"shutdown\"",
+    "\"leave-down\"",
+    "\"pray\"",
+];
+
+/// The built-in text with a `[watchdog.services.NAME]` section holding `lines`.
+fn with_service_section(name: &str, lines: &[(&str, String)]) -> String {
+    let mut text = format!("{BUILT_IN}\n[watchdog.services.\"{name}\"]\n");
+    for (key, value) in lines {
+        text.push_str(&format!("{key} = {value}\n"));
+    }
+    text
 }
 
 /// Values that break naive range checks.
@@ -94,6 +153,50 @@ proptest! {
         let value = if use_number { format!("{number:?}") } else { nasty.to_string() };
         if let Ok(cfg) = RinsConfig::parse(&with_value(line, &value), "prop") {
             build_everything(&cfg);
+        }
+    }
+
+    #[test]
+    fn per_service_restart_settings_are_accepted_only_within_range(
+        service in prop::sample::select(SUPERVISED.to_vec()),
+        lines in prop::collection::vec(
+            (
+                prop::sample::select(RESTART_KEYS.to_vec()),
+                prop::sample::select(RESTART_VALUES.to_vec()),
+                any::<f64>(),
+                any::<bool>(),
+            ),
+            1..4,
+        ),
+    ) {
+        let lines: Vec<(&str, String)> = lines
+            .into_iter()
+            .map(|(key, value, number, use_number)| {
+                (key, if use_number { format!("{number:?}") } else { value.to_string() })
+            })
+            .collect();
+        if let Ok(cfg) = RinsConfig::parse(&with_service_section(service, &lines), "prop") {
+            build_everything(&cfg);
+        }
+    }
+
+    #[test]
+    fn an_unknown_service_section_is_refused_naming_it(
+        name in prop::sample::select(NOT_SERVICES.to_vec()),
+        key in prop::sample::select(RESTART_KEYS[..6].to_vec()),
+    ) {
+        let value = if key == "give_up" { "\"leave-down\"" } else { "1" };
+        let text = with_service_section(name, &[(key, value.to_string())]);
+        let err = match RinsConfig::parse(&text, "prop") {
+            Ok(_) => panic!("[watchdog.services.{name:?}] was accepted"),
+            Err(e) => e.to_string(),
+        };
+        prop_assert!(
+            err.contains(&format!("watchdog.services.{name}: no such service")),
+            "{}", err
+        );
+        for valid in SUPERVISED {
+            prop_assert!(err.contains(valid), "{}", err);
         }
     }
 

@@ -149,6 +149,38 @@ fn bad_restart_settings_are_refused_naming_the_key() {
         &["up", "--config", window.path()],
         &["watchdog.restart_window_s = -5"],
     );
+    let zero_window = TempFile::new(
+        "limits",
+        "toml",
+        "[watchdog.services.navigator]\nrestart_window_s = 0\n",
+    );
+    fails_with(
+        "limits-zero-window",
+        &["up", "--config", zero_window.path()],
+        &[
+            "watchdog.services.navigator.restart_window_s = 0: must be a number of seconds in [0.001, 86400]",
+        ],
+    );
+    let many = TempFile::new(
+        "limits",
+        "toml",
+        "[watchdog.services.fusion]\nmax_restarts = 100000\n",
+    );
+    fails_with(
+        "limits-many",
+        &["up", "--config", many.path()],
+        &["watchdog.services.fusion.max_restarts = 100000: must be <= 10000"],
+    );
+    let field = TempFile::new(
+        "limits",
+        "toml",
+        "[watchdog.services.sim]\nmax_restart = 3\n",
+    );
+    fails_with(
+        "limits-field",
+        &["up", "--config", field.path()],
+        &["max_restart", "max_restarts"],
+    );
     let action = TempFile::new("limits", "toml", "[watchdog]\ngive_up = \"panic\"\n");
     fails_with(
         "limits-action",

@@ -91,7 +91,11 @@ fn wait_for_path(path: &Path, supervisor: &mut Supervisor, shutdown: &Shutdown) 
     let mut events = Vec::new();
     while !path.exists() {
         supervisor.poll(&mut events);
-        if let Some(ChildEvent::Exited { name, status, .. }) = events.first() {
+        // A child given up (a restart limit of 0) stops the start-up too rather than being lost.
+        if let Some(
+            ChildEvent::Exited { name, status, .. } | ChildEvent::GaveUp { name, status, .. },
+        ) = events.first()
+        {
             bail!(
                 "{name} exited ({status}) before creating {}",
                 path.display()

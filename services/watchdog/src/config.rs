@@ -5,7 +5,7 @@ use std::time::Duration;
 
 use serde::Deserialize;
 
-use crate::restart_policy::{GiveUp, RestartPolicy};
+use crate::restart_policy::{GiveUp, MAX_RESTARTS_LIMIT, RestartPolicy};
 
 /// Services `[watchdog.services.NAME]` may name.
 pub const SUPERVISED: [&str; 6] = [
@@ -46,8 +46,10 @@ pub struct WatchdogConfig {
     /// restarted. 0 turns the check off.
     pub heartbeat_timeout_s: f64,
     /// At most this many restarts of one child within `restart_window_s`; one more and the
-    /// watchdog gives up on it (`give_up`). 0: never restart.
+    /// watchdog gives up on it (`give_up`). 0: never restart; at most
+    /// [`MAX_RESTARTS_LIMIT`], which bounds the exit instants kept per child.
     pub max_restarts: u32,
+    /// Seconds, in [0.001, 86400].
     pub restart_window_s: f64,
     /// `shutdown` (stop everything, `rins up` fails naming the child) or `leave-down`.
     pub give_up: GiveUp,
@@ -74,29 +76,17 @@ impl Default for WatchdogConfig {
 
 impl WatchdogConfig {
     pub fn validate(&self) -> Result<(), String> {
-        validate_restart(
-            "watchdog",
-            self.restart_initial_backoff_ms,
-            self.restart_max_backoff_ms,
-            self.restart_stable_after_s,
-            self.restart_window_s,
-        )?;
-        for (name, o) in &self.services {
+        self.settings_for(None).validate("watchdog")?;
+        for name in self.services.keys() {
             if !SUPERVISED.contains(&name.as_str()) {
                 return Err(format!(
                     "watchdog.services.{name}: no such service (expected one of {})",
                     SUPERVISED.join(", ")
                 ));
             }
-            let p = self.policy_for(name);
-            validate_restart(
-                &format!("watchdog.services.{name}"),
-                p.initial_backoff.as_millis() as u64,
-                p.max_backoff.as_millis() as u64,
-                o.restart_stable_after_s
-                    .unwrap_or(self.restart_stable_after_s),
-                o.restart_window_s.unwrap_or(self.restart_window_s),
-            )?;
+            // Checked merged: an override must fit with the `[watchdog]` values it keeps.
+            self.settings_for(Some(name))
+                .validate(&format!("watchdog.services.{name}"))?;
         }
         if !(self.status_period_s.is_finite() && self.status_period_s >= 0.0) {
             return Err(format!(
@@ -122,57 +112,90 @@ impl WatchdogConfig {
     /// The restart policy of service `name`: its overrides over the `[watchdog]` values. Call on
     /// a validated configuration (durations are then finite and non-negative).
     pub fn policy_for(&self, name: &str) -> RestartPolicy {
-        let o = self.services.get(name).cloned().unwrap_or_default();
+        let s = self.settings_for(Some(name));
         let seconds = |s: f64| Duration::try_from_secs_f64(s).unwrap_or(Duration::MAX);
         RestartPolicy {
-            initial_backoff: Duration::from_millis(
-                o.restart_initial_backoff_ms
-                    .unwrap_or(self.restart_initial_backoff_ms),
-            ),
-            max_backoff: Duration::from_millis(
-                o.restart_max_backoff_ms
-                    .unwrap_or(self.restart_max_backoff_ms),
-            ),
-            stable_after: seconds(
-                o.restart_stable_after_s
-                    .unwrap_or(self.restart_stable_after_s),
-            ),
+            initial_backoff: Duration::from_millis(s.initial_backoff_ms),
+            max_backoff: Duration::from_millis(s.max_backoff_ms),
+            stable_after: seconds(s.stable_after_s),
+            max_restarts: s.max_restarts,
+            window: seconds(s.window_s),
+            give_up: s.give_up,
+        }
+    }
+
+    /// The restart keys of service `name` (`None`: the `[watchdog]` values alone), as written, so
+    /// that validation can quote them.
+    fn settings_for(&self, name: Option<&str>) -> RestartSettings {
+        let o = name
+            .and_then(|n| self.services.get(n))
+            .cloned()
+            .unwrap_or_default();
+        RestartSettings {
+            initial_backoff_ms: o
+                .restart_initial_backoff_ms
+                .unwrap_or(self.restart_initial_backoff_ms),
+            max_backoff_ms: o
+                .restart_max_backoff_ms
+                .unwrap_or(self.restart_max_backoff_ms),
+            stable_after_s: o
+                .restart_stable_after_s
+                .unwrap_or(self.restart_stable_after_s),
             max_restarts: o.max_restarts.unwrap_or(self.max_restarts),
-            window: seconds(o.restart_window_s.unwrap_or(self.restart_window_s)),
+            window_s: o.restart_window_s.unwrap_or(self.restart_window_s),
             give_up: o.give_up.unwrap_or(self.give_up),
         }
     }
 }
 
-/// Range checks shared by `[watchdog]` and every `[watchdog.services.NAME]`.
-fn validate_restart(
-    section: &str,
-    initial_ms: u64,
-    max_ms: u64,
+/// The restart keys of one service after the fallback to `[watchdog]`, before conversion to a
+/// [`RestartPolicy`].
+struct RestartSettings {
+    initial_backoff_ms: u64,
+    max_backoff_ms: u64,
     stable_after_s: f64,
+    max_restarts: u32,
     window_s: f64,
-) -> Result<(), String> {
-    if initial_ms > max_ms {
-        return Err(format!(
-            "{section}.restart_initial_backoff_ms = {initial_ms}: must be <= restart_max_backoff_ms ({max_ms})"
-        ));
-    }
-    if max_ms > 3_600_000 {
-        return Err(format!(
-            "{section}.restart_max_backoff_ms = {max_ms}: must be <= 3600000 (an hour)"
-        ));
-    }
-    for (field, value) in [
-        ("restart_stable_after_s", stable_after_s),
-        ("restart_window_s", window_s),
-    ] {
-        if !(value.is_finite() && (0.0..=86_400.0).contains(&value)) {
+    give_up: GiveUp,
+}
+
+impl RestartSettings {
+    /// Range checks shared by `[watchdog]` and every `[watchdog.services.NAME]`; errors name
+    /// `section.field` and the value.
+    fn validate(&self, section: &str) -> Result<(), String> {
+        let (initial_ms, max_ms) = (self.initial_backoff_ms, self.max_backoff_ms);
+        if initial_ms > max_ms {
             return Err(format!(
-                "{section}.{field} = {value}: must be a number of seconds in [0, 86400]"
+                "{section}.restart_initial_backoff_ms = {initial_ms}: must be <= restart_max_backoff_ms ({max_ms})"
             ));
         }
+        if max_ms > 3_600_000 {
+            return Err(format!(
+                "{section}.restart_max_backoff_ms = {max_ms}: must be <= 3600000 (an hour)"
+            ));
+        }
+        let stable = self.stable_after_s;
+        if !(stable.is_finite() && (0.0..=86_400.0).contains(&stable)) {
+            return Err(format!(
+                "{section}.restart_stable_after_s = {stable}: must be a number of seconds in [0, 86400]"
+            ));
+        }
+        // A window shorter than the supervision loop's period (1 ms) would hold no earlier exit,
+        // so the limit would never apply.
+        let window = self.window_s;
+        if !(window.is_finite() && (0.001..=86_400.0).contains(&window)) {
+            return Err(format!(
+                "{section}.restart_window_s = {window}: must be a number of seconds in [0.001, 86400]"
+            ));
+        }
+        if self.max_restarts > MAX_RESTARTS_LIMIT {
+            return Err(format!(
+                "{section}.max_restarts = {}: must be <= {MAX_RESTARTS_LIMIT} (0: never restart)",
+                self.max_restarts
+            ));
+        }
+        Ok(())
     }
-    Ok(())
 }
 
 #[cfg(test)]
@@ -242,5 +265,54 @@ mod tests {
         assert!(
             toml::from_str::<WatchdogConfig>("[services.fusion]\ngive_up = \"pray\"\n").is_err()
         );
+        assert!(toml::from_str::<WatchdogConfig>("[services.fusion]\nmax_restart = 3\n").is_err());
+    }
+
+    #[test]
+    fn limits_and_windows_out_of_range_are_refused() {
+        let err = parse("[services.fusion]\nmax_restarts = 10001\n")
+            .validate()
+            .unwrap_err();
+        assert_eq!(
+            err,
+            "watchdog.services.fusion.max_restarts = 10001: must be <= 10000 (0: never restart)"
+        );
+        assert!(parse("max_restarts = 10000\n").validate().is_ok());
+        assert!(parse("max_restarts = 0\n").validate().is_ok());
+        for window in ["0", "-0.0", "1e-300", "0.0009", "nan", "inf", "86400.5"] {
+            let err = parse(&format!("restart_window_s = {window}\n"))
+                .validate()
+                .unwrap_err();
+            assert!(err.starts_with("watchdog.restart_window_s = "), "{err}");
+            assert!(err.contains("[0.001, 86400]"), "{err}");
+        }
+        let err = parse("[services.sim]\nrestart_stable_after_s = nan\n")
+            .validate()
+            .unwrap_err();
+        assert!(
+            err.starts_with("watchdog.services.sim.restart_stable_after_s = NaN"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn an_override_is_checked_with_the_values_it_keeps() {
+        // Raising only the initial backoff above the global cap is refused; raising both is fine.
+        assert!(
+            parse("[services.navigator]\nrestart_initial_backoff_ms = 6000\n")
+                .validate()
+                .is_err()
+        );
+        let c = parse(
+            "[services.navigator]\nrestart_initial_backoff_ms = 6000\nrestart_max_backoff_ms = 60000\n",
+        );
+        assert!(c.validate().is_ok());
+        let p = c.policy_for("navigator");
+        assert_eq!(
+            (p.initial_backoff, p.max_backoff),
+            (Duration::from_secs(6), Duration::from_secs(60))
+        );
+        // A service without a section gets the `[watchdog]` values.
+        assert_eq!(c.policy_for("fusion"), RestartPolicy::default());
     }
 }

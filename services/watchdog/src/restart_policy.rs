@@ -75,8 +75,12 @@ impl RestartPolicy {
     }
 }
 
+/// The largest `max_restarts` the configuration accepts. It bounds the ring of exit instants each
+/// child keeps (16 bytes an entry), so that the ring is allocated once at start and never grows.
+pub const MAX_RESTARTS_LIMIT: u32 = 10_000;
+
 /// The exits of one child within the policy's window. Holds at most `max_restarts + 1` instants,
-/// allocated once.
+/// allocated once: recording an exit never allocates.
 #[derive(Debug, Clone)]
 pub struct RestartWindow {
     exits: VecDeque<Instant>,
@@ -85,11 +89,13 @@ pub struct RestartWindow {
 }
 
 impl RestartWindow {
+    /// A limit above [`MAX_RESTARTS_LIMIT`] (only possible for a policy not read from the
+    /// configuration, which refuses it) is taken as that limit, keeping the ring bounded.
     pub fn new(policy: &RestartPolicy) -> Self {
-        let capacity = usize::try_from(policy.max_restarts).unwrap_or(usize::MAX - 1) + 1;
+        let max_restarts = policy.max_restarts.min(MAX_RESTARTS_LIMIT);
         Self {
-            exits: VecDeque::with_capacity(capacity.min(4096)),
-            max_restarts: policy.max_restarts,
+            exits: VecDeque::with_capacity(max_restarts as usize + 1),
+            max_restarts,
             window: policy.window,
         }
     }
@@ -176,5 +182,44 @@ mod tests {
         };
         let mut w = RestartWindow::new(&p);
         assert!(!w.allow_restart(Instant::now()));
+    }
+
+    #[test]
+    fn the_ring_never_grows_past_its_first_allocation() {
+        let p = RestartPolicy {
+            max_restarts: 5,
+            window: Duration::from_secs(3600),
+            ..RestartPolicy::default()
+        };
+        let mut w = RestartWindow::new(&p);
+        let capacity = w.exits.capacity();
+        let t0 = Instant::now();
+        for i in 0..1_000 {
+            w.allow_restart(t0 + Duration::from_millis(i));
+        }
+        assert_eq!(w.exits(), 6);
+        assert_eq!(w.exits.capacity(), capacity);
+        // A limit beyond what the configuration accepts is clamped, not allocated.
+        let huge = RestartWindow::new(&RestartPolicy {
+            max_restarts: u32::MAX,
+            ..RestartPolicy::default()
+        });
+        assert!(huge.exits.capacity() <= MAX_RESTARTS_LIMIT as usize + 1 + 64);
+    }
+
+    #[test]
+    fn exits_exactly_one_window_apart_still_count() {
+        let p = RestartPolicy {
+            max_restarts: 1,
+            window: Duration::from_secs(10),
+            ..RestartPolicy::default()
+        };
+        let t0 = Instant::now();
+        let mut w = RestartWindow::new(&p);
+        assert!(w.allow_restart(t0));
+        assert!(!w.allow_restart(t0 + Duration::from_secs(10)));
+        let mut w = RestartWindow::new(&p);
+        assert!(w.allow_restart(t0));
+        assert!(w.allow_restart(t0 + Duration::from_millis(10_001)));
     }
 }

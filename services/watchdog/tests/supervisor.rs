@@ -1,0 +1,130 @@
+//! The supervisor with real child processes: a child that keeps exiting is restarted exactly
+//! `max_restarts` times, then given up (no further restart, reported as given up), while a healthy
+//! sibling is left alone.
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use rins_watchdog::restart_policy::{GiveUp, RestartPolicy};
+use rins_watchdog::supervisor::{ChildEvent, ChildSpec, Supervisor};
+
+fn shell(name: &str, script: &str, policy: RestartPolicy) -> ChildSpec {
+    ChildSpec {
+        name: name.to_string(),
+        program: PathBuf::from("/bin/sh"),
+        args: vec!["-c".to_string(), script.to_string()],
+        policy,
+    }
+}
+
+/// Polls until `done` holds for the events seen so far (at most 10 s).
+fn poll_until(
+    supervisor: &mut Supervisor,
+    done: impl Fn(&[ChildEvent]) -> bool,
+) -> Vec<ChildEvent> {
+    let start = Instant::now();
+    let mut events = Vec::new();
+    while !done(&events) {
+        assert!(start.elapsed() < Duration::from_secs(10), "{events:?}");
+        supervisor.poll(&mut events);
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    events
+}
+
+fn gave_up(events: &[ChildEvent]) -> bool {
+    events
+        .iter()
+        .any(|e| matches!(e, ChildEvent::GaveUp { .. }))
+}
+
+#[test]
+fn a_crashing_child_is_restarted_up_to_its_limit_then_given_up() {
+    let policy = RestartPolicy {
+        initial_backoff: Duration::from_millis(1),
+        max_backoff: Duration::from_millis(4),
+        max_restarts: 2,
+        window: Duration::from_secs(60),
+        give_up: GiveUp::LeaveDown,
+        ..RestartPolicy::default()
+    };
+    let mut supervisor = Supervisor::new();
+    supervisor
+        .start(shell("altimeter", "exit 3", policy))
+        .expect("start the crashing child");
+    supervisor
+        .start(shell("fusion", "exec sleep 30", RestartPolicy::default()))
+        .expect("start the healthy child");
+    let events = poll_until(&mut supervisor, gave_up);
+
+    let exited = events
+        .iter()
+        .filter(|e| matches!(e, ChildEvent::Exited { .. }))
+        .count();
+    let restarted = events
+        .iter()
+        .filter(|e| matches!(e, ChildEvent::Restarted { .. }))
+        .count();
+    assert_eq!((exited, restarted), (2, 2), "{events:?}");
+    match events.last() {
+        Some(ChildEvent::GaveUp {
+            name,
+            status,
+            exits,
+            window,
+            action,
+        }) => {
+            assert_eq!(name, "altimeter");
+            assert!(status.contains('3'), "{status}");
+            assert_eq!(
+                (*exits, *window, *action),
+                (3, Duration::from_secs(60), GiveUp::LeaveDown)
+            );
+        }
+        other => panic!("the last event should be the give-up: {other:?}"),
+    }
+
+    // Given up stays given up: no restart however long it is polled.
+    let mut later = Vec::new();
+    for _ in 0..50 {
+        supervisor.poll(&mut later);
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    assert!(later.is_empty(), "{later:?}");
+    let children = supervisor.children();
+    let altimeter = &children[0];
+    assert_eq!(
+        (altimeter.pid, altimeter.restarts, altimeter.given_up),
+        (None, 2, true)
+    );
+    let fusion = &children[1];
+    assert!(fusion.pid.is_some() && !fusion.given_up, "{fusion:?}");
+    assert_eq!(supervisor.running().len(), 1);
+    supervisor.stop_all(Duration::from_secs(2));
+    assert!(supervisor.running().is_empty());
+}
+
+#[test]
+fn a_zero_limit_gives_up_at_the_first_exit() {
+    let policy = RestartPolicy {
+        max_restarts: 0,
+        ..RestartPolicy::default()
+    };
+    let mut supervisor = Supervisor::new();
+    supervisor
+        .start(shell("sim", "exit 0", policy))
+        .expect("start the child");
+    let events = poll_until(&mut supervisor, gave_up);
+    assert!(
+        matches!(
+            events.as_slice(),
+            [ChildEvent::GaveUp {
+                exits: 1,
+                action: GiveUp::Shutdown,
+                ..
+            }]
+        ),
+        "{events:?}"
+    );
+    assert_eq!(supervisor.restarts(), 0);
+}
