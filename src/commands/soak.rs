@@ -17,6 +17,7 @@ use rins_runtime::ipc::{IpcSettings, TopicSubscriber, create_node};
 use rins_runtime::lane_selector::{SelectorConfig, trusted};
 use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::shutdown::Shutdown;
+use rins_watchdog::seq_gaps::SeqGaps;
 use serde::Serialize;
 
 use crate::cli::SoakArgs;
@@ -62,10 +63,10 @@ pub struct SoakSummary {
 /// Tracks the navigation output: sequence gaps and the longest silence.
 #[derive(Debug, Default)]
 struct NavWatch {
-    last_seq: Option<u64>,
+    /// Sequence numbers missing from the stream (the watchdog's own count).
+    gaps: SeqGaps,
     last_at: Option<Instant>,
     samples: u64,
-    lost: u64,
     max_gap: Duration,
     navigated: bool,
     not_navigating: u64,
@@ -81,15 +82,10 @@ impl NavWatch {
     }
 
     fn observe(&mut self, seq: u64, at: Instant) {
-        if let Some(last) = self.last_seq
-            && seq > last
-        {
-            self.lost += seq - last - 1;
-        }
+        self.gaps.observe(seq);
         if let Some(prev) = self.last_at {
             self.max_gap = self.max_gap.max(at - prev);
         }
-        self.last_seq = Some(self.last_seq.map_or(seq, |l| l.max(seq)));
         self.last_at = Some(at);
         self.samples += 1;
     }
@@ -222,7 +218,7 @@ pub fn run(args: &SoakArgs) -> Result<()> {
         let now = Instant::now();
         // No kill in the last seconds: every killed service must be back before the summary.
         if now >= next_kill && now + SETTLE < end {
-            if !recovered(report.as_ref(), &nav_in, nav.last_seq.unwrap_or(0)) {
+            if !recovered(report.as_ref(), &nav_in, nav.gaps.last().unwrap_or(0)) {
                 deferred += 1;
                 next_kill = now + RECHECK;
                 continue;
@@ -245,7 +241,7 @@ pub fn run(args: &SoakArgs) -> Result<()> {
                 (now - start).as_secs_f64(),
                 run_s,
                 kills.iter().sum::<u64>(),
-                nav.lost,
+                nav.gaps.missing,
                 nav.max_gap.as_secs_f64() * 1e3
             );
             next_progress += Duration::from_secs(10);
@@ -275,7 +271,7 @@ pub fn run(args: &SoakArgs) -> Result<()> {
             .collect(),
         restarts: number("restarts"),
         nav_samples: nav.samples,
-        lost_nav_samples: nav.lost,
+        lost_nav_samples: nav.gaps.missing,
         max_gap_ms: nav.max_gap.as_secs_f64() * 1e3,
         not_navigating_samples: nav.not_navigating,
         lane_switches,
@@ -299,9 +295,9 @@ mod tests {
             w.observe(seq, t0 + Duration::from_millis(ms));
         }
         // 12, 13, 14 missing at the jump; the late 14 does not undo the count nor move the seq back.
-        assert_eq!(w.lost, 3);
+        assert_eq!(w.gaps.missing, 3);
         assert_eq!(w.samples, 6);
-        assert_eq!(w.last_seq, Some(17));
+        assert_eq!(w.gaps.last(), Some(17));
         assert_eq!(w.max_gap, Duration::from_millis(39));
     }
 }

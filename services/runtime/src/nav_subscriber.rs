@@ -19,16 +19,12 @@ pub struct NavSubscriber {
 
 impl NavSubscriber {
     pub fn new(node: &IpcNode) -> Result<Self> {
-        Self::with_config(node, SelectorConfig::default())
-    }
-
-    pub fn with_config(node: &IpcNode, config: SelectorConfig) -> Result<Self> {
         Ok(Self {
             lanes: [
                 TopicSubscriber::new(node, names::NAV_LANES[0])?,
                 TopicSubscriber::new(node, names::NAV_LANES[1])?,
             ],
-            selector: LaneSelector::new(config),
+            selector: LaneSelector::new(SelectorConfig::default()),
             lane_totals: [0; LANES],
             lane_latest: [None; LANES],
         })

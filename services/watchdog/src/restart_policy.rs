@@ -18,15 +18,6 @@ pub enum GiveUp {
     LeaveDown,
 }
 
-impl GiveUp {
-    pub fn name(self) -> &'static str {
-        match self {
-            GiveUp::Shutdown => "shutdown",
-            GiveUp::LeaveDown => "leave-down",
-        }
-    }
-}
-
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RestartPolicy {
     /// Delay before the first restart.

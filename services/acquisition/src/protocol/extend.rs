@@ -46,11 +46,6 @@ impl SeqExtender {
     pub fn last(&self) -> Option<u64> {
         self.last
     }
-
-    /// Forgets the reference; the next frame sets it again.
-    pub fn reset(&mut self) {
-        *self = Self::default();
-    }
 }
 
 /// Extends the device's 32-bit microsecond clock (wraps every 2^32 µs ≈ 71.6 min) to 64 bits.
@@ -83,11 +78,6 @@ impl TimeExtender {
         u64::try_from(extended).unwrap_or(0)
     }
 
-    /// Forgets the reference; the next frame sets it again.
-    pub fn reset(&mut self) {
-        self.last = None;
-    }
-
     /// Continues from `last_us`, the extended time of a frame published earlier.
     pub fn resume_from(&mut self, last_us: u64) {
         self.last = i64::try_from(last_us).ok();
@@ -113,8 +103,6 @@ mod tests {
         // 65535 steps forward: 65534 lost.
         assert_eq!(s.extend(2), (65539 + 65535, 65534));
         assert_eq!(s.extend(2), (65539 + 65535, 0));
-        s.reset();
-        assert_eq!(s.extend(100), (100, 0));
     }
 
     #[test]
