@@ -30,9 +30,9 @@ pub enum Command {
     },
     /// Run the device simulator on a pseudo-terminal.
     Sim(SimArgs),
-    /// Print every sample of a topic.
-    /// Randomised SIGKILLs of the services under a running pipeline; JSON summary of kills,
-    /// restarts, lost navigation samples, the longest output gap and leaked shared memory.
+    /// Randomised faults under a running pipeline (SIGKILLs, hangs, sensor-channel faults, serial
+    /// unplugs); JSON summary of kills, restarts, lost navigation samples per fault kind, the
+    /// longest output gap and leaked shared memory.
     Soak(SoakArgs),
     /// The watchdog's report on every process: state, pid, restarts, heartbeat age, output rate.
     Status {
@@ -43,6 +43,7 @@ pub enum Command {
         #[arg(long, default_value_t = 2.0)]
         timeout: f64,
     },
+    /// Print every sample of a topic.
     Echo {
         /// Topic: raw-imu, raw-baro, raw-mag, raw-aux, fused-imu, altitude, nav, truth, heartbeat,
         /// health.
@@ -311,13 +312,41 @@ pub struct SoakArgs {
     /// How long to run, minutes.
     #[arg(long)]
     pub minutes: f64,
-    /// Seed of the kill schedule.
+    /// Seed of the fault schedule.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Shortest time between two kills, s.
+    /// Shortest time between two faults, s.
     #[arg(long = "min-interval", default_value_t = 2.0)]
     pub min_interval_s: f64,
-    /// Longest time between two kills, s.
+    /// Longest time between two faults, s.
     #[arg(long = "max-interval", default_value_t = 6.0)]
     pub max_interval_s: f64,
+    /// Kinds of fault, comma-separated: kill (SIGKILL a service), hang (SIGSTOP a service until
+    /// the watchdog replaces it), sensor (fault one gyro or accelerometer channel, then clear and
+    /// readmit it), disconnect (unplug the serial device for 0.2-1 s).
+    #[arg(long, default_value = "kill,sensor")]
+    pub faults: String,
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    use super::Cli;
+
+    /// `rins --help` is the operator's map: every command, at every depth, says what it does (a
+    /// doc comment that drifts onto the next command leaves its own command without one).
+    #[test]
+    fn every_command_says_what_it_does() {
+        fn check(cmd: &clap::Command, path: &str) {
+            for sub in cmd.get_subcommands().filter(|s| s.get_name() != "help") {
+                let path = format!("{path} {}", sub.get_name());
+                let about = sub.get_about().map(|a| a.to_string()).unwrap_or_default();
+                assert!(!about.trim().is_empty(), "`{path}` has no description");
+                check(sub, &path);
+            }
+        }
+        Cli::command().debug_assert();
+        check(&Cli::command(), "rins");
+    }
 }

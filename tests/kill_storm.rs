@@ -6,7 +6,7 @@ mod common;
 
 use std::time::{Duration, Instant};
 
-use common::{Isolated, PipelineSlot, num, spawn_up, stop_up};
+use common::{Isolated, PipelineSlot, num, spawn_up_navigating, stop_up};
 use serde_json::Value;
 
 const KILLS: usize = 50;
@@ -78,12 +78,10 @@ fn fifty_kills_leave_no_zombie_no_shared_memory_growth_and_a_live_watchdog() {
     let _alone = ALONE.lock().unwrap_or_else(|e| e.into_inner());
     let _slot = PipelineSlot::take();
     let ipc = Isolated::new("storm");
-    let up = spawn_up(
+    let up = spawn_up_navigating(
         &ipc,
         &["--scenario", "static", "--duration", "600", "--json"],
     );
-    let first = ipc.run(&["echo", "nav", "--count", "1", "--timeout", "120"]);
-    assert!(first.status.success());
     let pids = wait_all_running(&ipc, Duration::from_secs(30));
     let watchdog = pids
         .iter()
@@ -147,12 +145,10 @@ fn the_watchdog_frees_the_shared_memory_of_a_killed_process_it_did_not_start() {
     let _alone = ALONE.lock().unwrap_or_else(|e| e.into_inner());
     let _slot = PipelineSlot::take();
     let ipc = Isolated::new("deadnode");
-    let up = spawn_up(
+    let up = spawn_up_navigating(
         &ipc,
         &["--scenario", "static", "--duration", "120", "--json"],
     );
-    let first = ipc.run(&["echo", "nav", "--count", "1", "--timeout", "120"]);
-    assert!(first.status.success());
     wait_all_running(&ipc, Duration::from_secs(30));
     let before = ipc.shm_entries().len();
     // A consumer on the deployment's prefix, killed without a chance to clean up: its node and

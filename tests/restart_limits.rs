@@ -5,7 +5,7 @@ mod common;
 
 use std::time::{Duration, Instant};
 
-use common::{Isolated, PipelineSlot, TempFile, fails_with, spawn_up, stderr, stop_up};
+use common::{Isolated, PipelineSlot, TempFile, fails_with, spawn_up_navigating, stderr, stop_up};
 use serde_json::Value;
 
 fn service(report: &Value, name: &str) -> Value {
@@ -47,7 +47,7 @@ fn a_service_over_its_limit_is_left_down_and_the_rest_navigates() {
         "toml",
         "[watchdog.services.altimeter]\nmax_restarts = 2\nrestart_window_s = 60\ngive_up = \"leave-down\"\n",
     );
-    let up = spawn_up(
+    let up = spawn_up_navigating(
         &ipc,
         &[
             "--config",
@@ -59,8 +59,6 @@ fn a_service_over_its_limit_is_left_down_and_the_rest_navigates() {
             "--json",
         ],
     );
-    let first = ipc.run(&["echo", "nav", "--count", "1", "--timeout", "120"]);
-    assert!(first.status.success());
     // Two kills are restarted; the third is one too many.
     let mut pid = running_pid(&ipc, "altimeter", None);
     for _ in 0..2 {

@@ -5,7 +5,7 @@ mod common;
 
 use std::time::{Duration, Instant};
 
-use common::{Isolated, PipelineSlot, spawn_up, stop_up};
+use common::{Isolated, PipelineSlot, spawn_up, spawn_up_navigating, stop_up};
 use serde_json::Value;
 
 fn service<'a>(report: &'a Value, name: &str) -> &'a Value {
@@ -34,12 +34,10 @@ fn wait_for(ipc: &Isolated, limit: Duration, done: impl Fn(&Value) -> bool) -> V
 fn status_shows_every_process_and_counts_a_restart_after_sigkill() {
     let _slot = PipelineSlot::take();
     let ipc = Isolated::new("status");
-    let up = spawn_up(
+    let up = spawn_up_navigating(
         &ipc,
         &["--scenario", "static", "--duration", "300", "--json"],
     );
-    let first = ipc.run(&["echo", "nav", "--count", "1", "--timeout", "120"]);
-    assert!(first.status.success());
 
     let names = [
         "watchdog",

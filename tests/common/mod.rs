@@ -192,6 +192,15 @@ pub fn spawn_up(ipc: &Isolated, args: &[&str]) -> std::process::Child {
         .expect("cannot start rins up")
 }
 
+/// [`spawn_up`], then waits (up to two minutes: a loaded machine starts six processes slowly) for
+/// the first navigation sample, so the pipeline is known to run end to end.
+pub fn spawn_up_navigating(ipc: &Isolated, args: &[&str]) -> std::process::Child {
+    let up = spawn_up(ipc, args);
+    let first = ipc.run(&["echo", "nav", "--count", "1", "--timeout", "120"]);
+    assert!(first.status.success(), "no navigation sample: {first:?}");
+    up
+}
+
 /// Stops a pipeline from [`spawn_up`] with SIGTERM, as an operator does, checks that it ended
 /// cleanly with no shared memory left, and returns its JSON summary.
 pub fn stop_up(ipc: &Isolated, up: std::process::Child) -> serde_json::Value {
