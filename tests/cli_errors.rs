@@ -74,11 +74,23 @@ fn echo_without_a_pipeline_times_out_naming_the_topic() {
 fn soak_refuses_bad_arguments_before_starting_anything() {
     fails_with(
         &["soak", "--minutes", "1", "--faults", "kill,reboot"],
-        &["--faults \"kill,reboot\"", "\"reboot\"", "kill, hang, sensor, disconnect"],
+        &[
+            "--faults \"kill,reboot\"",
+            "\"reboot\"",
+            "kill, hang, sensor, disconnect",
+        ],
     );
     fails_with(&["soak", "--minutes", "0"], &["--minutes 0"]);
     fails_with(
-        &["soak", "--minutes", "1", "--min-interval", "3", "--max-interval", "2"],
+        &[
+            "soak",
+            "--minutes",
+            "1",
+            "--min-interval",
+            "3",
+            "--max-interval",
+            "2",
+        ],
         &["--min-interval 3 / --max-interval 2"],
     );
 }

@@ -8,9 +8,15 @@
 //!
 //! Switching rule, built against the known failure modes of lane switching:
 //! - **Dead lane** (liveness): the selected lane has delivered nothing beyond the output while the
-//!   other lane is [`SelectorConfig::switch_lag`] samples ahead. One late sample is not a failure
-//!   (no switch on a glitch): the lag has to build up first, which bounds the output gap to
-//!   `switch_lag` sample periods.
+//!   other lane is [`SelectorConfig::switch_lag`] samples ahead *and* has published for
+//!   [`SelectorConfig::dead_after_ns`] since the selected lane's last sample (navigator publish
+//!   times). One late sample is not a failure (no switch on a glitch): the lag has to build up
+//!   first, which bounds the output gap to `switch_lag` sample periods. Nor is a burst: when a
+//!   restarted fusion replays its history, or the serial line delivers what waited in it, both
+//!   lanes work through hundreds of samples within a millisecond and one is briefly ahead; the
+//!   selected lane is only dead when it has been silent for the time, not merely behind in count.
+//!   A lane so far ahead that its pending samples would overflow ([`FORCE_SWITCH_PENDING`]) is
+//!   taken regardless, since losing samples is worse than a switch.
 //! - **Untrusted lane** (quality): the selected lane is aligning or its solution is younger than
 //!   [`SelectorConfig::settle`] samples (it just reset or took over), while the other lane is trusted
 //!   and has the next sample. A lane that just reset is never chosen for quality: only a dead
@@ -25,18 +31,25 @@
 
 use std::collections::VecDeque;
 
-use ipc_types::{NavMode, NavState};
+use ipc_types::{NavMode, NavState, Stage};
 
 /// Number of navigator lanes.
 pub const LANES: usize = 2;
 
-/// Pending samples kept per lane; more than any switch lag, so a switch always finds the next one.
-const PENDING: usize = 64;
+/// Pending samples kept per lane; more than any switch lag and than a burst that builds up while
+/// the selected lane is silent for less than the dead time, so a switch always finds the next one.
+const PENDING: usize = 512;
+
+/// Pending samples of the other lane at which a silent selected lane is left at once.
+pub const FORCE_SWITCH_PENDING: usize = PENDING / 2;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SelectorConfig {
     /// Samples the other lane must be ahead of the output before the selected lane counts as dead.
     pub switch_lag: u64,
+    /// And how long the other lane must have published since the selected lane's last sample, ns
+    /// (samples without publish times are judged by the count alone).
+    pub dead_after_ns: u64,
     /// Samples a solution must have run (since alignment or takeover) before it is trusted.
     pub settle: u64,
     /// Samples between a switch and a quality switch.
@@ -49,6 +62,7 @@ impl Default for SelectorConfig {
     fn default() -> Self {
         Self {
             switch_lag: 8,
+            dead_after_ns: 8_000_000,
             settle: 2000,
             min_dwell: 1000,
         }
@@ -80,6 +94,9 @@ pub struct LaneSelector {
     pending: [VecDeque<NavState>; LANES],
     selected: usize,
     last_delivered: Option<u64>,
+    /// Navigator publish time of the newest sample delivered from the selected lane (0: none yet,
+    /// or unstamped).
+    selected_published_ns: u64,
     last_switch_seq: Option<u64>,
     switches: u64,
     last_switch: Option<Switch>,
@@ -101,6 +118,7 @@ impl LaneSelector {
             pending: std::array::from_fn(|_| VecDeque::with_capacity(PENDING)),
             selected: 0,
             last_delivered: None,
+            selected_published_ns: 0,
             last_switch_seq: None,
             switches: 0,
             last_switch: None,
@@ -169,6 +187,9 @@ impl LaneSelector {
         };
         let sample = self.pending[lane].pop_front()?;
         self.last_delivered = Some(sample.header.origin_seq);
+        if lane == self.selected {
+            self.selected_published_ns = sample.header.stage_ns(Stage::Navigator);
+        }
         Some(sample)
     }
 
@@ -197,7 +218,9 @@ impl LaneSelector {
             // Dead: nothing from the selected lane while the other has delivered `switch_lag`
             // samples ahead of the output. Counted in samples, not in sequence numbers, so that a
             // hole in the input (both lanes skip the same numbers) is no reason to switch.
-            return self.pending[other].len() as u64 >= self.config.switch_lag;
+            let ahead = self.pending[other].len();
+            return ahead >= FORCE_SWITCH_PENDING
+                || (ahead as u64 >= self.config.switch_lag && self.silent_for_dead_time(other));
         };
         // Untrusted: only towards a trusted lane that has the next sample (not behind the
         // selected one), and not within the dwell time of the last switch.
@@ -208,6 +231,17 @@ impl LaneSelector {
             && !trusted(next, self.config.settle)
             && trusted(candidate, self.config.settle)
             && candidate.header.origin_seq <= next.header.origin_seq
+    }
+
+    /// The other lane has published for the dead time since the selected lane's last sample.
+    fn silent_for_dead_time(&self, other: usize) -> bool {
+        let newest = self.pending[other]
+            .back()
+            .map_or(0, |s| s.header.stage_ns(Stage::Navigator));
+        if self.selected_published_ns == 0 || newest == 0 {
+            return true;
+        }
+        newest.saturating_sub(self.selected_published_ns) >= self.config.dead_after_ns
     }
 
     fn switch_to(&mut self, lane: usize) {
@@ -226,6 +260,8 @@ impl LaneSelector {
             at_seq,
         });
         self.selected = lane;
+        // The new lane's clock starts with its first delivery.
+        self.selected_published_ns = 0;
         self.last_switch_seq = Some(at_seq);
         self.switches += 1;
     }
@@ -240,6 +276,7 @@ mod tests {
     fn cfg() -> SelectorConfig {
         SelectorConfig {
             switch_lag: 8,
+            dead_after_ns: 8_000_000,
             settle: SETTLE,
             min_dwell: 50,
         }
@@ -341,6 +378,85 @@ mod tests {
         assert_eq!(sel.switches(), 0);
         assert!(out.iter().all(|o| o.1 == 0));
         assert_eq!(out.len(), 300);
+    }
+
+    /// [`nav`] published by its navigator at `ns`.
+    fn stamped(lane: u8, seq: u64, ns: u64) -> NavState {
+        let mut s = nav(lane, seq, 1);
+        s.header.stamp(Stage::Navigator, ns);
+        s
+    }
+
+    const MS: u64 = 1_000_000;
+
+    #[test]
+    fn a_burst_with_the_other_lane_ahead_is_not_a_dead_lane() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        for seq in 1..=100 {
+            sel.push(0, stamped(0, seq, seq * MS));
+            sel.push(1, stamped(1, seq, seq * MS));
+            drain(&mut sel, &mut out);
+        }
+        // A replayed history: 300 samples within 0.3 ms, lane 1 working through 40 at a time
+        // before lane 0 catches up.
+        let t0 = 101 * MS;
+        for chunk in (101..=400u64).collect::<Vec<_>>().chunks(40) {
+            for &seq in chunk {
+                sel.push(1, stamped(1, seq, t0 + seq * 1_000));
+            }
+            drain(&mut sel, &mut out);
+            for &seq in chunk {
+                sel.push(0, stamped(0, seq, t0 + seq * 1_000 + 500));
+            }
+            drain(&mut sel, &mut out);
+        }
+        assert_eq!(sel.switches(), 0);
+        assert_eq!(out.len(), 400);
+        assert!(
+            out.iter()
+                .enumerate()
+                .all(|(i, &(s, l))| s == i as u64 + 1 && l == 0)
+        );
+    }
+
+    #[test]
+    fn a_silent_lane_is_left_after_the_dead_time() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        let mut stall = 0;
+        for seq in 1..=300 {
+            sel.push(1, stamped(1, seq, seq * MS));
+            if seq <= 200 {
+                sel.push(0, stamped(0, seq, seq * MS));
+            }
+            let before = out.len();
+            drain(&mut sel, &mut out);
+            stall += u32::from(out.len() == before);
+        }
+        // Lane 1 publishes 208 at 208 ms, 8 ms after lane 0's last sample: the switch.
+        assert_eq!(stall, 7);
+        assert_eq!(sel.last_switch().map(|s| (s.to, s.at_seq)), Some((1, 201)));
+        assert_eq!(out.len(), 300);
+    }
+
+    #[test]
+    fn a_burst_that_would_overflow_the_pending_samples_switches_at_once() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        for seq in 1..=200 {
+            sel.push(0, stamped(0, seq, seq * MS));
+            sel.push(1, stamped(1, seq, seq * MS));
+            drain(&mut sel, &mut out);
+        }
+        // Lane 0 is gone; lane 1 replays 2 × PENDING samples within a millisecond.
+        for seq in 201..=200 + 2 * PENDING as u64 {
+            sel.push(1, stamped(1, seq, 200 * MS + seq));
+            drain(&mut sel, &mut out);
+        }
+        assert_eq!(sel.last_switch().map(|s| (s.to, s.at_seq)), Some((1, 201)));
+        let seqs: Vec<u64> = out.iter().map(|o| o.0).collect();
+        assert_eq!(seqs, (1..=200 + 2 * PENDING as u64).collect::<Vec<_>>());
     }
 
     #[test]
