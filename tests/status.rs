@@ -5,7 +5,7 @@ mod common;
 
 use std::time::{Duration, Instant};
 
-use common::{Isolated, PipelineSlot, spawn_up, spawn_up_navigating, stop_up};
+use common::{Isolated, PipelineSlot, TempFile, spawn_up, spawn_up_navigating, stop_up};
 use serde_json::Value;
 
 fn service<'a>(report: &'a Value, name: &str) -> &'a Value {
@@ -103,9 +103,19 @@ fn status_without_a_pipeline_fails_naming_the_prefix() {
 fn a_stopped_service_is_seen_silent_killed_and_restarted() {
     let _slot = PipelineSlot::take();
     let ipc = Isolated::new("hang");
+    // The heartbeat path alone: the output deadline would replace the navigator sooner.
+    let config = TempFile::new("hang", "toml", "[watchdog]\noutput_deadline_s = 0\n");
     let up = spawn_up(
         &ipc,
-        &["--scenario", "static", "--duration", "300", "--json"],
+        &[
+            "--config",
+            config.path(),
+            "--scenario",
+            "static",
+            "--duration",
+            "300",
+            "--json",
+        ],
     );
     let report = wait_for(&ipc, Duration::from_secs(60), |r| {
         service(r, "navigator")["state"] == "running"
@@ -130,6 +140,51 @@ fn a_stopped_service_is_seen_silent_killed_and_restarted() {
     let again = ipc.run(&["echo", "nav", "--count", "5", "--timeout", "30"]);
     assert!(again.status.success());
 
+    assert_eq!(stop_up(&ipc, up)["restarts"], 1);
+}
+
+#[test]
+fn a_stage_that_stops_answering_its_input_is_replaced_by_its_output_deadline() {
+    let _slot = PipelineSlot::take();
+    let ipc = Isolated::new("deadline");
+    // Heartbeats would take ten minutes to call it hung: only the output deadline can act here.
+    let config = TempFile::new(
+        "deadline",
+        "toml",
+        "[watchdog]\nheartbeat_timeout_s = 600\noutput_deadline_s = 0.5\n",
+    );
+    let up = spawn_up_navigating(
+        &ipc,
+        &[
+            "--config",
+            config.path(),
+            "--scenario",
+            "static",
+            "--duration",
+            "300",
+            "--json",
+        ],
+    );
+    let report = wait_for(&ipc, Duration::from_secs(60), |r| {
+        service(r, "fusion")["state"] == "running"
+    });
+    let old_pid = service(&report, "fusion")["pid"].as_u64().unwrap();
+    let pid = libc::pid_t::try_from(old_pid).expect("pid fits pid_t");
+    // SIGSTOP: raw IMU samples go on arriving, fused ones stop.
+    // SAFETY: sends a signal to a process of this test's own pipeline.
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGSTOP) }, 0);
+    let after = wait_for(&ipc, Duration::from_secs(20), |r| {
+        let f = service(r, "fusion");
+        f["restarts"] == 1 && f["state"] == "running"
+    });
+    assert_ne!(service(&after, "fusion")["pid"].as_u64().unwrap(), old_pid);
+    // SAFETY: signal 0 only checks whether the pid exists.
+    assert_ne!(unsafe { libc::kill(pid, 0) }, 0, "pid {pid} still exists");
+    for name in ["acquisition", "altimeter", "navigator", "navigator-standby"] {
+        assert_eq!(service(&after, name)["restarts"], 0, "{name}: {after}");
+    }
+    let again = ipc.run(&["echo", "nav", "--count", "5", "--timeout", "30"]);
+    assert!(again.status.success());
     assert_eq!(stop_up(&ipc, up)["restarts"], 1);
 }
 

@@ -6,11 +6,13 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
+use ipc_types::ServiceKind;
 use rins_runtime::ipc::{IpcSettings, create_node};
 use rins_runtime::shm_cleanup;
 use rins_runtime::shutdown::Shutdown;
 use rins_watchdog::health_publisher::HealthPublisher;
 use rins_watchdog::monitor::{COUNTED, Monitor};
+use rins_watchdog::output_deadline::OutputDeadline;
 use rins_watchdog::restart_policy::GiveUp;
 use rins_watchdog::restart_timing::RestartTiming;
 use rins_watchdog::status::status_line;
@@ -283,8 +285,43 @@ fn kill_hung(report: &ipc_types::HealthReport, supervisor: &mut Supervisor) {
     }
 }
 
-/// The third way a death is seen, besides the child's exit and its heartbeat: iceoryx2 finds its
-/// node dead. Every dead node's resources are freed; a child the supervisor still counts as
+/// Stages judged by their output deadline: each reads a topic the monitor counts.
+const DEADLINED: [ServiceKind; 4] = [
+    ServiceKind::Fusion,
+    ServiceKind::Altimeter,
+    ServiceKind::Navigator,
+    ServiceKind::NavigatorStandby,
+];
+
+/// A hung stage is seen sooner by its output than by its heartbeat: input arriving, output silent
+/// for `[watchdog] output_deadline_s`. It is killed, so that it is reaped and restarted like any
+/// exit.
+fn kill_overdue_outputs(
+    deadline: &mut OutputDeadline,
+    monitor: &Monitor,
+    supervisor: &mut Supervisor,
+    now: Instant,
+) {
+    for kind in DEADLINED {
+        let (Some(pid), Some(input), Some(output)) = (
+            supervisor.running_pid(kind.name()),
+            monitor.input_count(kind),
+            monitor.output_count(kind),
+        ) else {
+            continue;
+        };
+        if deadline.observe(kind, pid, input, output, now) && supervisor.kill(pid) {
+            tracing::warn!(
+                service = kind.name(),
+                pid,
+                "output overdue while its input arrives: killed, will be restarted"
+            );
+        }
+    }
+}
+
+/// Another way a death is seen, besides the child's exit, its heartbeat and its output deadline:
+/// iceoryx2 finds its node dead. Every dead node's resources are freed; a child the supervisor still counts as
 /// running under that pid is killed, so that it is reaped and restarted like any exit.
 fn sweep_dead_nodes(settings: &IpcSettings, supervisor: &mut Supervisor) {
     let result = rins_runtime::ipc::for_each_dead_node(settings, |name, pid| {
@@ -328,6 +365,8 @@ fn supervise(
         timing,
     } = watch;
     let end = args.duration.map(|d| started + Duration::from_secs_f64(d));
+    let mut deadline = (cfg.watchdog.output_deadline_s > 0.0)
+        .then(|| OutputDeadline::new(Duration::from_secs_f64(cfg.watchdog.output_deadline_s)));
     let period = (cfg.watchdog.status_period_s > 0.0)
         .then(|| Duration::from_secs_f64(cfg.watchdog.status_period_s));
     let mut next_status = period.map(|p| Instant::now() + p);
@@ -338,6 +377,9 @@ fn supervise(
         monitor.drain()?;
         timing.observe(Instant::now(), |kind| monitor.output_count(kind));
         supervisor.poll(&mut events);
+        if let Some(deadline) = deadline.as_mut() {
+            kill_overdue_outputs(deadline, monitor, supervisor, Instant::now());
+        }
         if let Some(report) = health.tick(supervisor, monitor)? {
             sweep_dead_nodes(settings, supervisor);
             if cfg.watchdog.heartbeat_timeout_s > 0.0 {

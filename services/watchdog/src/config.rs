@@ -45,6 +45,10 @@ pub struct WatchdogConfig {
     /// A child whose heartbeat (once a second) is older than this is hung: it is killed and
     /// restarted. 0 turns the check off.
     pub heartbeat_timeout_s: f64,
+    /// A stage (fusion, altimeter, a navigator lane) whose input arrives while its output stays
+    /// silent this long is hung: it is killed and restarted, without waiting for the heartbeat
+    /// timeout. 0 turns the check off.
+    pub output_deadline_s: f64,
     /// At most this many restarts of one child within `restart_window_s`; one more and the
     /// watchdog gives up on it (`give_up`). 0: never restart; at most
     /// [`MAX_RESTARTS_LIMIT`], which bounds the exit instants kept per child.
@@ -66,6 +70,7 @@ impl Default for WatchdogConfig {
             stop_grace_ms: 2_000,
             status_period_s: 1.0,
             heartbeat_timeout_s: 3.0,
+            output_deadline_s: 0.5,
             max_restarts: 20,
             restart_window_s: 60.0,
             give_up: GiveUp::Shutdown,
@@ -98,6 +103,12 @@ impl WatchdogConfig {
         if !(h.is_finite() && (h == 0.0 || (1.5..=600.0).contains(&h))) {
             return Err(format!(
                 "watchdog.heartbeat_timeout_s = {h}: must be 0 (off) or in [1.5, 600] s (heartbeats come once a second)"
+            ));
+        }
+        let o = self.output_deadline_s;
+        if !(o.is_finite() && (o == 0.0 || (0.05..=60.0).contains(&o))) {
+            return Err(format!(
+                "watchdog.output_deadline_s = {o}: must be 0 (off) or in [0.05, 60] s"
             ));
         }
         if self.stop_grace_ms > 60_000 {
@@ -214,6 +225,25 @@ mod tests {
                 .unwrap_err()
                 .contains("watchdog.status_period_s = NaN")
         );
+    }
+
+    #[test]
+    fn the_output_deadline_is_off_or_in_range() {
+        for ok in [0.0, 0.05, 0.5, 60.0] {
+            let c = WatchdogConfig {
+                output_deadline_s: ok,
+                ..Default::default()
+            };
+            assert!(c.validate().is_ok(), "{ok}");
+        }
+        for bad in [0.01, -1.0, 61.0, f64::INFINITY, f64::NAN] {
+            let c = WatchdogConfig {
+                output_deadline_s: bad,
+                ..Default::default()
+            };
+            let e = c.validate().unwrap_err();
+            assert!(e.contains("watchdog.output_deadline_s = "), "{e}");
+        }
     }
 
     fn parse(text: &str) -> WatchdogConfig {

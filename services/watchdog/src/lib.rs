@@ -7,6 +7,7 @@ pub mod fault_tracking;
 pub mod health_publisher;
 pub mod health_report;
 pub mod monitor;
+pub mod output_deadline;
 pub mod restart_policy;
 pub mod restart_timing;
 pub mod seq_gaps;

@@ -93,15 +93,18 @@ impl Monitor {
         })
     }
 
+    /// Samples seen so far on the [`COUNTED`] topic `name`.
+    fn topic_total(&self, name: &str) -> Option<u64> {
+        COUNTED
+            .iter()
+            .position(|c| *c == name)
+            .map(|i| self.totals[i])
+    }
+
     /// Samples seen so far on the output topic of `kind` (each navigator lane on its own topic);
     /// `None` for a process without an output the monitor counts.
     pub fn output_count(&self, kind: ServiceKind) -> Option<u64> {
-        let topic = |name: &str| {
-            COUNTED
-                .iter()
-                .position(|c| *c == name)
-                .map(|i| self.totals[i])
-        };
+        let topic = |name: &str| self.topic_total(name);
         match kind {
             ServiceKind::Acquisition => topic("imu"),
             ServiceKind::Fusion => topic("fused"),
@@ -109,6 +112,18 @@ impl Monitor {
             ServiceKind::Navigator => Some(self.nav.lane_totals()[0]),
             ServiceKind::NavigatorStandby => Some(self.nav.lane_totals()[1]),
             ServiceKind::Simulator | ServiceKind::Watchdog => None,
+        }
+    }
+
+    /// Samples seen so far on the input topic of `kind`, for the stages whose input the monitor
+    /// counts; `None` for the others (acquisition reads the serial line).
+    pub fn input_count(&self, kind: ServiceKind) -> Option<u64> {
+        let topic = |name: &str| self.topic_total(name);
+        match kind {
+            ServiceKind::Fusion => topic("imu"),
+            ServiceKind::Altimeter => topic("baro"),
+            ServiceKind::Navigator | ServiceKind::NavigatorStandby => topic("fused"),
+            ServiceKind::Acquisition | ServiceKind::Simulator | ServiceKind::Watchdog => None,
         }
     }
 

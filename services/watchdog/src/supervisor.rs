@@ -193,6 +193,14 @@ impl Supervisor {
         child.kill().is_ok()
     }
 
+    /// The pid of the running child `name` (no allocation: the supervision loop asks often).
+    pub fn running_pid(&self, name: &str) -> Option<u32> {
+        self.children
+            .iter()
+            .find(|m| m.spec.name == name)
+            .and_then(|m| m.child.as_ref().map(Child::id))
+    }
+
     /// Every supervised child: name, current pid (`None` while waiting to restart), restarts.
     pub fn children(&self) -> Vec<ChildStatus> {
         self.children

@@ -1,0 +1,157 @@
+//! The output deadline: a hung stage is seen long before its heartbeat is overdue. A stage whose
+//! input keeps arriving while its own output stays silent for the deadline is not working (it is
+//! stopped, spinning or blocked); the watchdog kills it and restarts it like any exit. A stage whose
+//! input is quiet is not judged (it has nothing to do: the stall is upstream), nor one that has not
+//! published since it started (its start-up is the heartbeat's to judge).
+
+use std::time::{Duration, Instant};
+
+use ipc_types::ServiceKind;
+
+const KINDS: usize = ServiceKind::ALL.len();
+
+/// Input samples that must have arrived, unanswered, before a silent output counts as missed.
+pub const MIN_UNANSWERED_INPUT: u64 = 5;
+
+#[derive(Debug, Clone, Copy)]
+struct Track {
+    pid: u32,
+    /// Output and input counts when the output last moved (or when this pid was first seen).
+    output: u64,
+    input: u64,
+    since: Instant,
+    /// The output has moved under this pid, and no miss has been reported since.
+    armed: bool,
+}
+
+#[derive(Debug, Clone)]
+pub struct OutputDeadline {
+    deadline: Duration,
+    tracks: [Option<Track>; KINDS],
+}
+
+impl OutputDeadline {
+    pub fn new(deadline: Duration) -> Self {
+        Self {
+            deadline,
+            tracks: [None; KINDS],
+        }
+    }
+
+    /// One look at `kind`, running as `pid`, with its input and output counts now. True once per
+    /// stall when the output has missed its deadline.
+    pub fn observe(
+        &mut self,
+        kind: ServiceKind,
+        pid: u32,
+        input: u64,
+        output: u64,
+        now: Instant,
+    ) -> bool {
+        let slot = &mut self.tracks[kind as usize];
+        let fresh = Track {
+            pid,
+            output,
+            input,
+            since: now,
+            armed: false,
+        };
+        let Some(track) = slot.as_mut().filter(|t| t.pid == pid) else {
+            *slot = Some(fresh);
+            return false;
+        };
+        if output != track.output {
+            *track = Track {
+                armed: true,
+                ..fresh
+            };
+            return false;
+        }
+        let missed = track.armed
+            && input >= track.input + MIN_UNANSWERED_INPUT
+            && now.saturating_duration_since(track.since) >= self.deadline;
+        if missed {
+            track.armed = false;
+        }
+        missed
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const FUSION: ServiceKind = ServiceKind::Fusion;
+
+    fn ms(t0: Instant, ms: u64) -> Instant {
+        t0 + Duration::from_millis(ms)
+    }
+
+    #[test]
+    fn a_stage_that_stops_answering_its_input_misses_its_deadline_once() {
+        let t0 = Instant::now();
+        let mut d = OutputDeadline::new(Duration::from_millis(500));
+        // 1 kHz in, 1 kHz out for 100 ms.
+        for t in 0..=100 {
+            assert!(!d.observe(FUSION, 7, t, t, ms(t0, t)));
+        }
+        // Hung at 100 ms: input goes on, output stays at 100.
+        let missed: Vec<u64> = (101..=800)
+            .filter(|&t| d.observe(FUSION, 7, t, 100, ms(t0, t)))
+            .collect();
+        assert_eq!(missed, vec![600]);
+    }
+
+    #[test]
+    fn a_quiet_input_is_no_reason() {
+        let t0 = Instant::now();
+        let mut d = OutputDeadline::new(Duration::from_millis(500));
+        d.observe(FUSION, 7, 0, 0, t0);
+        d.observe(FUSION, 7, 10, 10, ms(t0, 10));
+        // Acquisition stops: fusion's input and output both stop, for seconds.
+        assert!((11..5_000).all(|t| !d.observe(
+            FUSION,
+            7,
+            10 + MIN_UNANSWERED_INPUT - 1,
+            10,
+            ms(t0, t)
+        )));
+    }
+
+    #[test]
+    fn a_new_process_is_judged_only_after_its_first_output() {
+        let t0 = Instant::now();
+        let mut d = OutputDeadline::new(Duration::from_millis(500));
+        d.observe(FUSION, 7, 0, 0, t0);
+        d.observe(FUSION, 7, 5, 5, ms(t0, 5));
+        // Restarted as pid 8: still setting up for 2 s while input flows, output unchanged.
+        assert!((6..2_000).all(|t| !d.observe(FUSION, 8, t, 5, ms(t0, t))));
+        // First output at 2 s; hung again right after: missed 500 ms later.
+        assert!(!d.observe(FUSION, 8, 2_000, 6, ms(t0, 2_000)));
+        let missed: Vec<u64> = (2_001..=3_000)
+            .filter(|&t| d.observe(FUSION, 8, t, 6, ms(t0, t)))
+            .collect();
+        assert_eq!(missed, vec![2_500]);
+    }
+
+    #[test]
+    fn kinds_are_judged_apart() {
+        let t0 = Instant::now();
+        let mut d = OutputDeadline::new(Duration::from_millis(100));
+        for t in 0..=10 {
+            d.observe(FUSION, 7, t, t, ms(t0, t));
+            d.observe(ServiceKind::Altimeter, 9, t, t, ms(t0, t));
+        }
+        // Only the altimeter stalls.
+        let mut missed = Vec::new();
+        for t in 11..=200 {
+            if d.observe(FUSION, 7, t, t, ms(t0, t)) {
+                missed.push((FUSION, t));
+            }
+            if d.observe(ServiceKind::Altimeter, 9, t, 10, ms(t0, t)) {
+                missed.push((ServiceKind::Altimeter, t));
+            }
+        }
+        assert_eq!(missed, vec![(ServiceKind::Altimeter, 110)]);
+    }
+}
