@@ -50,6 +50,8 @@ pub struct SelectorConfig {
     /// And how long the other lane must have published since the selected lane's last sample, ns
     /// (samples without publish times are judged by the count alone).
     pub dead_after_ns: u64,
+    /// The same when the other lane is not trusted (aligning, or younger than `settle`).
+    pub dead_after_untrusted_ns: u64,
     /// Samples a solution must have run (since alignment or takeover) before it is trusted.
     pub settle: u64,
     /// Samples between a switch and a quality switch.
@@ -57,12 +59,13 @@ pub struct SelectorConfig {
 }
 
 impl Default for SelectorConfig {
-    /// At the block's 1 kHz: a dead lane is left after 8 ms, a solution trusted after 2 s, at most
-    /// one quality switch per second.
+    /// At the block's 1 kHz: a dead lane is left after 8 ms (100 ms for a lane not trusted yet), a
+    /// solution trusted after 2 s, at most one quality switch per second.
     fn default() -> Self {
         Self {
             switch_lag: 8,
             dead_after_ns: 8_000_000,
+            dead_after_untrusted_ns: 100_000_000,
             settle: 2000,
             min_dwell: 1000,
         }
@@ -218,9 +221,16 @@ impl LaneSelector {
             // Dead: nothing from the selected lane while the other has delivered `switch_lag`
             // samples ahead of the output. Counted in samples, not in sequence numbers, so that a
             // hole in the input (both lanes skip the same numbers) is no reason to switch.
+            // Towards a lane that just reset, only after a longer silence: a selected lane that
+            // is merely starved of CPU for a few milliseconds must not hand the output to it.
+            let dead_after = if trusted(candidate, self.config.settle) {
+                self.config.dead_after_ns
+            } else {
+                self.config.dead_after_untrusted_ns
+            };
             let ahead = self.pending[other].len();
             return ahead >= FORCE_SWITCH_PENDING
-                || (ahead as u64 >= self.config.switch_lag && self.silent_for_dead_time(other));
+                || (ahead as u64 >= self.config.switch_lag && self.silent_for(other, dead_after));
         };
         // Untrusted: only towards a trusted lane that has the next sample (not behind the
         // selected one), and not within the dwell time of the last switch.
@@ -233,15 +243,15 @@ impl LaneSelector {
             && candidate.header.origin_seq <= next.header.origin_seq
     }
 
-    /// The other lane has published for the dead time since the selected lane's last sample.
-    fn silent_for_dead_time(&self, other: usize) -> bool {
+    /// The other lane has published for `dead_after` ns since the selected lane's last sample.
+    fn silent_for(&self, other: usize, dead_after: u64) -> bool {
         let newest = self.pending[other]
             .back()
             .map_or(0, |s| s.header.stage_ns(Stage::Navigator));
         if self.selected_published_ns == 0 || newest == 0 {
             return true;
         }
-        newest.saturating_sub(self.selected_published_ns) >= self.config.dead_after_ns
+        newest.saturating_sub(self.selected_published_ns) >= dead_after
     }
 
     fn switch_to(&mut self, lane: usize) {
@@ -277,6 +287,7 @@ mod tests {
         SelectorConfig {
             switch_lag: 8,
             dead_after_ns: 8_000_000,
+            dead_after_untrusted_ns: 100_000_000,
             settle: SETTLE,
             min_dwell: 50,
         }
@@ -438,6 +449,43 @@ mod tests {
         assert_eq!(stall, 7);
         assert_eq!(sel.last_switch().map(|s| (s.to, s.at_seq)), Some((1, 201)));
         assert_eq!(out.len(), 300);
+    }
+
+    #[test]
+    fn a_starved_lane_is_not_left_for_one_that_just_reset() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        // Lane 1 restarted at 701: not trusted until its solution has run SETTLE (100) samples.
+        let young = |seq: u64, ns: u64| {
+            let mut s = stamped(1, seq, ns);
+            s.solution_start_seq = 701;
+            s
+        };
+        for seq in 1..=700 {
+            sel.push(0, stamped(0, seq, seq * MS));
+            drain(&mut sel, &mut out);
+        }
+        // Lane 0 starved of CPU for 50 ms while lane 1 publishes 701..=750, then catches up.
+        for seq in 701..=750 {
+            sel.push(1, young(seq, seq * MS));
+            drain(&mut sel, &mut out);
+        }
+        for seq in 701..=760 {
+            sel.push(0, stamped(0, seq, 751 * MS + seq));
+            drain(&mut sel, &mut out);
+        }
+        assert_eq!(sel.switches(), 0);
+        assert!(out.iter().all(|o| o.1 == 0));
+        assert_eq!(out.len(), 760);
+        // Lane 0 silent for good: after 100 ms lane 1 takes over, young as it is (anything beats
+        // no output), from the next sample on.
+        for seq in 761..=880 {
+            sel.push(1, young(seq, seq * MS));
+            drain(&mut sel, &mut out);
+        }
+        assert_eq!(sel.last_switch().map(|s| (s.to, s.at_seq)), Some((1, 761)));
+        let seqs: Vec<u64> = out.iter().map(|o| o.0).collect();
+        assert_eq!(seqs, (1..=880).collect::<Vec<_>>());
     }
 
     #[test]

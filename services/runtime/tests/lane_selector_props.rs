@@ -52,7 +52,7 @@ proptest! {
         // Per sample, whether the standby's sample arrives before the primary's.
         order in prop::collection::vec(any::<bool>(), N as usize),
     ) {
-        let config = SelectorConfig { switch_lag: 8, dead_after_ns: 8_000_000, settle: 50, min_dwell: 20 };
+        let config = SelectorConfig { switch_lag: 8, dead_after_ns: 8_000_000, dead_after_untrusted_ns: 100_000_000, settle: 50, min_dwell: 20 };
         let mut sel = LaneSelector::new(config);
         let mut out: Vec<u64> = Vec::new();
         let start = |lane: u8, seq: u64| {
