@@ -19,7 +19,9 @@ struct Track {
     /// Output and input counts when the output last moved (or when this pid was first seen).
     output: u64,
     input: u64,
-    since: Instant,
+    /// When the first input after that arrived: the deadline runs from there (after an outage
+    /// upstream the input returns long after the last output, and the stage needs its moment).
+    unanswered_since: Option<Instant>,
     /// The output has moved under this pid, and no miss has been reported since.
     armed: bool,
 }
@@ -53,7 +55,7 @@ impl OutputDeadline {
             pid,
             output,
             input,
-            since: now,
+            unanswered_since: None,
             armed: false,
         };
         let Some(track) = slot.as_mut().filter(|t| t.pid == pid) else {
@@ -67,9 +69,14 @@ impl OutputDeadline {
             };
             return false;
         }
+        if input > track.input && track.unanswered_since.is_none() {
+            track.unanswered_since = Some(now);
+        }
         let missed = track.armed
             && input >= track.input + MIN_UNANSWERED_INPUT
-            && now.saturating_duration_since(track.since) >= self.deadline;
+            && track
+                .unanswered_since
+                .is_some_and(|t| now.saturating_duration_since(t) >= self.deadline);
         if missed {
             track.armed = false;
         }
@@ -99,7 +106,27 @@ mod tests {
         let missed: Vec<u64> = (101..=800)
             .filter(|&t| d.observe(FUSION, 7, t, 100, ms(t0, t)))
             .collect();
-        assert_eq!(missed, vec![600]);
+        // The first unanswered input came at 101 ms.
+        assert_eq!(missed, vec![601]);
+    }
+
+    #[test]
+    fn an_input_back_after_an_outage_gets_the_whole_deadline() {
+        let t0 = Instant::now();
+        let mut d = OutputDeadline::new(Duration::from_millis(500));
+        for t in 0..=100 {
+            d.observe(FUSION, 7, t, t, ms(t0, t));
+        }
+        // Nothing arrives for 1.3 s (the serial device unplugged), then the input is back and
+        // the stage answers 3 ms later: no miss.
+        assert!((101..1_400).all(|t| !d.observe(FUSION, 7, 100, 100, ms(t0, t))));
+        assert!((1_400..1_403).all(|t| !d.observe(FUSION, 7, 100 + t - 1_399, 100, ms(t0, t))));
+        assert!(!d.observe(FUSION, 7, 104, 104, ms(t0, 1_403)));
+        // Back, but unanswered: missed 500 ms after the first new input.
+        let missed: Vec<u64> = (1_404..=2_500)
+            .filter(|&t| d.observe(FUSION, 7, 104 + t - 1_403, 104, ms(t0, t)))
+            .collect();
+        assert_eq!(missed, vec![1_904]);
     }
 
     #[test]
@@ -131,7 +158,7 @@ mod tests {
         let missed: Vec<u64> = (2_001..=3_000)
             .filter(|&t| d.observe(FUSION, 8, t, 6, ms(t0, t)))
             .collect();
-        assert_eq!(missed, vec![2_500]);
+        assert_eq!(missed, vec![2_501]);
     }
 
     #[test]
@@ -152,6 +179,6 @@ mod tests {
                 missed.push((ServiceKind::Altimeter, t));
             }
         }
-        assert_eq!(missed, vec![(ServiceKind::Altimeter, 110)]);
+        assert_eq!(missed, vec![(ServiceKind::Altimeter, 111)]);
     }
 }
