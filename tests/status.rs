@@ -99,60 +99,13 @@ fn status_without_a_pipeline_fails_naming_the_prefix() {
     );
 }
 
-#[test]
-fn a_stopped_service_is_seen_silent_killed_and_restarted() {
+/// Runs a static pipeline with `watchdog` as its `[watchdog]` settings, SIGSTOPs `name` once it
+/// runs, and checks that the watchdog replaced it — a new pid, the stopped process gone, no other
+/// service restarted, navigation going on — before `limit`; then stops the pipeline cleanly.
+fn stopped_service_is_replaced(test: &str, watchdog: &str, name: &str, limit: Duration) {
     let _slot = PipelineSlot::take();
-    let ipc = Isolated::new("hang");
-    // The heartbeat path alone: the output deadline would replace the navigator sooner.
-    let config = TempFile::new("hang", "toml", "[watchdog]\noutput_deadline_s = 0\n");
-    let up = spawn_up(
-        &ipc,
-        &[
-            "--config",
-            config.path(),
-            "--scenario",
-            "static",
-            "--duration",
-            "300",
-            "--json",
-        ],
-    );
-    let report = wait_for(&ipc, Duration::from_secs(60), |r| {
-        service(r, "navigator")["state"] == "running"
-    });
-    let old_pid = service(&report, "navigator")["pid"].as_u64().unwrap();
-    let pid = libc::pid_t::try_from(old_pid).expect("pid fits pid_t");
-    // SIGSTOP: the process is still there but does nothing, as if hung. Its heartbeat stops; after
-    // the 3 s heartbeat timeout the watchdog kills and restarts it.
-    // SAFETY: sends a signal to a process of this test's own pipeline.
-    assert_eq!(unsafe { libc::kill(pid, libc::SIGSTOP) }, 0);
-    let after = wait_for(&ipc, Duration::from_secs(30), |r| {
-        let n = service(r, "navigator");
-        n["restarts"] == 1 && n["state"] == "running"
-    });
-    assert_ne!(
-        service(&after, "navigator")["pid"].as_u64().unwrap(),
-        old_pid
-    );
-    // The stopped process is gone (killed and reaped: no zombie under the old pid).
-    // SAFETY: signal 0 only checks whether the pid exists.
-    assert_ne!(unsafe { libc::kill(pid, 0) }, 0, "pid {pid} still exists");
-    let again = ipc.run(&["echo", "nav", "--count", "5", "--timeout", "30"]);
-    assert!(again.status.success());
-
-    assert_eq!(stop_up(&ipc, up)["restarts"], 1);
-}
-
-#[test]
-fn a_stage_that_stops_answering_its_input_is_replaced_by_its_output_deadline() {
-    let _slot = PipelineSlot::take();
-    let ipc = Isolated::new("deadline");
-    // Heartbeats would take ten minutes to call it hung: only the output deadline can act here.
-    let config = TempFile::new(
-        "deadline",
-        "toml",
-        "[watchdog]\nheartbeat_timeout_s = 600\noutput_deadline_s = 0.5\n",
-    );
+    let ipc = Isolated::new(test);
+    let config = TempFile::new(test, "toml", &format!("[watchdog]\n{watchdog}"));
     let up = spawn_up_navigating(
         &ipc,
         &[
@@ -166,26 +119,58 @@ fn a_stage_that_stops_answering_its_input_is_replaced_by_its_output_deadline() {
         ],
     );
     let report = wait_for(&ipc, Duration::from_secs(60), |r| {
-        service(r, "fusion")["state"] == "running"
+        service(r, name)["state"] == "running"
     });
-    let old_pid = service(&report, "fusion")["pid"].as_u64().unwrap();
+    let old_pid = service(&report, name)["pid"].as_u64().unwrap();
     let pid = libc::pid_t::try_from(old_pid).expect("pid fits pid_t");
-    // SIGSTOP: raw IMU samples go on arriving, fused ones stop.
+    // SIGSTOP: the process is still there but does nothing, as if hung.
     // SAFETY: sends a signal to a process of this test's own pipeline.
     assert_eq!(unsafe { libc::kill(pid, libc::SIGSTOP) }, 0);
-    let after = wait_for(&ipc, Duration::from_secs(20), |r| {
-        let f = service(r, "fusion");
-        f["restarts"] == 1 && f["state"] == "running"
+    let after = wait_for(&ipc, limit, |r| {
+        let s = service(r, name);
+        s["restarts"] == 1 && s["state"] == "running"
     });
-    assert_ne!(service(&after, "fusion")["pid"].as_u64().unwrap(), old_pid);
+    assert_ne!(service(&after, name)["pid"].as_u64().unwrap(), old_pid);
+    // The stopped process is gone (killed and reaped: no zombie under the old pid).
     // SAFETY: signal 0 only checks whether the pid exists.
     assert_ne!(unsafe { libc::kill(pid, 0) }, 0, "pid {pid} still exists");
-    for name in ["acquisition", "altimeter", "navigator", "navigator-standby"] {
-        assert_eq!(service(&after, name)["restarts"], 0, "{name}: {after}");
+    let others = [
+        "acquisition",
+        "fusion",
+        "altimeter",
+        "navigator",
+        "navigator-standby",
+    ];
+    for other in others.into_iter().filter(|&o| o != name) {
+        assert_eq!(service(&after, other)["restarts"], 0, "{other}: {after}");
     }
     let again = ipc.run(&["echo", "nav", "--count", "5", "--timeout", "30"]);
     assert!(again.status.success());
     assert_eq!(stop_up(&ipc, up)["restarts"], 1);
+}
+
+#[test]
+fn a_stopped_service_is_seen_silent_killed_and_restarted() {
+    // The heartbeat path alone (the output deadline would replace the navigator sooner): its
+    // heartbeat stops, and after the 3 s timeout the watchdog kills and restarts it.
+    stopped_service_is_replaced(
+        "hang",
+        "output_deadline_s = 0\n",
+        "navigator",
+        Duration::from_secs(30),
+    );
+}
+
+#[test]
+fn a_stage_that_stops_answering_its_input_is_replaced_by_its_output_deadline() {
+    // Raw IMU samples go on arriving, fused ones stop. Heartbeats would take ten minutes to call
+    // it hung: only the output deadline can act within the limit.
+    stopped_service_is_replaced(
+        "deadline",
+        "heartbeat_timeout_s = 600\noutput_deadline_s = 0.5\n",
+        "fusion",
+        Duration::from_secs(20),
+    );
 }
 
 #[test]
