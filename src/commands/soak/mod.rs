@@ -20,7 +20,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
 use ipc_types::{
-    ChannelState, FusedImu, HealthReport, NavMode, ServiceKind, ServiceState, fused_flags, names,
+    ChannelState, FusedImu, HealthReport, ServiceKind, ServiceState, fused_flags, names,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -201,6 +201,15 @@ fn signal(pid: u32, signal: libc::c_int) -> Result<(), String> {
     }
 }
 
+/// Runs a fault's commands on their own thread.
+fn in_background(
+    exe: &Path,
+    commands: impl FnOnce(&Path) -> Result<(), String> + Send + 'static,
+) -> JoinHandle<Result<(), String>> {
+    let exe: PathBuf = exe.to_path_buf();
+    std::thread::spawn(move || commands(&exe))
+}
+
 /// Begins `fault`; an immediate failure is returned, a later one comes from the action's thread.
 fn begin(fault: Fault, exe: &Path, report: &HealthReport) -> Result<Active, String> {
     let began = Instant::now();
@@ -220,19 +229,13 @@ fn begin(fault: Fault, exe: &Path, report: &HealthReport) -> Result<Active, Stri
             channel,
             fault,
             hold,
-        } => {
-            let exe = exe.to_path_buf();
-            Some(std::thread::spawn(move || {
-                sensor_fault(&exe, channel, fault, hold)
-            }))
-        }
-        Fault::Disconnect { duration_s } => {
-            let exe: PathBuf = exe.to_path_buf();
+        } => Some(in_background(exe, move |exe| {
+            sensor_fault(exe, channel, fault, hold)
+        })),
+        Fault::Disconnect { duration_s } => Some(in_background(exe, move |exe| {
             let duration = format!("{duration_s:.3}");
-            Some(std::thread::spawn(move || {
-                rins_tool(&exe, &["inject", "disconnect", "--duration", &duration])
-            }))
-        }
+            rins_tool(exe, &["inject", "disconnect", "--duration", &duration])
+        })),
     };
     Ok(Active {
         began,
@@ -334,10 +337,7 @@ pub fn run(args: &SoakArgs) -> Result<()> {
             bail!("the pipeline produced no navigation output within 120 s");
         }
         nav_in.wait(Duration::from_millis(100))?;
-        while let Some(n) = nav_in.receive()? {
-            nav.observe(n.header.origin_seq, Instant::now());
-            nav.observe_mode(NavMode::from_u8(n.mode));
-        }
+        nav.drain(&mut nav_in)?;
     }
     let start = Instant::now();
     let end = start + Duration::from_secs_f64(run_s);
@@ -348,10 +348,7 @@ pub fn run(args: &SoakArgs) -> Result<()> {
     let mut next_progress = start + Duration::from_secs(10);
     while Instant::now() < end && !shutdown.requested() {
         nav_in.wait(Duration::from_millis(5))?;
-        while let Some(n) = nav_in.receive()? {
-            nav.observe(n.header.origin_seq, Instant::now());
-            nav.observe_mode(NavMode::from_u8(n.mode));
-        }
+        nav.drain(&mut nav_in)?;
         while let Some(r) = health_in.receive()? {
             latest.health = Some(r);
         }

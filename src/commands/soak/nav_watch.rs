@@ -3,7 +3,9 @@
 
 use std::time::{Duration, Instant};
 
+use anyhow::Result;
 use ipc_types::NavMode;
+use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_watchdog::seq_gaps::SeqGaps;
 
 #[derive(Debug, Default)]
@@ -22,6 +24,15 @@ pub struct NavWatch {
 }
 
 impl NavWatch {
+    /// Takes every navigation sample that is due.
+    pub fn drain(&mut self, nav: &mut NavSubscriber) -> Result<()> {
+        while let Some(n) = nav.receive()? {
+            self.observe(n.header.origin_seq, Instant::now());
+            self.observe_mode(NavMode::from_u8(n.mode));
+        }
+        Ok(())
+    }
+
     pub fn observe_mode(&mut self, mode: NavMode) {
         if mode == NavMode::Aligning {
             self.not_navigating += u64::from(self.navigated);
