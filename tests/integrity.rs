@@ -1,30 +1,227 @@
 //! Integrity of the navigation solution end to end: a device played by the test (a pseudo-terminal
 //! speaking the wire protocol) feeds `rins up --port`, and the navigation stream must say what is
-//! wrong when the input goes wrong, and come back when it is right again.
+//! wrong when the input goes wrong — never "navigating" while it is — and come back to `ok` when
+//! the input is right again, without an operator.
+//!
+//! Times are the device's (the frames' own clock), so a loaded machine changes nothing but the
+//! wall-clock length of a test. Bounds: the integrity must leave `ok` within 0.1 s of the input
+//! going wrong (the invalid limit is 50 ms of IMU outage); it must be `ok` again within the
+//! recovery chain's length after the input is right: fusion's re-admission hold (1 s) when every
+//! channel was out, the navigator's recovery hold (1 s), the next aiding updates, plus 1 s margin.
 
 mod common;
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU8, Ordering};
 use std::time::Duration;
 
-use common::device::FakeDevice;
+use common::device::{DeviceTick, FakeDevice};
 use common::topic_stream::TopicStream;
 use common::{Isolated, PipelineSlot, spawn_up, stop_up};
+use ipc_types::{Integrity, NavMode, integrity_reason as why};
+use rins_acquisition::protocol::Payload;
 use rins_sim::Scenario;
+use serde_json::Value;
 
-fn mode(v: &serde_json::Value) -> u64 {
-    v["mode"].as_u64().unwrap_or(u64::MAX)
+/// When the device misbehaves, device seconds.
+const FAULT_AT_S: f64 = 8.0;
+/// The integrity must have left `ok` this soon after the input went wrong, s.
+const DETECT_WITHIN_S: f64 = 0.1;
+/// Longest wall-clock wait for any one condition.
+const WAIT: Duration = Duration::from_secs(90);
+
+fn device_s(v: &Value) -> f64 {
+    v["header"]["origin_device_time_us"]
+        .as_f64()
+        .unwrap_or(f64::NAN)
+        * 1e-6
+}
+
+fn integrity(v: &Value) -> Integrity {
+    Integrity::from_u8(v["integrity"].as_u64().unwrap_or(255) as u8)
+}
+
+fn mode(v: &Value) -> NavMode {
+    NavMode::from_u8(v["mode"].as_u64().unwrap_or(255) as u8)
+}
+
+fn reasons(v: &Value) -> u32 {
+    v["integrity_reasons"].as_u64().unwrap_or(0) as u32
+}
+
+/// What the navigation stream did around one misbehaviour of the device.
+struct Episode {
+    /// The first sample after the fault that is not `ok`.
+    first_bad: Value,
+    /// The worst integrity seen during the fault, and every reason seen.
+    worst: Integrity,
+    reasons: u32,
+    /// The first `ok` sample after the fault ended.
+    back_ok: Value,
+    summary: Value,
+}
+
+/// Runs the pipeline on a device whose ticks from `FAULT_AT_S` to `FAULT_AT_S + duration_s` go
+/// through `fault`, and follows the navigation stream through it.
+fn episode(
+    name: &str,
+    duration_s: f64,
+    fault: impl Fn(f64, &mut DeviceTick) + Send + 'static,
+) -> Episode {
+    let _slot = PipelineSlot::take();
+    let ipc = Isolated::new(name);
+    let end = FAULT_AT_S + duration_s;
+    let device = FakeDevice::start(Scenario::Static, move |mut tick| {
+        if (FAULT_AT_S..end).contains(&tick.t_s) {
+            fault(tick.t_s - FAULT_AT_S, &mut tick);
+        }
+    });
+    let up = spawn_up(&ipc, &["--port", device.tty(), "--json"]);
+    let nav = TopicStream::start(&ipc, "nav");
+    let (before, _) = nav.wait_for("ok before the fault", 0, WAIT, |v| {
+        integrity(v) == Integrity::Ok && mode(v) == NavMode::Navigating
+    });
+    let (i, _) = nav.wait_for("at the fault", before, WAIT, |v| device_s(v) >= FAULT_AT_S);
+    let (_, first_bad) = nav.wait_for("not ok after the fault", i, WAIT, |v| {
+        integrity(v) != Integrity::Ok
+    });
+    let (j, _) = nav.wait_for("after the fault", i, WAIT, |v| device_s(v) >= end);
+    let (_, back_ok) = nav.wait_for("ok after the fault", j, WAIT, |v| {
+        integrity(v) == Integrity::Ok
+    });
+    let during = nav.since(i);
+    let during = during
+        .iter()
+        .take_while(|v| device_s(v) < device_s(&back_ok));
+    let (mut worst, mut all_reasons) = (Integrity::Ok, 0);
+    for v in during {
+        worst = worst.max(integrity(v));
+        all_reasons |= reasons(v);
+        // Never navigating while invalid, in any sample.
+        if integrity(v) == Integrity::Invalid {
+            assert_eq!(mode(v), NavMode::Invalid, "{v}");
+            assert_eq!(v["aiding"].as_u64().unwrap_or(0) & 0xff, 0, "{v}");
+        }
+    }
+    drop(nav);
+    let summary = stop_up(&ipc, up);
+    Episode {
+        first_bad,
+        worst,
+        reasons: all_reasons,
+        back_ok,
+        summary,
+    }
+}
+
+fn imu<'t>(tick: &'t mut DeviceTick<'_>) -> &'t mut rins_acquisition::protocol::ImuFrame {
+    match &mut tick.frames[0].payload {
+        Payload::Imu(f) => f,
+        _ => panic!("the first frame of a tick is the IMU's"),
+    }
+}
+
+fn assert_detected(e: &Episode, reason: u32) {
+    let t = device_s(&e.first_bad);
+    assert!(
+        t <= FAULT_AT_S + DETECT_WITHIN_S,
+        "integrity left ok only at {t} s: {}",
+        e.first_bad
+    );
+    assert_eq!(
+        e.worst,
+        Integrity::Invalid,
+        "reasons {}",
+        why::describe(e.reasons)
+    );
+    assert!(
+        e.reasons & reason != 0,
+        "reasons seen: {}",
+        why::describe(e.reasons)
+    );
+}
+
+fn assert_back_within(e: &Episode, fault_s: f64, within_s: f64) {
+    let t = device_s(&e.back_ok);
+    assert!(
+        t <= FAULT_AT_S + fault_s + within_s,
+        "ok again only at {t} s (fault ended at {} s)",
+        FAULT_AT_S + fault_s
+    );
+    assert_eq!(mode(&e.back_ok), NavMode::Navigating, "{}", e.back_ok);
 }
 
 #[test]
-fn a_device_on_a_pseudo_terminal_is_navigated() {
-    let _slot = PipelineSlot::take();
-    let ipc = Isolated::new("integrity_clean");
-    let device = FakeDevice::start(Scenario::Static, |_| {});
-    let up = spawn_up(&ipc, &["--port", device.tty(), "--json"]);
-    let nav = TopicStream::start(&ipc, "nav");
-    let (_, first) = nav.wait_for("navigating", 0, Duration::from_secs(60), |v| mode(v) == 1);
-    assert!(first["altitude_m"].as_f64().is_some(), "{first}");
-    drop(nav);
-    let summary = stop_up(&ipc, up);
-    assert_eq!(summary["crc_errors"], 0, "{summary}");
+fn every_channel_invalid_for_five_seconds_is_invalid_then_recovers_without_an_operator() {
+    let e = episode("ig_invalid", 5.0, |_, tick| {
+        imu(tick).valid_mask = 0;
+    });
+    assert_detected(&e, why::IMU_UNUSABLE);
+    // Fusion's re-admission hold, the navigator's recovery, the next updates, margin.
+    assert_back_within(&e, 5.0, 3.5);
+    // The altitude did not run away while nothing was integrated.
+    let alt = e.back_ok["altitude_m"].as_f64().unwrap();
+    assert!((alt - 488.0).abs() < 5.0, "altitude {alt}");
+    assert_eq!(e.summary["restarts"], 0, "{}", e.summary);
+}
+
+#[test]
+fn the_whole_block_at_full_scale_is_a_block_fault_not_motion() {
+    // +full scale for 3 s, then −full scale for 3 s, every gyro and accelerometer channel.
+    let e = episode("ig_full", 6.0, |dt, tick| {
+        let count = if dt < 3.0 { 2047 } else { -2048 };
+        let f = imu(tick);
+        f.gyro_counts[..4].fill(count);
+        f.accel_counts[..4].fill(count);
+    });
+    assert_detected(&e, why::IMU_UNUSABLE);
+    assert_back_within(&e, 6.0, 2.5);
+    let alt = e.back_ok["altitude_m"].as_f64().unwrap();
+    assert!((alt - 488.0).abs() < 5.0, "altitude {alt}");
+    assert_eq!(e.summary["restarts"], 0, "{}", e.summary);
+}
+
+#[test]
+fn gyros_at_full_scale_do_not_turn_the_heading() {
+    let e = episode("ig_gyro", 5.0, |_, tick| {
+        imu(tick).gyro_counts[..4].fill(2047);
+    });
+    assert_detected(&e, why::IMU_UNUSABLE);
+    assert_back_within(&e, 5.0, 2.5);
+    let q: Vec<f64> = (0..4)
+        .map(|i| e.back_ok["quaternion"][i].as_f64().unwrap())
+        .collect();
+    let yaw = (2.0 * (q[0] * q[3] + q[1] * q[2]))
+        .atan2(1.0 - 2.0 * (q[2] * q[2] + q[3] * q[3]))
+        .to_degrees();
+    // The static scenario's heading is 30°: the magnetometer holds it within its σ.
+    assert!((yaw - 30.0).abs() < 3.0, "yaw {yaw}");
+}
+
+#[test]
+fn a_block_of_the_wrong_shape_is_invalid_input_and_fusion_is_not_restarted() {
+    // 16 gyros and 16 accelerometers for 2 s, then 3 and 3 for 2 s: valid frames of another
+    // sensor block.
+    let phase = Arc::new(AtomicU8::new(0));
+    let seen = Arc::clone(&phase);
+    let e = episode("ig_shape", 4.0, move |dt, tick| {
+        let n = if dt < 2.0 { 16 } else { 3 };
+        seen.store(n, Ordering::Relaxed);
+        let f = imu(tick);
+        let (g, a) = (f.gyro_counts[0], f.accel_counts[0]);
+        f.n_gyro = n;
+        f.n_accel = n;
+        f.gyro_counts[..usize::from(n)].fill(g);
+        f.accel_counts[..usize::from(n)].fill(a);
+        f.valid_mask = if n == 16 {
+            u32::MAX
+        } else {
+            0b111 | 0b111 << 16
+        };
+    });
+    assert_eq!(phase.load(Ordering::Relaxed), 3, "both shapes were sent");
+    assert_detected(&e, why::IMU_UNUSABLE);
+    assert_back_within(&e, 4.0, 2.5);
+    // The stall was upstream: fusion answered every frame, the watchdog restarted nothing.
+    assert_eq!(e.summary["restarts"], 0, "{}", e.summary);
 }

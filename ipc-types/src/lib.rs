@@ -11,7 +11,7 @@ use serde::Serialize;
 pub mod names;
 
 /// Version of every payload layout in this crate. Bump it on any layout change.
-pub const PAYLOAD_VERSION: u16 = 4;
+pub const PAYLOAD_VERSION: u16 = 5;
 
 /// Up to this many single-axis channels per sensor type (gyro, accelerometer).
 pub const MAX_CHANNELS: usize = 16;
@@ -278,6 +278,15 @@ pub mod fused_flags {
     /// Fusion is still measuring the per-channel gyro biases at rest: the rate is not yet
     /// bias-corrected, so a navigator must not start its own static alignment on it.
     pub const GYRO_REST_BIAS_PENDING: u32 = 1 << 4;
+    /// Fewer than three channels of the type are off the converter rails: the whole block reads
+    /// full scale. The true value lies beyond the range, so the solution is not valid (a block
+    /// fault or an over-range, never motion to integrate).
+    pub const GYRO_SATURATED: u32 = 1 << 5;
+    pub const ACCEL_SATURATED: u32 = 1 << 6;
+    /// The raw frame did not match the configured sensor block (payload version or channel
+    /// counts): nothing was fused, the sample only carries the frame's header onwards so that
+    /// downstream stages see the input and why it is unusable.
+    pub const INPUT_REJECTED: u32 = 1 << 7;
 }
 
 impl Default for FusedImu {
@@ -348,6 +357,8 @@ pub enum NavMode {
     Navigating = 1,
     /// Navigating on inertial only: an aiding source expected by the profile is missing.
     Coasting = 2,
+    /// Aligned, but the solution's integrity is [`Integrity::Invalid`]: it must not be used.
+    Invalid = 3,
 }
 
 impl NavMode {
@@ -355,6 +366,7 @@ impl NavMode {
         match v {
             1 => NavMode::Navigating,
             2 => NavMode::Coasting,
+            3 => NavMode::Invalid,
             _ => NavMode::Aligning,
         }
     }
@@ -364,7 +376,97 @@ impl NavMode {
             NavMode::Aligning => "aligning",
             NavMode::Navigating => "navigating",
             NavMode::Coasting => "coasting",
+            NavMode::Invalid => "invalid",
         }
+    }
+
+    /// A solution a consumer may use: aligned and not invalid.
+    pub fn is_usable(self) -> bool {
+        matches!(self, NavMode::Navigating | NavMode::Coasting)
+    }
+}
+
+/// How far the navigation solution can be trusted, [`NavState::integrity`]: the navigator's own
+/// judgement from its filter's consistency and its input (see [`integrity_reason`]).
+#[repr(u8)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
+pub enum Integrity {
+    /// Consistent: use it.
+    #[default]
+    Ok = 0,
+    /// Usable with care: an aiding source is inconsistent or silent, an uncertainty is beyond its
+    /// limit, or the solution is recovering from an invalid episode.
+    Degraded = 1,
+    /// Not usable: the solution is not being propagated, or nothing that aids it agrees with it.
+    Invalid = 2,
+}
+
+impl Integrity {
+    pub const ALL: [Integrity; 3] = [Integrity::Ok, Integrity::Degraded, Integrity::Invalid];
+
+    /// Unknown values read as `Invalid`: a consumer must not trust what it cannot read.
+    pub fn from_u8(v: u8) -> Self {
+        Self::ALL
+            .get(usize::from(v))
+            .copied()
+            .unwrap_or(Integrity::Invalid)
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrity::Ok => "ok",
+            Integrity::Degraded => "degraded",
+            Integrity::Invalid => "invalid",
+        }
+    }
+}
+
+/// Why the integrity is not [`Integrity::Ok`], bits of [`NavState::integrity_reasons`].
+pub mod integrity_reason {
+    /// Fused IMU samples arrive without a usable solution (too few channels of a type, the block
+    /// saturated, frames rejected): the state is not propagated. Invalid beyond the outage limit.
+    pub const IMU_UNUSABLE: u32 = 1 << 0;
+    /// The device time does not advance from sample to sample (or jumps): nothing is integrated.
+    pub const TIME_NOT_ADVANCING: u32 = 1 << 1;
+    /// Every configured aiding source disagrees with the solution persistently.
+    pub const ALL_AIDING_REJECTED: u32 = 1 << 2;
+    /// Baro heights persistently rejected, or their normalised innovations too large.
+    pub const BARO_INCONSISTENT: u32 = 1 << 3;
+    /// Magnetometer headings persistently rejected, or their normalised innovations too large.
+    pub const MAG_INCONSISTENT: u32 = 1 << 4;
+    /// Zero-velocity (or stance heading) updates persistently rejected or inconsistent.
+    pub const ZUPT_INCONSISTENT: u32 = 1 << 5;
+    /// An error standard deviation (tilt, heading, vertical, horizontal) beyond its limit.
+    pub const COVARIANCE: u32 = 1 << 6;
+    /// Back from an invalid episode or a reset: held degraded until the aiding confirms it.
+    pub const RECOVERING: u32 = 1 << 7;
+    /// The filter state is not finite.
+    pub const NON_FINITE: u32 = 1 << 8;
+    /// A configured aiding source is silent: the filter coasts on the inertial solution.
+    pub const AIDING_STALE: u32 = 1 << 9;
+
+    /// Every reason with its name, in bit order.
+    pub const NAMES: [(u32, &str); 10] = [
+        (IMU_UNUSABLE, "imu-unusable"),
+        (TIME_NOT_ADVANCING, "time-not-advancing"),
+        (ALL_AIDING_REJECTED, "all-aiding-rejected"),
+        (BARO_INCONSISTENT, "baro-inconsistent"),
+        (MAG_INCONSISTENT, "mag-inconsistent"),
+        (ZUPT_INCONSISTENT, "zupt-inconsistent"),
+        (COVARIANCE, "covariance"),
+        (RECOVERING, "recovering"),
+        (NON_FINITE, "non-finite"),
+        (AIDING_STALE, "aiding-stale"),
+    ];
+
+    /// The names of the bits set in `reasons`, comma-separated (empty for none).
+    pub fn describe(reasons: u32) -> String {
+        let names: Vec<&str> = NAMES
+            .iter()
+            .filter(|(bit, _)| reasons & bit != 0)
+            .map(|(_, name)| *name)
+            .collect();
+        names.join(",")
     }
 }
 
@@ -406,6 +508,11 @@ pub struct NavState {
     /// can take over its peer's solution in flight.
     pub gyro_bias_rps: [f64; 3],
     pub accel_bias_mps2: [f64; 3],
+    /// [`Integrity`] as u8.
+    pub integrity: u8,
+    pub _pad: [u8; 3],
+    /// Why the integrity is not ok, bits of [`integrity_reason`].
+    pub integrity_reasons: u32,
 }
 
 impl Default for NavState {
@@ -427,6 +534,9 @@ impl Default for NavState {
             solution_start_seq: 0,
             gyro_bias_rps: [0.0; 3],
             accel_bias_mps2: [0.0; 3],
+            integrity: Integrity::Ok as u8,
+            _pad: [0; 3],
+            integrity_reasons: 0,
         }
     }
 }

@@ -324,7 +324,8 @@ pub struct Fused {
 }
 
 impl Fused {
-    /// [`FusedImu::flags`] bits: insufficient channels and detected-not-isolated faults.
+    /// [`FusedImu::flags`] bits: insufficient channels, a saturated block, detected-not-isolated
+    /// faults, the rest bias still pending.
     pub fn flags(&self) -> u32 {
         let mut flags = 0;
         if !self.gyro_ok {
@@ -341,6 +342,12 @@ impl Fused {
         }
         if self.rest_bias_pending {
             flags |= fused_flags::GYRO_REST_BIAS_PENDING;
+        }
+        if self.gyro_status.block_saturated {
+            flags |= fused_flags::GYRO_SATURATED;
+        }
+        if self.accel_status.block_saturated {
+            flags |= fused_flags::ACCEL_SATURATED;
         }
         flags
     }

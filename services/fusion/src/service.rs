@@ -5,7 +5,7 @@ use std::time::Duration;
 use anyhow::Result;
 use ipc_types::{
     ChannelState, FusedImu, FusionControl, Health, PAYLOAD_VERSION, RawImu, SensorType,
-    ServiceKind, Stage, names,
+    ServiceKind, Stage, fused_flags, names,
 };
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::heartbeat::Heartbeat;
@@ -40,8 +40,41 @@ pub fn fused_message(raw: &RawImu, fused: &Fused, n_gyro: usize, n_accel: usize)
     msg
 }
 
+/// The message for a raw frame that does not match the configured sensor block: no estimate, the
+/// flags saying why, the channel states as they stand. Published rather than dropped, so that the
+/// navigator sees its input arrive unusable (and says so) and the watchdog sees fusion answer.
+pub fn rejected_message(raw: &RawImu, fuser: &ImuFuser) -> FusedImu {
+    let (gyro, accel) = (
+        fuser.monitor(SensorType::Gyro),
+        fuser.monitor(SensorType::Accel),
+    );
+    FusedImu {
+        version: PAYLOAD_VERSION,
+        n_gyro: fuser.gyro_geometry().n() as u8,
+        n_accel: fuser.accel_geometry().n() as u8,
+        flags: fused_flags::INPUT_REJECTED
+            | fused_flags::GYRO_INSUFFICIENT
+            | fused_flags::ACCEL_INSUFFICIENT,
+        header: raw.header,
+        gyro_state: gyro.status().states.map(|s| s as u8),
+        accel_state: accel.status().states.map(|s| s as u8),
+        gyro_reason: gyro.status().reasons.map(|r| r as u8),
+        accel_reason: accel.status().reasons.map(|r| r as u8),
+        ..FusedImu::default()
+    }
+}
+
 /// Every channel state change is a structured event (rare: faults, exclusions, re-admissions).
 fn log_events(fused: &Fused, device_time_us: u64) {
+    for status in [&fused.gyro_status, &fused.accel_status] {
+        if status.auto_readmitted != 0 {
+            tracing::warn!(
+                channels = format!("{:#06b}", status.auto_readmitted),
+                device_time_us,
+                "sensor type had no solution: excluded channels consistent again, re-admitted automatically"
+            );
+        }
+    }
     for e in fused.events.as_slice() {
         let fields = (
             e.sensor.name(),
@@ -142,6 +175,10 @@ pub fn run(
                         "raw IMU frame does not match the configured sensor block; rejecting such frames"
                     );
                 }
+                let mut msg = rejected_message(&raw, &fuser);
+                msg.header.stamp(Stage::Fusion, monotonic_ns());
+                output.publish(msg)?;
+                counters.published += 1;
                 continue;
             }
             let fused = fuser.fuse_raw(&raw);

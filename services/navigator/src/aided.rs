@@ -13,10 +13,12 @@ use serde::{Deserialize, Serialize};
 use crate::aiding::BaroAidingConfig;
 use crate::alignment::{AlignConfig, AlignError, Alignment, StaticAligner};
 use crate::ekf::{AidingSource, EkfNoise, ErrorStateEkf, UpdateOutcome};
+use crate::integrity::{IntegrityConfig, IntegrityMonitor};
 use crate::mag_calibration::MagCalibration;
 use crate::mag_heading::{FieldReference, MagAidingConfig};
 use crate::mechanisation::{ImuBias, NominalState, StepOutcome, StrapdownConfig};
 use crate::stance::{StanceConfig, StanceDetector};
+use ipc_types::Integrity;
 
 /// Settings of the zero-velocity aiding (`[navigator.zupt]`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -59,6 +61,20 @@ pub struct AidedConfig {
     pub declination_rad: f64,
     /// Position where navigation starts: latitude, longitude (rad), altitude (m).
     pub origin: [f64; 3],
+    /// The integrity monitor and its recovery policies (`[navigator.integrity]`).
+    pub integrity: IntegrityConfig,
+}
+
+impl AidedConfig {
+    /// The aiding sources this profile uses, indexed by [`AidingSource`].
+    pub fn configured_sources(&self) -> [bool; AidingSource::COUNT] {
+        let mut on = [false; AidingSource::COUNT];
+        on[AidingSource::Baro as usize] = self.baro.enabled;
+        on[AidingSource::Mag as usize] = self.mag.enabled && !self.mag.stance_only;
+        on[AidingSource::Zupt as usize] = self.zupt.enabled;
+        on[AidingSource::Hupt as usize] = self.mag.enabled && self.mag.stance_only;
+        on
+    }
 }
 
 /// Where the navigator is in its sequence. Held inline, not boxed, so that the step from
@@ -110,6 +126,8 @@ pub struct AidedNavigator {
     /// The magnetometer reference comes from the first sample after a takeover (there was no
     /// alignment window of our own to take it from).
     pub(crate) reference_from_next_mag: bool,
+    /// Whether the solution can be used (see [`crate::integrity`]).
+    pub(crate) integrity: IntegrityMonitor,
 }
 
 impl AidedNavigator {
@@ -131,6 +149,7 @@ impl AidedNavigator {
             last_reading_us: [None; AidingSource::COUNT],
             navigating_since_us: None,
             reference_from_next_mag: false,
+            integrity: IntegrityMonitor::new(config.integrity, config.configured_sources()),
         }
     }
 
@@ -155,6 +174,8 @@ impl AidedNavigator {
         self.field_reference = None;
         self.reference_from_next_mag = true;
         self.navigating_since_us = Some(t_us);
+        self.integrity =
+            IntegrityMonitor::new(self.config.integrity, self.config.configured_sources());
         self.phase = Phase::Navigating(ekf);
     }
 
@@ -260,10 +281,15 @@ impl AidedNavigator {
             Phase::Navigating(ekf) => {
                 let outcome = ekf.predict(rate_rps, specific_force, dt_s);
                 step.propagated = Some(outcome);
-                if outcome == StepOutcome::NonFiniteInput {
-                    // The epoch stays: the next good sample integrates across this one.
-                    self.last_time_us = previous_time_us;
-                    return step;
+                match outcome {
+                    StepOutcome::Applied => self.integrity.on_propagated(t_us),
+                    StepOutcome::InvalidDt => self.integrity.on_time_stall(t_us),
+                    StepOutcome::NonFiniteInput => {
+                        // The epoch stays: the next good sample integrates across this one.
+                        self.last_time_us = previous_time_us;
+                        self.integrity.on_unusable_imu(t_us);
+                        return step;
+                    }
                 }
                 // The detector sees bias-corrected rates, so a gyro bias the filter has learnt
                 // does not read as motion.
@@ -280,11 +306,42 @@ impl AidedNavigator {
                     if result.is_accepted() {
                         self.last_accepted_us[AidingSource::Zupt as usize] = Some(t_us);
                     }
+                    self.integrity
+                        .on_update(AidingSource::Zupt, t_us, result, 3);
                     step.zupt = Some(result);
                 }
             }
         }
         step
+    }
+
+    /// A fused IMU sample at `t_us` without a usable solution (too few channels, a saturated
+    /// block, a rejected frame): nothing to integrate. The state stands still, the integrity
+    /// monitor counts the outage, and the next usable sample integrates from this time on (the
+    /// outage is skipped, not integrated across with the first rates after it).
+    pub fn on_unusable_imu(&mut self, t_us: u64) {
+        if self.is_navigating() {
+            self.integrity.on_unusable_imu(t_us);
+            if self.last_time_us.is_none_or(|last| t_us > last) {
+                self.last_time_us = Some(t_us);
+            }
+        }
+    }
+
+    /// The integrity of the solution now, with its reasons (bits of
+    /// [`ipc_types::integrity_reason`]); `Invalid` with no reason while aligning. Evaluate once
+    /// per solution published: leaving an invalid episode starts a recovery.
+    pub fn evaluate_integrity(&mut self) -> (Integrity, u32) {
+        let stale = AidingSource::ALL.map(|s| self.is_stale(s));
+        match &self.phase {
+            Phase::Navigating(ekf) => self.integrity.evaluate(ekf, stale),
+            Phase::Aligning(_) => (Integrity::Invalid, 0),
+        }
+    }
+
+    /// Resets of the filter from each aiding source so far (see [`crate::integrity`]).
+    pub fn resets(&self) -> [u64; AidingSource::COUNT] {
+        self.integrity.resets()
     }
 
     /// Starts the filter from a good alignment window: attitude and gyro bias from the window,

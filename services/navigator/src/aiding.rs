@@ -9,7 +9,8 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use crate::aided::AidedNavigator;
-use crate::ekf::{AidingSource, POS, UpdateOutcome};
+use crate::attitude::{rotation_vector_to_quaternion, wrap_pi};
+use crate::ekf::{ATT, AidingSource, POS, UpdateOutcome, VEL};
 use crate::mag_heading::{FieldReference, adaptive_sigma, measured_heading};
 
 /// Settings of the barometric height aiding (`[navigator.baro]`).
@@ -59,6 +60,9 @@ pub enum AidingOutcome {
     Readmitted,
     /// Not used: aiding disabled, a bad reading, too old, rate limit, outside stance for HUPT.
     Skipped,
+    /// Persistently rejected while the reading itself is sound: the filter's state was re-set
+    /// from it (altitude from the baro, heading from the magnetometer), see [`crate::integrity`].
+    Reset,
 }
 
 impl AidedNavigator {
@@ -120,7 +124,30 @@ impl AidedNavigator {
         if outcome.is_accepted() {
             self.last_accepted_us[AidingSource::Baro as usize] = Some(t_us);
         }
+        self.integrity
+            .on_update(AidingSource::Baro, t_us, outcome, 1);
+        if self.integrity.wants_reset(AidingSource::Baro, t_us) {
+            self.reset_altitude(t_us, height_m, sigma);
+            return AidingOutcome::Reset;
+        }
         AidingOutcome::Update(outcome)
+    }
+
+    /// Every baro height has been gated out for the persistence time while the filter claims to
+    /// know its altitude: the filter is wrong (it integrated something that was not motion), not
+    /// the barometer. The altitude is re-set from the reading and its correlations dropped; the
+    /// vertical velocity keeps its value but its variance grows to cover it, so that the next
+    /// readings correct it rather than face the gate again.
+    fn reset_altitude(&mut self, t_us: u64, height_m: f64, sigma_m: f64) {
+        let Some(ekf) = self.ekf_mut() else {
+            return;
+        };
+        ekf.state_mut().alt = height_m;
+        ekf.reset_component(POS + 2, sigma_m * sigma_m);
+        let vd = ekf.state().velocity_ned[2];
+        ekf.reset_component(VEL + 2, vd * vd + 1.0);
+        self.last_accepted_us[AidingSource::Baro as usize] = Some(t_us);
+        self.integrity.on_reset(AidingSource::Baro, t_us);
     }
 
     /// One magnetometer sample (raw µT, body FRD) at device time `t_us`: calibrated, then used
@@ -182,10 +209,37 @@ impl AidedNavigator {
         if outcome.is_accepted() {
             self.last_accepted_us[source as usize] = Some(t_us);
         }
+        self.integrity.on_update(source, t_us, outcome, 1);
+        // Only an undisturbed field (every adaptive check passed) may re-set the heading.
+        let undisturbed = sigma <= c.sigma_deg.to_radians();
+        if undisturbed && self.integrity.wants_reset(source, t_us) {
+            self.reset_heading(source, t_us, psi, sigma);
+            return AidingOutcome::Reset;
+        }
         if returning && outcome.is_accepted() {
             AidingOutcome::Readmitted
         } else {
             AidingOutcome::Update(outcome)
         }
+    }
+
+    /// Every heading update of `source` gated out for the persistence time, from a field that
+    /// passes every disturbance check: the filter's heading is wrong (its gyros were out, or
+    /// integrated something that was not motion). The attitude is turned about the vertical onto
+    /// the measured heading and the heading error's correlations dropped.
+    fn reset_heading(&mut self, source: AidingSource, t_us: u64, psi: f64, sigma: f64) {
+        let Some(ekf) = self.ekf_mut() else {
+            return;
+        };
+        let attitude = ekf.state().attitude;
+        let c = attitude.to_rotation_matrix();
+        let current = c[(1, 0)].atan2(c[(0, 0)]);
+        let turn = rotation_vector_to_quaternion(&Vector3::new(0.0, 0.0, wrap_pi(psi - current)));
+        let mut q = turn * attitude;
+        q.renormalize();
+        ekf.state_mut().attitude = q;
+        ekf.reset_component(ATT + 2, sigma * sigma);
+        self.last_accepted_us[source as usize] = Some(t_us);
+        self.integrity.on_reset(source, t_us);
     }
 }

@@ -7,6 +7,7 @@ use crate::aiding::BaroAidingConfig;
 use crate::alignment::AlignConfig;
 use crate::earth::normal_gravity;
 use crate::ekf::EkfNoise;
+use crate::integrity::IntegrityConfig;
 use crate::mag_calibration::MagCalibration;
 use crate::mag_heading::MagAidingConfig;
 use crate::mechanisation::StrapdownConfig;
@@ -56,6 +57,8 @@ pub struct NavigatorConfig {
     /// Hard- and soft-iron correction of the magnetometer (`[navigator.mag_calibration]`, as
     /// printed by `rins calibrate mag`).
     pub mag_calibration: MagCalibration,
+    /// Integrity monitor and recovery policies (`[navigator.integrity]`).
+    pub integrity: IntegrityConfig,
 }
 
 impl Default for NavigatorConfig {
@@ -81,6 +84,7 @@ impl Default for NavigatorConfig {
             baro: BaroAidingConfig::default(),
             mag: MagAidingConfig::default(),
             mag_calibration: MagCalibration::default(),
+            integrity: IntegrityConfig::default(),
         }
     }
 }
@@ -207,6 +211,14 @@ impl NavigatorConfig {
             )
             .within("navigator.mag"));
         }
+        if let Err((field, value)) = self.integrity.check() {
+            return Err(ConfigError::new(
+                field,
+                value,
+                "out of range (nis_window 1..=64, time_stall_samples >= 1, limits >= 0, others finite and > 0)",
+            )
+            .within("navigator.integrity"));
+        }
         let calibration = &self.mag_calibration;
         let entries = calibration
             .hard_iron_ut
@@ -239,6 +251,7 @@ impl NavigatorConfig {
                 self.initial_longitude_deg.to_radians(),
                 self.initial_altitude_m,
             ],
+            integrity: self.integrity,
         }
     }
 

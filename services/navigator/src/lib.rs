@@ -12,6 +12,7 @@ mod checks;
 pub mod config;
 pub mod earth;
 pub mod ekf;
+pub mod integrity;
 pub mod mag_calibration;
 pub mod mag_heading;
 pub mod mechanisation;

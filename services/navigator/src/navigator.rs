@@ -8,11 +8,17 @@
 //! device-time difference to the previous one. A difference that is not positive or exceeds `max_dt_s`
 //! is a device-time glitch: the sample is not integrated and the epoch jumps to it.
 //!
+//! Integrity. Every solution carries the integrity monitor's verdict (see [`crate::integrity`]); a
+//! solution judged invalid is published with mode [`NavMode::Invalid`] and without aiding bits, so
+//! that no view reports it as navigating. Fused samples without a usable solution reach the
+//! navigator too ([`Navigator::on_unusable_imu`]): the state stands still and the monitor counts
+//! the outage.
+//!
 //! Initial state: position from the configuration, altitude from the first valid baro reading if one
 //! arrived (else the configured altitude, and the first valid reading after alignment then sets it),
 //! velocity zero, heading from the magnetometer when it reported during the window.
 
-use ipc_types::{NAV_STATES, NavMode, NavState, aiding};
+use ipc_types::{Integrity, NAV_STATES, NavMode, NavState, aiding};
 
 use crate::aided::AidedNavigator;
 use crate::aiding::AidingOutcome;
@@ -51,6 +57,11 @@ pub struct NavOutput {
     /// Estimated gyro bias (rad/s) and accelerometer bias (m/s²), body FRD.
     pub gyro_bias_rps: [f64; 3],
     pub accel_bias_mps2: [f64; 3],
+    /// Whether the solution can be used, and why not (bits of [`ipc_types::integrity_reason`]).
+    pub integrity: Integrity,
+    pub integrity_reasons: u32,
+    /// Resets of the filter from each aiding source so far, per [`AidingSource`].
+    pub resets: [u64; AidingSource::COUNT],
 }
 
 impl NavOutput {
@@ -66,6 +77,8 @@ impl NavOutput {
         out.covariance_diag = self.covariance_diag;
         out.gyro_bias_rps = self.gyro_bias_rps;
         out.accel_bias_mps2 = self.accel_bias_mps2;
+        out.integrity = self.integrity as u8;
+        out.integrity_reasons = self.integrity_reasons;
         for (k, c) in self.counts.iter().enumerate() {
             out.aiding_accepted[k] = u32::try_from(c.accepted).unwrap_or(u32::MAX);
             out.aiding_rejected[k] = u32::try_from(c.rejected).unwrap_or(u32::MAX);
@@ -95,6 +108,8 @@ pub struct Navigator {
     /// Device time of the navigation state (of the last IMU sample while aligning), µs.
     state_time_us: u64,
     rejected_imu_samples: u64,
+    /// The integrity of the last sample, evaluated once per sample.
+    integrity: (Integrity, u32),
 }
 
 impl Navigator {
@@ -106,6 +121,7 @@ impl Navigator {
             aiding_timeout_us: (config.aiding_timeout_s * 1e6).round() as u64,
             state_time_us: 0,
             rejected_imu_samples: 0,
+            integrity: (Integrity::Invalid, 0),
             config,
         })
     }
@@ -121,6 +137,7 @@ impl Navigator {
             &sol.covariance_diag,
         );
         self.state_time_us = sol.device_time_us;
+        self.integrity = self.core.evaluate_integrity();
         Ok(())
     }
 
@@ -137,13 +154,23 @@ impl Navigator {
         &self.config
     }
 
-    /// Aligning or navigating.
+    /// Aligning, navigating, or (aligned but the integrity says so) invalid.
     pub fn mode(&self) -> NavMode {
-        if self.core.is_navigating() {
-            NavMode::Navigating
-        } else {
-            NavMode::Aligning
+        match (self.core.is_navigating(), self.integrity.0) {
+            (false, _) => NavMode::Aligning,
+            (true, Integrity::Invalid) => NavMode::Invalid,
+            (true, _) => NavMode::Navigating,
         }
+    }
+
+    /// The integrity of the last solution and its reasons.
+    pub fn integrity(&self) -> (Integrity, u32) {
+        self.integrity
+    }
+
+    /// Resets of the filter from each aiding source so far, per [`AidingSource`].
+    pub fn resets(&self) -> [u64; AidingSource::COUNT] {
+        self.core.resets()
     }
 
     /// The alignment the solution started from.
@@ -189,6 +216,16 @@ impl Navigator {
             }
             Some(StepOutcome::NonFiniteInput) => self.rejected_imu_samples += 1,
         }
+        self.integrity = self.core.evaluate_integrity();
+        self.core.is_navigating().then(|| self.output())
+    }
+
+    /// A fused IMU sample at device time `device_time_us` without a usable solution: nothing is
+    /// integrated; once aligned, the solution is published as it stands with the integrity that
+    /// says so. While aligning the window is not disturbed (`None`).
+    pub fn on_unusable_imu(&mut self, device_time_us: u64) -> Option<NavOutput> {
+        self.core.on_unusable_imu(device_time_us);
+        self.integrity = self.core.evaluate_integrity();
         self.core.is_navigating().then(|| self.output())
     }
 
@@ -222,6 +259,7 @@ impl Navigator {
             }
         };
         let mut aiding_bits = 0;
+        let (integrity, integrity_reasons) = self.integrity;
         let mut counts = [AidingCounts::default(); AidingSource::COUNT];
         let mut covariance_diag = [0.0; NAV_STATES];
         let (mut gyro_bias_rps, mut accel_bias_mps2) = ([0.0; 3], [0.0; 3]);
@@ -258,6 +296,11 @@ impl Navigator {
             for (k, d) in covariance_diag.iter_mut().enumerate() {
                 *d = p[(k, k)];
             }
+            // An invalid solution is aided by nothing: whatever was accepted before no longer
+            // vouches for it.
+            if integrity == Integrity::Invalid {
+                aiding_bits &= aiding::BARO_STALE | aiding::MAG_STALE;
+            }
         }
         NavOutput {
             device_time_us: self.state_time_us,
@@ -272,18 +315,25 @@ impl Navigator {
             counts,
             gyro_bias_rps,
             accel_bias_mps2,
+            integrity,
+            integrity_reasons,
+            resets: self.core.resets(),
         }
     }
 }
 
-/// Whether a fused IMU sample (its `FusedImu::flags`) may drive the navigator: both solutions valid,
-/// and fusion no longer measuring per-channel gyro biases — the rate before that correction carries
+/// Whether a fused IMU sample (its `FusedImu::flags`) may drive the navigator: both solutions valid
+/// (enough channels, not saturated, the frame not rejected), and fusion no longer measuring
+/// per-channel gyro biases — the rate before that correction carries
 /// the biases the alignment window would otherwise average into its own estimate.
 pub fn fused_sample_usable(flags: u32) -> bool {
     use ipc_types::fused_flags;
     flags
         & (fused_flags::GYRO_INSUFFICIENT
             | fused_flags::ACCEL_INSUFFICIENT
-            | fused_flags::GYRO_REST_BIAS_PENDING)
+            | fused_flags::GYRO_REST_BIAS_PENDING
+            | fused_flags::GYRO_SATURATED
+            | fused_flags::ACCEL_SATURATED
+            | fused_flags::INPUT_REJECTED)
         == 0
 }

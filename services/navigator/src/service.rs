@@ -6,8 +6,8 @@ use std::time::Duration;
 
 use anyhow::{Result, anyhow, bail};
 use ipc_types::{
-    Altitude, FusedImu, Health, NavMode, NavState, PAYLOAD_VERSION, RawMag, ServiceKind, Stage,
-    names,
+    Altitude, FusedImu, Health, Integrity, NavMode, NavState, PAYLOAD_VERSION, RawMag, ServiceKind,
+    Stage, integrity_reason, names,
 };
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::heartbeat::Heartbeat;
@@ -15,28 +15,34 @@ use rins_runtime::ipc::{IpcSettings, TopicPublisher, TopicSubscriber, create_nod
 use rins_runtime::shutdown::Shutdown;
 
 use crate::config::NavigatorConfig;
+use crate::ekf::AidingSource;
 use crate::navigator::{Navigator, fused_sample_usable};
 use crate::takeover::Handover;
 
 const WAIT: Duration = Duration::from_millis(100);
 
 /// Feeds one fused IMU sample to the navigator and returns the state to publish (header copied,
-/// navigator stamp left to the caller). Samples without a valid solution are not integrated.
+/// navigator stamp left to the caller). Samples without a valid solution are not integrated; they
+/// are published with the integrity that says so.
 pub fn step(nav: &mut Navigator, imu: &FusedImu, last: &NavState) -> NavState {
     let mut out = NavState {
         header: imu.header,
         ..*last
     };
-    if fused_sample_usable(imu.flags)
-        && let Some(solution) = nav.on_imu(
-            imu.header.origin_device_time_us,
-            imu.rate_rps,
-            imu.specific_force_mps2,
-        )
-    {
-        solution.write_nav_state(&mut out);
+    let t_us = imu.header.origin_device_time_us;
+    let solution = if fused_sample_usable(imu.flags) {
+        nav.on_imu(t_us, imu.rate_rps, imu.specific_force_mps2)
     } else {
-        out.mode = nav.mode() as u8;
+        nav.on_unusable_imu(t_us)
+    };
+    match solution {
+        Some(solution) => solution.write_nav_state(&mut out),
+        None => {
+            out.mode = nav.mode() as u8;
+            let (integrity, reasons) = nav.integrity();
+            out.integrity = integrity as u8;
+            out.integrity_reasons = reasons;
+        }
     }
     // The first sample of a solution marks its start; aligning has none.
     out.solution_start_seq = match NavMode::from_u8(out.mode) {
@@ -82,6 +88,35 @@ fn take_over_if_ready(
     Some(newest)
 }
 
+/// A change of the integrity level, with its reasons (rare: logged off the per-sample path).
+fn log_integrity(state: &NavState) {
+    let integrity = Integrity::from_u8(state.integrity);
+    let reasons = integrity_reason::describe(state.integrity_reasons);
+    let t = state.header.origin_device_time_us;
+    match integrity {
+        Integrity::Ok => tracing::info!(device_time_us = t, "navigation integrity ok"),
+        Integrity::Degraded => {
+            tracing::warn!(device_time_us = t, reasons, "navigation integrity degraded")
+        }
+        Integrity::Invalid => {
+            tracing::error!(device_time_us = t, reasons, "navigation solution invalid")
+        }
+    }
+}
+
+/// A reset of the filter from an aiding source.
+fn log_resets(before: [u64; AidingSource::COUNT], now: [u64; AidingSource::COUNT], t: u64) {
+    for source in AidingSource::ALL {
+        if now[source as usize] != before[source as usize] {
+            tracing::warn!(
+                source = source.name(),
+                device_time_us = t,
+                "every update persistently rejected: filter reset from this source"
+            );
+        }
+    }
+}
+
 pub fn run(
     config: &NavigatorConfig,
     settings: &IpcSettings,
@@ -116,6 +151,7 @@ pub fn run(
         _ => None,
     };
     let mut handover = Handover::default();
+    let mut resets = nav.resets();
 
     while !shutdown.requested() {
         imu_in.wait(WAIT)?;
@@ -175,6 +211,13 @@ pub fn run(
             state.version = PAYLOAD_VERSION;
             state.header.stamp(Stage::Navigator, monotonic_ns());
             output.publish(state)?;
+            if state.integrity != last.integrity {
+                log_integrity(&state);
+            }
+            if nav.resets() != resets {
+                log_resets(resets, nav.resets(), state.header.origin_device_time_us);
+                resets = nav.resets();
+            }
             last = state;
             counters.published += 1;
         }

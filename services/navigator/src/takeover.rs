@@ -44,7 +44,8 @@ pub struct PeerSolution {
 
 /// Checks a peer's sample and reads its filter state.
 pub fn peer_solution(peer: &NavState) -> Result<PeerSolution, TakeOverError> {
-    if NavMode::from_u8(peer.mode) == NavMode::Aligning {
+    // An invalid solution is not worth taking over: a lane that aligns on its own is better.
+    if !NavMode::from_u8(peer.mode).is_usable() {
         return Err(TakeOverError::NotNavigating(peer.mode));
     }
     if !trusted(peer, SelectorConfig::default().settle) {

@@ -4,7 +4,7 @@
 mod common;
 
 use common::{Noise, earth_field_ned, specific_force_at_rest};
-use ipc_types::{NavMode, NavState, aiding};
+use ipc_types::{Integrity, NavMode, NavState, aiding, integrity_reason};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use rins_navigator::earth::normal_gravity;
 use rins_navigator::ekf::{AidingCounts, AidingSource};
@@ -262,9 +262,17 @@ fn output_fills_the_ipc_payload() {
         ],
         gyro_bias_rps: [1e-3, -2e-3, 3e-3],
         accel_bias_mps2: [0.1, 0.2, -0.3],
+        integrity: Integrity::Degraded,
+        integrity_reasons: integrity_reason::MAG_INCONSISTENT | integrity_reason::RECOVERING,
+        resets: [0, 2, 0, 0],
     };
     let mut state = NavState::default();
     out.write_nav_state(&mut state);
+    assert_eq!(state.integrity, Integrity::Degraded as u8);
+    assert_eq!(
+        state.integrity_reasons,
+        integrity_reason::MAG_INCONSISTENT | integrity_reason::RECOVERING
+    );
     assert_eq!(state.gyro_bias_rps, [1e-3, -2e-3, 3e-3]);
     assert_eq!(state.accel_bias_mps2, [0.1, 0.2, -0.3]);
     assert_eq!(state.mode, NavMode::Navigating as u8);

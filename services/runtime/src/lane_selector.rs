@@ -17,7 +17,7 @@
 //!   selected lane is only dead when it has been silent for the time, not merely behind in count.
 //!   A lane so far ahead that its pending samples would overflow ([`FORCE_SWITCH_PENDING`]) is
 //!   taken regardless, since losing samples is worse than a switch.
-//! - **Untrusted lane** (quality): the selected lane is aligning or its solution is younger than
+//! - **Untrusted lane** (quality): the selected lane is aligning, its solution invalid, or younger than
 //!   [`SelectorConfig::settle`] samples (it just reset or took over), while the other lane is trusted
 //!   and has the next sample. A lane that just reset is never chosen for quality: only a dead
 //!   selected lane makes the selector take an untrusted one, since anything beats no output.
@@ -50,7 +50,7 @@ pub struct SelectorConfig {
     /// And how long the other lane must have published since the selected lane's last sample, ns
     /// (samples without publish times are judged by the count alone).
     pub dead_after_ns: u64,
-    /// The same when the other lane is not trusted (aligning, or younger than `settle`).
+    /// The same when the other lane is not trusted (aligning, invalid, or younger than `settle`).
     pub dead_after_untrusted_ns: u64,
     /// Samples a solution must have run (since alignment or takeover) before it is trusted.
     pub settle: u64,
@@ -77,7 +77,7 @@ impl Default for SelectorConfig {
 pub enum SwitchReason {
     /// The selected lane stopped delivering.
     Dead,
-    /// The selected lane was aligning or too young, the other one trusted.
+    /// The selected lane was aligning, invalid or too young, the other one trusted.
     Untrusted,
 }
 
@@ -108,7 +108,7 @@ pub struct LaneSelector {
 
 /// A solution the selector may choose for quality.
 pub fn trusted(s: &NavState, settle: u64) -> bool {
-    NavMode::from_u8(s.mode) != NavMode::Aligning
+    NavMode::from_u8(s.mode).is_usable()
         && s.solution_start_seq != 0
         && s.header.origin_seq.saturating_sub(s.solution_start_seq) >= settle
         && s.quaternion.iter().all(|q| q.is_finite())

@@ -1,6 +1,6 @@
 //! The once-a-second status line.
 
-use ipc_types::{NavMode, NavState};
+use ipc_types::{Integrity, NavMode, NavState, integrity_reason};
 use nalgebra::{Quaternion, UnitQuaternion};
 
 use crate::monitor::{COUNTED, DeviceCounters};
@@ -44,6 +44,14 @@ pub fn status_line(
                 if nav.aiding & bit != 0 {
                     line.push_str(&format!(" | {what}, coasting"));
                 }
+            }
+            let integrity = Integrity::from_u8(nav.integrity);
+            if integrity != Integrity::Ok && NavMode::from_u8(nav.mode) != NavMode::Aligning {
+                line.push_str(&format!(
+                    " | integrity {}: {}",
+                    integrity.name().to_uppercase(),
+                    integrity_reason::describe(nav.integrity_reasons)
+                ));
             }
         }
         None => line.push_str(" | no navigation output yet"),
@@ -99,5 +107,25 @@ mod tests {
         );
         assert!(line.contains("baro stale, coasting"), "{line}");
         assert!(!line.contains("mag stale"), "{line}");
+        assert!(!line.contains("integrity"), "{line}");
+        let invalid = NavState {
+            mode: NavMode::Invalid as u8,
+            integrity: Integrity::Invalid as u8,
+            integrity_reasons: integrity_reason::IMU_UNUSABLE | integrity_reason::COVARIANCE,
+            ..nav
+        };
+        let line = status_line(
+            3.0,
+            &[1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0],
+            0,
+            &DeviceCounters::default(),
+            Some(&invalid),
+        );
+        assert!(
+            line.contains("| invalid roll")
+                && line.contains("integrity INVALID: imu-unusable,covariance"),
+            "{line}"
+        );
+        assert!(!line.contains("navigating"), "{line}");
     }
 }

@@ -201,6 +201,9 @@ mod tests {
             counts: Default::default(),
             gyro_bias_rps: [0.0; 3],
             accel_bias_mps2: [0.0; 3],
+            integrity: ipc_types::Integrity::Ok,
+            integrity_reasons: 0,
+            resets: [0; 4],
         }
     }
 

@@ -20,6 +20,19 @@ pub enum ParityNoise {
     Adaptive,
 }
 
+/// What happens to latched exclusions when a sensor type has lost its solution.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ReadmitPolicy {
+    /// With fewer than three channels in service, the excluded channels are re-tested and those
+    /// consistent again for `readmit_after_samples` return by themselves (see
+    /// [`super::recovery`]).
+    #[default]
+    Auto,
+    /// Exclusions latch until an operator re-admits the channel, whatever the consequences.
+    Operator,
+}
+
 /// Fault detection and isolation settings. Sample counts are at the IMU rate.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -72,6 +85,12 @@ pub struct FdiConfig {
     /// Uncertainty of the sampling instants between channels, s: adds (τ·|dx/dt|)² to every
     /// channel's variance in the parity test (units on separate clocks; 0 for one converter).
     pub timing_skew_s: f64,
+    /// `"auto"` or `"operator"`: whether a sensor type left without a solution re-admits its
+    /// excluded channels once they are consistent again (see [`ReadmitPolicy`]).
+    pub readmit: ReadmitPolicy,
+    /// Samples in a row an excluded channel must be valid, off the converter rails, varying and
+    /// consistent with the others before it returns by itself.
+    pub readmit_after_samples: u32,
 }
 
 impl Default for FdiConfig {
@@ -98,6 +117,8 @@ impl Default for FdiConfig {
             reference_ratio: 3.0,
             motion_noise_fraction: 0.0,
             timing_skew_s: 0.0,
+            readmit: ReadmitPolicy::Auto,
+            readmit_after_samples: 1_000,
         }
     }
 }
@@ -122,6 +143,8 @@ pub struct FdiSettings {
     /// [`FdiConfig::timing_skew_s`] in samples; set by the fuser, which knows the sample rate
     /// (0 from [`FdiConfig::settings`]).
     pub timing_skew_samples: f64,
+    pub readmit: ReadmitPolicy,
+    pub readmit_after_samples: u32,
     /// Per-sample exceedance probability α₁ behind the thresholds.
     pub exceedance_probability: f64,
     /// χ² threshold for each parity dimension (index m; entry 0 unused).
@@ -243,7 +266,10 @@ impl FdiConfig {
                 "must be in [0, 1] s",
             ));
         }
+        at_least("readmit_after_samples", self.readmit_after_samples, 10)?;
         Ok(FdiSettings {
+            readmit: self.readmit,
+            readmit_after_samples: self.readmit_after_samples,
             motion_noise_fraction: self.motion_noise_fraction,
             timing_skew_samples: 0.0,
             persistence_k: k,

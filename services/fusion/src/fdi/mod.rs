@@ -1,4 +1,4 @@
-//! Fault detection, isolation and reconfiguration (FDI) of the redundant channels (DESIGN §4.2).
+//! Fault detection, isolation and reconfiguration (FDI) of the redundant channels.
 //!
 //! - [`parity`]: parity basis V (faer SVD), whitening, test statistic, GLT scores.
 //! - [`chi2`]: χ² tail and quantile for the thresholds.
@@ -8,6 +8,7 @@
 //! - [`stationary`]: stationary detector and the per-channel reference for N = 4 isolation.
 //! - [`offset`]: the learnt parity offset (channel biases left by calibration).
 //! - [`noise_estimate`]: the adaptive parity noise covariance.
+//! - [`recovery`]: re-test of latched exclusions when a sensor type has lost its solution.
 //! - [`monitor`]: all of the above for one sensor type, with latched exclusions.
 //! - [`report`]: per-channel states, reasons and state-change events.
 //! - [`config`]: the `[fusion.fdi]` table.
@@ -22,6 +23,7 @@ pub mod noise_estimate;
 pub mod offset;
 pub mod parity;
 pub mod persistence;
+pub mod recovery;
 pub mod report;
 pub mod stationary;
 
@@ -30,7 +32,7 @@ use crate::geometry::MAX_CHANNELS;
 /// Largest parity dimension: N − 3 for N = 16.
 pub const MAX_PARITY: usize = MAX_CHANNELS - 3;
 
-pub use config::{FdiConfig, FdiSettings, ParityNoise};
+pub use config::{FdiConfig, FdiSettings, ParityNoise, ReadmitPolicy};
 pub use monitor::{MonitorInput, ReadmitError, SensorEstimate, SensorMonitor};
 pub use parity::{ParityError, ParitySpace};
 pub use report::{ChannelEvent, ChannelEvents, MAX_EVENTS, SensorStatus};

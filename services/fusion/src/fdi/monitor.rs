@@ -16,20 +16,29 @@
 //!    fault is reported as detected-not-isolated, and every channel stays in the solution;
 //! 4. weighted least squares over the active set.
 //!
-//! **Exclusions latch.** An excluded channel is never re-admitted automatically, not even when it
-//! looks healthy again. In 2005 the air data inertial reference unit of a Boeing 777 (Malaysia
-//! Airlines 124), after a second accelerometer failed, went back to an accelerometer that had
-//! failed years before — that earlier exclusion had not been kept — and its wrong output pitched
-//! the aircraft up. Only an explicit command ([`SensorMonitor::readmit`]) returns a channel.
+//! **Exclusions latch.** While the type has a solution, an excluded channel is never re-admitted
+//! automatically, not even when it looks healthy again. In 2005 the air data inertial reference
+//! unit of a Boeing 777 (Malaysia Airlines 124), after a second accelerometer failed, went back to
+//! an accelerometer that had failed years before — that earlier exclusion had not been kept — and
+//! its wrong output pitched the aircraft up. Only an explicit command ([`SensorMonitor::readmit`])
+//! returns a channel then. Once fewer than three channels remain, there is no solution left to
+//! protect: with `readmit = "auto"` (the default) the excluded channels are re-tested and return
+//! when they are consistent again ([`super::recovery`]); `readmit = "operator"` keeps the latch.
+//!
+//! **Block saturation.** When fewer than three channels in service are off the converter rails,
+//! the true value lies beyond the range and no combination of the channels measures it: the
+//! status says `block_saturated` and the fused solution is flagged not valid. Nothing is
+//! excluded (an over-range is not a channel fault) and the channels are Suspect (Saturated).
 
 use super::MAX_PARITY;
-use super::channel_health::{ChannelHealth, HealthFindings};
-use super::config::{FdiSettings, ParityNoise};
+use super::channel_health::{COUNT_MAX, COUNT_MIN, ChannelHealth, HealthFindings};
+use super::config::{FdiSettings, ParityNoise, ReadmitPolicy};
 use super::isolation::{self, ParityIsolation, ParityWindow};
 use super::noise_estimate::AdaptiveParityNoise;
 use super::offset::ParityOffset;
 use super::parity::ParitySpace;
 use super::persistence::Persistence;
+use super::recovery::{ExclusionRetest, RetestInput};
 use super::report::{ChannelEvents, SensorStatus};
 use super::stationary::ChannelReference;
 use crate::geometry::{Geometry, MAX_CHANNELS};
@@ -82,6 +91,14 @@ struct ParityOutcome {
     learning: bool,
 }
 
+/// What the health checks and the recovery re-test decided on one sample, for the status.
+struct HealthOutcome {
+    /// Channels Suspect for a genuine over-range.
+    saturated_suspect: u32,
+    block_saturated: bool,
+    auto_readmitted: u32,
+}
+
 fn bits(mut mask: u32) -> impl Iterator<Item = usize> {
     std::iter::from_fn(move || {
         (mask != 0).then(|| {
@@ -124,6 +141,11 @@ pub struct SensorMonitor {
     last_x: [f64; 3],
     /// Channel variance the motion adds now (see [`FdiSettings::motion_noise_fraction`]).
     motion_variance: f64,
+    /// The learnt parity offset in channel terms, as of the last parity space that had one: it
+    /// outlives a loss of the parity space (fewer than four channels) and is carried into the next.
+    channel_offset: [f64; MAX_CHANNELS],
+    /// Re-test of the exclusions while the type has no solution.
+    retest: ExclusionRetest,
 }
 
 impl SensorMonitor {
@@ -173,6 +195,8 @@ impl SensorMonitor {
             status,
             last_x: [0.0; 3],
             motion_variance: 0.0,
+            channel_offset: [0.0; MAX_CHANNELS],
+            retest: ExclusionRetest::default(),
         };
         monitor.reconfigure();
         monitor
@@ -198,6 +222,12 @@ impl SensorMonitor {
         if self.excluded_mask != before {
             self.reconfigure();
         }
+        let active = self.active_mask();
+        let health = HealthOutcome {
+            saturated_suspect,
+            block_saturated: active.count_ones() >= 3 && (active & !found.at_rail).count_ones() < 3,
+            auto_readmitted: self.retest_exclusions(input),
+        };
 
         // The solution before the test sets the motion's share of the noise for this sample.
         let before_test = self.solver.as_ref().map(|s| (s.mask(), s.solve(z)));
@@ -233,7 +263,7 @@ impl SensorMonitor {
             candidates,
             learning,
         };
-        let status = self.build_status(&parity, saturated_suspect, input);
+        let status = self.build_status(&parity, &health, input);
         events.record(self.sensor, &self.status, &status);
         self.status = status;
         (estimate, status)
@@ -385,9 +415,10 @@ impl SensorMonitor {
     fn build_status(
         &self,
         parity: &ParityOutcome,
-        saturated_suspect: u32,
+        health: &HealthOutcome,
         input: &MonitorInput,
     ) -> SensorStatus {
+        let saturated_suspect = health.saturated_suspect;
         let n = self.geometry.n();
         let candidates = parity.candidates;
         let mut status = SensorStatus {
@@ -398,6 +429,8 @@ impl SensorMonitor {
             detected_not_isolated: candidates != 0,
             device_error: input.device_error,
             learning: parity.learning,
+            block_saturated: health.block_saturated,
+            auto_readmitted: health.auto_readmitted,
             ..SensorStatus::ABSENT
         };
         for i in 0..n {
@@ -475,6 +508,53 @@ impl SensorMonitor {
         Ok(true)
     }
 
+    /// The recovery re-test (see [`super::recovery`]): while the type has no solution and the
+    /// policy allows, excluded channels that are valid, off the rails, varying and consistent with
+    /// the others for `readmit_after_samples` in a row return. Returns the channels re-admitted.
+    fn retest_exclusions(&mut self, input: &MonitorInput) -> u32 {
+        if self.solver.is_some() || self.settings.readmit == ReadmitPolicy::Operator {
+            self.retest.clear();
+            return 0;
+        }
+        let n = self.geometry.n();
+        let off_rail = (0..n)
+            .filter(|&i| {
+                input
+                    .counts
+                    .get(i)
+                    .is_some_and(|&c| c != COUNT_MIN && c != COUNT_MAX)
+            })
+            .fold(0u32, |m, i| m | 1 << i);
+        let candidates = self.active_mask() | (self.excluded_mask & input.valid & off_rail);
+        let mut z = *input.z;
+        for (v, offset) in z.iter_mut().zip(&self.channel_offset).take(n) {
+            *v -= offset;
+        }
+        let retest = RetestInput {
+            candidates,
+            counts: input.counts,
+            z: &z,
+        };
+        let Some(back) = self.retest.push(
+            &self.geometry,
+            &self.variances,
+            &self.settings.thresholds,
+            &retest,
+            self.settings.readmit_after_samples,
+        ) else {
+            return 0;
+        };
+        let returned = back & self.excluded_mask;
+        for ch in bits(returned) {
+            self.excluded[ch] = FaultReason::None;
+            self.health.forget(ch);
+        }
+        self.excluded_mask &= !returned;
+        self.reconfigure();
+        self.retest.clear();
+        returned
+    }
+
     fn exclude(&mut self, channel: usize, reason: FaultReason) {
         if self.excluded[channel] == FaultReason::None {
             self.excluded[channel] = reason;
@@ -508,10 +588,14 @@ impl SensorMonitor {
             p.set_noise_covariance(a.covariance());
         }
         if let Some(offset) = self.offset.as_mut() {
-            let carried = match (&old_parity, &self.parity) {
-                (Some(old), Some(new)) => new.carry_over(old, offset.mean()),
-                _ => [0.0; MAX_PARITY],
-            };
+            // Through channel terms, so that the offset also survives a spell without parity.
+            if let Some(old) = &old_parity {
+                self.channel_offset = old.to_channels(offset.mean());
+            }
+            let mut carried = [0.0; MAX_PARITY];
+            if let Some(new) = &self.parity {
+                new.parity(&self.channel_offset, &mut carried);
+            }
             offset.set_mean(carried);
         }
         self.persistence.reset();

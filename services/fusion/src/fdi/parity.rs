@@ -229,15 +229,22 @@ impl ParitySpace {
     /// space: `V' Vᵀ b`. Exact for a channel-bias offset b = Vβ, because V'β only sees the
     /// parity-visible part Pβ = Vᵀb of β (see [`super::offset`]).
     pub fn carry_over(&self, old: &ParitySpace, b: &[f64; MAX_PARITY]) -> [f64; MAX_PARITY] {
+        let beta = old.to_channels(b);
+        let mut out = [0.0; MAX_PARITY];
+        self.parity(&beta, &mut out);
+        out
+    }
+
+    /// The channel values `Vᵀ b` whose parity is `b` (V has orthonormal rows): a parity-domain
+    /// quantity, such as the learnt offset, carried in channel terms where no parity space exists.
+    pub fn to_channels(&self, b: &[f64; MAX_PARITY]) -> [f64; MAX_CHANNELS] {
         let mut beta = [0.0; MAX_CHANNELS];
-        for (row, br) in old.basis.iter().zip(b).take(old.dim) {
+        for (row, br) in self.basis.iter().zip(b).take(self.dim) {
             for (x, v) in beta.iter_mut().zip(row) {
                 *x += br * v;
             }
         }
-        let mut out = [0.0; MAX_PARITY];
-        self.parity(&beta, &mut out);
-        out
+        beta
     }
 
     /// GLT scores `(w_iᵀ p')² / (w_iᵀ w_i)` of every active channel visible to parity for the

@@ -26,6 +26,11 @@ pub struct SensorStatus {
     pub device_error: bool,
     /// The adaptive noise estimate is still learning: parity declarations are suspended.
     pub learning: bool,
+    /// Fewer than three channels in service are off the converter rails: the block reads full
+    /// scale, the solution is not valid.
+    pub block_saturated: bool,
+    /// Channels re-admitted by the recovery re-test on this sample (see [`super::recovery`]).
+    pub auto_readmitted: u32,
 }
 
 impl SensorStatus {
@@ -40,6 +45,8 @@ impl SensorStatus {
         detected_not_isolated: false,
         device_error: false,
         learning: false,
+        block_saturated: false,
+        auto_readmitted: 0,
     };
 
     /// Channels in state `state` (bit i = channel i).

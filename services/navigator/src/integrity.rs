@@ -1,0 +1,405 @@
+//! Integrity of the navigation solution: whether it can be used, judged from the filter's own
+//! consistency and from its input, and published with every solution ([`ipc_types::Integrity`],
+//! reasons in [`ipc_types::integrity_reason`]).
+//!
+//! **Invalid** — the solution must not be used:
+//! - the fused IMU has had no usable sample for `imu_outage_s` (every channel of a type out, the
+//!   block saturated, frames rejected upstream): the state is not being propagated;
+//! - the device time has not advanced over `time_stall_samples` samples in a row: nothing is
+//!   integrated although samples arrive;
+//! - every configured aiding source that reports is persistently rejected (each update gated out
+//!   for `rejection_persist_s`): nothing that observes the state agrees with it;
+//! - the state is not finite.
+//!
+//! **Degraded** — usable with care:
+//! - a shorter IMU outage, or a single device-time glitch;
+//! - one aiding source rejected several times in a row, or its normalised innovation squared (NIS, d²/m
+//!   over the last `nis_window` accepted updates) above `nis_limit` on average — a consistent
+//!   filter has a mean of 1;
+//! - an error standard deviation beyond its limit (tilt, heading, vertical, horizontal);
+//! - a configured aiding source silent (the filter coasts);
+//! - recovering: after an invalid episode or a reset from an aiding source, until
+//!   `recovery_s` has passed and every configured source that reports has been accepted again.
+//!
+//! **Ok** otherwise. The monitor is allocation-free and works in device time, like the filter.
+
+use serde::{Deserialize, Serialize};
+
+use ipc_types::{Integrity, integrity_reason as why};
+
+use crate::ekf::{ATT, AidingSource, ErrorStateEkf, POS, UpdateOutcome};
+
+/// Longest NIS window.
+pub const MAX_NIS_WINDOW: usize = 64;
+
+/// Settings of the integrity monitor (`[navigator.integrity]`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct IntegrityConfig {
+    /// An IMU outage longer than this makes the solution invalid, s of device time.
+    pub imu_outage_s: f64,
+    /// IMU samples in a row whose device time does not advance (or jumps beyond `max_dt_s`)
+    /// that make the solution invalid.
+    pub time_stall_samples: u32,
+    /// Accepted updates per aiding source in the NIS window, 1..=64.
+    pub nis_window: u32,
+    /// Mean of d²/m over the window above which a source is inconsistent.
+    pub nis_limit: f64,
+    /// A source whose every update is gated out for this long is persistently rejected, s.
+    pub rejection_persist_s: f64,
+    /// Reset the filter from a persistently rejected source (altitude from the baro, heading
+    /// from an undisturbed magnetometer): the filter, not the sensor, is then taken to be wrong.
+    pub reset_from_aiding: bool,
+    /// Held degraded this long after an invalid episode or a reset, s.
+    pub recovery_s: f64,
+    /// Limits on the error standard deviations (0 = no limit): roll/pitch, heading (degrees),
+    /// vertical and horizontal position (metres). Without horizontal aiding the horizontal error
+    /// grows without bound by design: set a limit where the mission needs one.
+    pub max_tilt_sigma_deg: f64,
+    pub max_heading_sigma_deg: f64,
+    pub max_vertical_sigma_m: f64,
+    pub max_horizontal_sigma_m: f64,
+}
+
+impl Default for IntegrityConfig {
+    fn default() -> Self {
+        Self {
+            imu_outage_s: 0.05,
+            time_stall_samples: 10,
+            nis_window: 20,
+            nis_limit: 4.0,
+            rejection_persist_s: 2.0,
+            reset_from_aiding: true,
+            recovery_s: 1.0,
+            max_tilt_sigma_deg: 5.0,
+            max_heading_sigma_deg: 30.0,
+            max_vertical_sigma_m: 20.0,
+            max_horizontal_sigma_m: 0.0,
+        }
+    }
+}
+
+impl IntegrityConfig {
+    /// `(field, value)` of the first out-of-range parameter.
+    pub fn check(&self) -> Result<(), (&'static str, f64)> {
+        let positive = |field, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err((field, v))
+            }
+        };
+        let limit = |field, v: f64| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err((field, v))
+            }
+        };
+        positive("imu_outage_s", self.imu_outage_s)?;
+        if self.time_stall_samples == 0 {
+            return Err(("time_stall_samples", 0.0));
+        }
+        if !(1..=MAX_NIS_WINDOW as u32).contains(&self.nis_window) {
+            return Err(("nis_window", f64::from(self.nis_window)));
+        }
+        positive("nis_limit", self.nis_limit)?;
+        positive("rejection_persist_s", self.rejection_persist_s)?;
+        limit("recovery_s", self.recovery_s)?;
+        limit("max_tilt_sigma_deg", self.max_tilt_sigma_deg)?;
+        limit("max_heading_sigma_deg", self.max_heading_sigma_deg)?;
+        limit("max_vertical_sigma_m", self.max_vertical_sigma_m)?;
+        limit("max_horizontal_sigma_m", self.max_horizontal_sigma_m)
+    }
+}
+
+/// Consistency record of one aiding source.
+#[derive(Debug, Clone, Copy)]
+struct SourceRecord {
+    /// d²/m of the last accepted updates (ring).
+    nis: [f64; MAX_NIS_WINDOW],
+    next: usize,
+    len: usize,
+    /// Device time of the first rejection of the current run (`None` after an acceptance).
+    rejected_since_us: Option<u64>,
+    /// Updates in the current run of rejections.
+    rejected_run: u32,
+    /// Accepted since the last invalid episode or reset.
+    confirmed: bool,
+    /// Updates tried at all.
+    attempts: u64,
+}
+
+impl Default for SourceRecord {
+    fn default() -> Self {
+        Self {
+            nis: [0.0; MAX_NIS_WINDOW],
+            next: 0,
+            len: 0,
+            rejected_since_us: None,
+            rejected_run: 0,
+            confirmed: false,
+            attempts: 0,
+        }
+    }
+}
+
+/// Rejected updates in a row that make a source inconsistent (degraded); persistent (a reset, or
+/// invalid when every source is) once the run has also lasted `rejection_persist_s`.
+const MIN_REJECTED_RUN: u32 = 3;
+
+impl SourceRecord {
+    fn mean_nis(&self) -> Option<f64> {
+        (self.len > 0).then(|| self.nis[..self.len].iter().sum::<f64>() / self.len as f64)
+    }
+
+    fn persistently_rejected(&self, now_us: u64, persist_us: u64) -> bool {
+        self.rejected_since_us.is_some_and(|since| {
+            self.rejected_run >= MIN_REJECTED_RUN && now_us.saturating_sub(since) >= persist_us
+        })
+    }
+}
+
+/// Seconds of device time in whole microseconds, so that limits compare exactly.
+fn micros(s: f64) -> u64 {
+    (s * 1e6).round() as u64
+}
+
+/// The integrity monitor of one navigator.
+#[derive(Debug, Clone)]
+pub struct IntegrityMonitor {
+    config: IntegrityConfig,
+    /// `imu_outage_s`, `rejection_persist_s`, `recovery_s` in µs.
+    outage_us: u64,
+    persist_us: u64,
+    recovery_us: u64,
+    /// Sources the profile uses (index [`AidingSource`]).
+    configured: [bool; AidingSource::COUNT],
+    sources: [SourceRecord; AidingSource::COUNT],
+    /// Newest device time seen on any IMU sample, µs.
+    latest_us: u64,
+    /// Device time of the first unusable IMU sample of the current outage.
+    outage_since_us: Option<u64>,
+    /// IMU samples in a row whose time did not advance.
+    time_stalls: u32,
+    /// Device time a recovery started (after an invalid episode or a reset).
+    recovering_since_us: Option<u64>,
+    /// The last evaluation.
+    last: (Integrity, u32),
+    /// Resets from each source so far.
+    resets: [u64; AidingSource::COUNT],
+}
+
+impl IntegrityMonitor {
+    /// A monitor for a profile that uses the sources marked in `configured`.
+    pub fn new(config: IntegrityConfig, configured: [bool; AidingSource::COUNT]) -> Self {
+        Self {
+            config,
+            outage_us: micros(config.imu_outage_s),
+            persist_us: micros(config.rejection_persist_s),
+            recovery_us: micros(config.recovery_s),
+            configured,
+            sources: [SourceRecord::default(); AidingSource::COUNT],
+            latest_us: 0,
+            outage_since_us: None,
+            time_stalls: 0,
+            recovering_since_us: None,
+            last: (Integrity::Ok, 0),
+            resets: [0; AidingSource::COUNT],
+        }
+    }
+
+    pub fn config(&self) -> &IntegrityConfig {
+        &self.config
+    }
+
+    fn see_time(&mut self, t_us: u64) {
+        self.latest_us = self.latest_us.max(t_us);
+    }
+
+    /// An IMU sample propagated the state at `t_us`.
+    pub fn on_propagated(&mut self, t_us: u64) {
+        self.see_time(t_us);
+        self.outage_since_us = None;
+        self.time_stalls = 0;
+    }
+
+    /// An IMU sample arrived whose device time did not advance (or jumped): not integrated.
+    pub fn on_time_stall(&mut self, t_us: u64) {
+        self.see_time(t_us);
+        self.time_stalls = self.time_stalls.saturating_add(1);
+    }
+
+    /// A fused IMU sample arrived without a usable solution.
+    pub fn on_unusable_imu(&mut self, t_us: u64) {
+        self.see_time(t_us);
+        self.outage_since_us.get_or_insert(t_us);
+    }
+
+    /// The outcome of one update of `source` at `t_us`; `dof` is the measurement's dimension.
+    pub fn on_update(&mut self, source: AidingSource, t_us: u64, outcome: UpdateOutcome, dof: u32) {
+        let window = self.config.nis_window as usize;
+        let r = &mut self.sources[source as usize];
+        r.attempts += 1;
+        match outcome {
+            UpdateOutcome::Accepted { d2 } => {
+                r.rejected_since_us = None;
+                r.rejected_run = 0;
+                r.confirmed = true;
+                r.nis[r.next] = d2 / f64::from(dof.max(1));
+                r.next = (r.next + 1) % window;
+                r.len = (r.len + 1).min(window);
+            }
+            UpdateOutcome::Rejected { .. } | UpdateOutcome::Singular => {
+                r.rejected_since_us.get_or_insert(t_us);
+                r.rejected_run = r.rejected_run.saturating_add(1);
+            }
+        }
+    }
+
+    /// Whether the filter should be reset from `source` now: its updates are persistently rejected
+    /// and the policy allows it.
+    pub fn wants_reset(&self, source: AidingSource, now_us: u64) -> bool {
+        self.config.reset_from_aiding
+            && self.sources[source as usize].persistently_rejected(now_us, self.persist_us)
+    }
+
+    /// The filter was reset from `source` at `t_us`: its record starts afresh and the solution is
+    /// held as recovering.
+    pub fn on_reset(&mut self, source: AidingSource, t_us: u64) {
+        self.resets[source as usize] += 1;
+        self.sources[source as usize] = SourceRecord::default();
+        self.start_recovery(t_us);
+    }
+
+    /// Resets from each source so far.
+    pub fn resets(&self) -> [u64; AidingSource::COUNT] {
+        self.resets
+    }
+
+    fn start_recovery(&mut self, t_us: u64) {
+        self.recovering_since_us = Some(t_us);
+        for r in &mut self.sources {
+            r.confirmed = false;
+        }
+    }
+
+    /// The integrity now, with the reasons; `stale` tells which configured sources are silent.
+    /// Call once per published solution.
+    pub fn evaluate(
+        &mut self,
+        ekf: &ErrorStateEkf,
+        stale: [bool; AidingSource::COUNT],
+    ) -> (Integrity, u32) {
+        let now = self.latest_us;
+        let c = self.config;
+        let (mut invalid, mut degraded) = (0u32, 0u32);
+        if let Some(since) = self.outage_since_us {
+            if now.saturating_sub(since) >= self.outage_us {
+                invalid |= why::IMU_UNUSABLE;
+            } else {
+                degraded |= why::IMU_UNUSABLE;
+            }
+        }
+        if self.time_stalls >= c.time_stall_samples {
+            invalid |= why::TIME_NOT_ADVANCING;
+        } else if self.time_stalls > 0 {
+            degraded |= why::TIME_NOT_ADVANCING;
+        }
+        let state = ekf.state();
+        let finite = state.attitude.coords.iter().all(|v| v.is_finite())
+            && state.velocity_ned.iter().all(|v| v.is_finite())
+            && [state.lat, state.lon, state.alt]
+                .iter()
+                .all(|v| v.is_finite());
+        if !finite {
+            invalid |= why::NON_FINITE;
+        }
+
+        let (mut reporting, mut rejected) = (0, 0);
+        for source in AidingSource::ALL {
+            let i = source as usize;
+            let r = &self.sources[i];
+            if !self.configured[i] {
+                continue;
+            }
+            if stale[i] {
+                degraded |= why::AIDING_STALE;
+                continue;
+            }
+            if r.attempts == 0 {
+                continue;
+            }
+            reporting += 1;
+            let persistent = r.persistently_rejected(now, self.persist_us);
+            if persistent {
+                rejected += 1;
+            }
+            let full = r.len >= c.nis_window as usize;
+            let high = full && r.mean_nis().is_some_and(|m| m > c.nis_limit);
+            if r.rejected_run >= MIN_REJECTED_RUN || high {
+                degraded |= inconsistency_bit(source);
+            }
+        }
+        if reporting > 0 && rejected == reporting {
+            invalid |= why::ALL_AIDING_REJECTED;
+        }
+        if self.covariance_beyond_limits(ekf) {
+            degraded |= why::COVARIANCE;
+        }
+
+        // Leaving an invalid episode starts a recovery; a recovery ends once it has lasted and
+        // every source that reports has agreed again.
+        if invalid == 0 && self.last.0 == Integrity::Invalid {
+            self.start_recovery(now);
+        }
+        if let Some(since) = self.recovering_since_us {
+            let lasted = now.saturating_sub(since) >= self.recovery_us;
+            let confirmed = AidingSource::ALL.iter().all(|s| {
+                let i = *s as usize;
+                let r = &self.sources[i];
+                !self.configured[i] || stale[i] || r.attempts == 0 || r.confirmed
+            });
+            if lasted && confirmed && invalid == 0 {
+                self.recovering_since_us = None;
+            } else {
+                degraded |= why::RECOVERING;
+            }
+        }
+        self.last = if invalid != 0 {
+            (Integrity::Invalid, invalid | degraded)
+        } else if degraded != 0 {
+            (Integrity::Degraded, degraded)
+        } else {
+            (Integrity::Ok, 0)
+        };
+        self.last
+    }
+
+    /// The last evaluation.
+    pub fn last(&self) -> (Integrity, u32) {
+        self.last
+    }
+
+    fn covariance_beyond_limits(&self, ekf: &ErrorStateEkf) -> bool {
+        let c = &self.config;
+        // A NaN σ is beyond any limit.
+        let over = |sigma: f64, limit: f64| limit > 0.0 && (sigma.is_nan() || sigma > limit);
+        let tilt = ekf.sigma(ATT).max(ekf.sigma(ATT + 1)).to_degrees();
+        let heading = ekf.sigma(ATT + 2).to_degrees();
+        let horizontal = ekf.sigma(POS).max(ekf.sigma(POS + 1));
+        over(tilt, c.max_tilt_sigma_deg)
+            || over(heading, c.max_heading_sigma_deg)
+            || over(ekf.sigma(POS + 2), c.max_vertical_sigma_m)
+            || over(horizontal, c.max_horizontal_sigma_m)
+    }
+}
+
+/// The reason bit of an inconsistent source.
+fn inconsistency_bit(source: AidingSource) -> u32 {
+    match source {
+        AidingSource::Baro => why::BARO_INCONSISTENT,
+        AidingSource::Mag => why::MAG_INCONSISTENT,
+        AidingSource::Zupt | AidingSource::Hupt => why::ZUPT_INCONSISTENT,
+    }
+}
