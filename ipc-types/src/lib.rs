@@ -334,6 +334,8 @@ pub mod aiding {
     pub const MAG: u32 = 1 << 1;
     pub const ZUPT: u32 = 1 << 2;
     pub const HUPT: u32 = 1 << 3;
+    /// The tilt is being re-levelled from gravity (after the IMU stopped propagating the attitude).
+    pub const GRAVITY: u32 = 1 << 4;
     /// Baro aiding is configured but no reading arrived within the aiding timeout: the altitude
     /// coasts on the inertial solution.
     pub const BARO_STALE: u32 = 1 << 8;
@@ -343,8 +345,8 @@ pub mod aiding {
 }
 
 /// Aiding sources counted in [`NavState::aiding_accepted`] / [`NavState::aiding_rejected`], in
-/// this order: baro, mag, zupt, hupt.
-pub const AIDING_SOURCES: usize = 4;
+/// this order: baro, mag, zupt, hupt, gravity.
+pub const AIDING_SOURCES: usize = 5;
 
 /// Navigator mode, [`NavState::mode`].
 #[repr(u8)]
@@ -495,7 +497,7 @@ pub struct NavState {
     pub longitude_rad: f64,
     pub altitude_m: f64,
     pub covariance_diag: [f64; NAV_STATES],
-    /// Updates accepted per aiding source since alignment (baro, mag, zupt, hupt).
+    /// Updates accepted per aiding source since alignment (baro, mag, zupt, hupt, gravity).
     pub aiding_accepted: [u32; AIDING_SOURCES],
     /// Updates rejected by the innovation gate per aiding source since alignment.
     pub aiding_rejected: [u32; AIDING_SOURCES],

@@ -493,6 +493,7 @@ fn summarise(
         nav_lane_samples: monitor.nav_lanes().lane_totals(),
         nav_lane_switches: monitor.nav_lanes().switches().0,
         nav_lane_filled: monitor.nav_lanes().filled(),
+        nav_integrity_samples: monitor.integrity_samples.into(),
         att_err_deg_rms: sim(acc.attitude_deg.rms()),
         att_err_deg_max: sim(acc.attitude_deg.max()),
         alt_err_m_rms: sim(acc.altitude_m.rms()),

@@ -6,6 +6,7 @@
 //! - [`fdi`]: fault detection and isolation on the real quadrotor recordings (false alarms, and
 //!   faults injected into the data).
 //! - [`datasets`]: loaders of recorded data sets (the four-IMU quadrotor flights).
+//! - [`integrity_tally`]: the share of a recording the navigator judged ok, degraded, invalid.
 //! - [`installation`]: relative rotation between IMUs from paired rate vectors (Wahba's problem).
 //! - [`quadrotor_nav`]: free-inertial roll, pitch and height on the quadrotor recordings, each unit
 //!   alone and the units fused.
@@ -15,6 +16,7 @@ pub mod datasets;
 pub mod fdi;
 pub mod foot;
 pub mod installation;
+pub mod integrity_tally;
 pub mod mc;
 pub mod quadrotor_nav;
 pub mod stats;

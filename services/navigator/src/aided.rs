@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::aiding::BaroAidingConfig;
 use crate::alignment::{AlignConfig, AlignError, Alignment, StaticAligner};
+use crate::attitude_recovery::AttitudeRecovery;
 use crate::ekf::{AidingSource, EkfNoise, ErrorStateEkf, UpdateOutcome};
 use crate::integrity::{IntegrityConfig, IntegrityMonitor};
 use crate::mag_calibration::MagCalibration;
@@ -128,6 +129,8 @@ pub struct AidedNavigator {
     pub(crate) reference_from_next_mag: bool,
     /// Whether the solution can be used (see [`crate::integrity`]).
     pub(crate) integrity: IntegrityMonitor,
+    /// Re-levelling after the attitude was lost (see [`crate::attitude_recovery`]).
+    attitude_recovery: AttitudeRecovery,
 }
 
 impl AidedNavigator {
@@ -150,6 +153,7 @@ impl AidedNavigator {
             navigating_since_us: None,
             reference_from_next_mag: false,
             integrity: IntegrityMonitor::new(config.integrity, config.configured_sources()),
+            attitude_recovery: AttitudeRecovery::default(),
         }
     }
 
@@ -176,6 +180,7 @@ impl AidedNavigator {
         self.navigating_since_us = Some(t_us);
         self.integrity =
             IntegrityMonitor::new(self.config.integrity, self.config.configured_sources());
+        self.attitude_recovery = AttitudeRecovery::default();
         self.phase = Phase::Navigating(ekf);
     }
 
@@ -186,7 +191,7 @@ impl AidedNavigator {
         let enabled = match source {
             AidingSource::Baro => self.config.baro.enabled,
             AidingSource::Mag => self.config.mag.enabled && !self.config.mag.stance_only,
-            AidingSource::Zupt | AidingSource::Hupt => false,
+            AidingSource::Zupt | AidingSource::Hupt | AidingSource::Gravity => false,
         };
         let (Some(now), Some(since)) = (self.last_time_us, self.navigating_since_us) else {
             return false;
@@ -282,7 +287,11 @@ impl AidedNavigator {
                 let outcome = ekf.predict(rate_rps, specific_force, dt_s);
                 step.propagated = Some(outcome);
                 match outcome {
-                    StepOutcome::Applied => self.integrity.on_propagated(t_us),
+                    StepOutcome::Applied => {
+                        if self.integrity.on_propagated(t_us) {
+                            self.attitude_recovery.lose(ekf, &self.config.integrity);
+                        }
+                    }
                     StepOutcome::InvalidDt => self.integrity.on_time_stall(t_us),
                     StepOutcome::NonFiniteInput => {
                         // The epoch stays: the next good sample integrates across this one.
@@ -297,6 +306,21 @@ impl AidedNavigator {
                 let rate = Vector3::from(rate_rps) - b.gyro_rps;
                 let force = Vector3::from(specific_force) - b.accel_mps2;
                 self.last_force = force;
+                if outcome.is_applied()
+                    && let Some(result) = self.attitude_recovery.push(
+                        ekf,
+                        &self.config.integrity,
+                        t_us,
+                        specific_force,
+                        &rate,
+                    )
+                {
+                    if result.is_accepted() {
+                        self.last_accepted_us[AidingSource::Gravity as usize] = Some(t_us);
+                    }
+                    self.integrity
+                        .on_update(AidingSource::Gravity, t_us, result, 2);
+                }
                 let g = ekf.strapdown().gravity();
                 step.stance = self.stance.push(rate.into(), force.into(), pressure, g);
                 self.in_stance = step.stance;

@@ -15,7 +15,8 @@
 //! - a shorter IMU outage, or a single device-time glitch;
 //! - one aiding source rejected several times in a row, or its normalised innovation squared (NIS, d²/m
 //!   over the last `nis_window` accepted updates) above `nis_limit` on average — a consistent
-//!   filter has a mean of 1;
+//!   filter has a mean of 1. Not for zero-velocity updates: they come on every sample of a stance,
+//!   their innovations strongly correlated, their σ a tuning device rather than a sensor's noise;
 //! - an error standard deviation beyond its limit (tilt, heading, vertical, horizontal);
 //! - a configured aiding source silent (the filter coasts);
 //! - recovering: after an invalid episode or a reset from an aiding source, until
@@ -59,6 +60,18 @@ pub struct IntegrityConfig {
     pub max_heading_sigma_deg: f64,
     pub max_vertical_sigma_m: f64,
     pub max_horizontal_sigma_m: f64,
+    /// After the IMU stopped propagating the state for an invalid spell, the attitude is lost:
+    /// its error σ on every axis, degrees (see [`crate::attitude_recovery`]).
+    pub lost_attitude_sigma_deg: f64,
+    /// Re-levelling from gravity: window, s; σ of the window's mean specific force as a
+    /// measurement of gravity, m/s²; the window counts as quasi-static when its mean |f| is
+    /// within the tolerance of g (m/s²) and no rate exceeds the limit (°/s); re-levelling ends
+    /// once the tilt σ is below `relevelled_tilt_sigma_deg`.
+    pub gravity_window_s: f64,
+    pub gravity_sigma_mps2: f64,
+    pub gravity_force_tolerance_mps2: f64,
+    pub gravity_max_rate_dps: f64,
+    pub relevelled_tilt_sigma_deg: f64,
 }
 
 impl Default for IntegrityConfig {
@@ -75,6 +88,12 @@ impl Default for IntegrityConfig {
             max_heading_sigma_deg: 30.0,
             max_vertical_sigma_m: 20.0,
             max_horizontal_sigma_m: 0.0,
+            lost_attitude_sigma_deg: 45.0,
+            gravity_window_s: 0.1,
+            gravity_sigma_mps2: 0.1,
+            gravity_force_tolerance_mps2: 0.3,
+            gravity_max_rate_dps: 10.0,
+            relevelled_tilt_sigma_deg: 0.3,
         }
     }
 }
@@ -109,7 +128,16 @@ impl IntegrityConfig {
         limit("max_tilt_sigma_deg", self.max_tilt_sigma_deg)?;
         limit("max_heading_sigma_deg", self.max_heading_sigma_deg)?;
         limit("max_vertical_sigma_m", self.max_vertical_sigma_m)?;
-        limit("max_horizontal_sigma_m", self.max_horizontal_sigma_m)
+        limit("max_horizontal_sigma_m", self.max_horizontal_sigma_m)?;
+        positive("lost_attitude_sigma_deg", self.lost_attitude_sigma_deg)?;
+        positive("gravity_window_s", self.gravity_window_s)?;
+        positive("gravity_sigma_mps2", self.gravity_sigma_mps2)?;
+        positive(
+            "gravity_force_tolerance_mps2",
+            self.gravity_force_tolerance_mps2,
+        )?;
+        positive("gravity_max_rate_dps", self.gravity_max_rate_dps)?;
+        positive("relevelled_tilt_sigma_deg", self.relevelled_tilt_sigma_deg)
     }
 }
 
@@ -217,11 +245,17 @@ impl IntegrityMonitor {
         self.latest_us = self.latest_us.max(t_us);
     }
 
-    /// An IMU sample propagated the state at `t_us`.
-    pub fn on_propagated(&mut self, t_us: u64) {
+    /// An IMU sample propagated the state at `t_us`. Returns whether it ends a spell without
+    /// propagation long enough to have made the solution invalid (the attitude is then lost).
+    pub fn on_propagated(&mut self, t_us: u64) -> bool {
         self.see_time(t_us);
+        let outage = self
+            .outage_since_us
+            .is_some_and(|since| t_us.saturating_sub(since) >= self.outage_us);
+        let stalled = self.time_stalls >= self.config.time_stall_samples;
         self.outage_since_us = None;
         self.time_stalls = 0;
+        outage || stalled
     }
 
     /// An IMU sample arrived whose device time did not advance (or jumped): not integrated.
@@ -335,7 +369,9 @@ impl IntegrityMonitor {
             if persistent {
                 rejected += 1;
             }
-            let full = r.len >= c.nis_window as usize;
+            // Zero-velocity updates come every sample of a stance, their innovations strongly
+            // correlated and their σ a tuning device: their NIS says nothing about consistency.
+            let full = r.len >= c.nis_window as usize && source != AidingSource::Zupt;
             let high = full && r.mean_nis().is_some_and(|m| m > c.nis_limit);
             if r.rejected_run >= MIN_REJECTED_RUN || high {
                 degraded |= inconsistency_bit(source);
@@ -401,5 +437,7 @@ fn inconsistency_bit(source: AidingSource) -> u32 {
         AidingSource::Baro => why::BARO_INCONSISTENT,
         AidingSource::Mag => why::MAG_INCONSISTENT,
         AidingSource::Zupt | AidingSource::Hupt => why::ZUPT_INCONSISTENT,
+        // Never configured: it only acts while the attitude is recovered.
+        AidingSource::Gravity => 0,
     }
 }

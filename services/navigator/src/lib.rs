@@ -8,6 +8,7 @@ pub mod aided;
 pub mod aiding;
 pub mod alignment;
 pub mod attitude;
+pub mod attitude_recovery;
 mod checks;
 pub mod config;
 pub mod earth;

@@ -97,6 +97,7 @@ const SOURCE_BITS: [(AidingSource, u32); AidingSource::COUNT] = [
     (AidingSource::Mag, aiding::MAG),
     (AidingSource::Zupt, aiding::ZUPT),
     (AidingSource::Hupt, aiding::HUPT),
+    (AidingSource::Gravity, aiding::GRAVITY),
 ];
 
 /// The navigator of the process. Allocation-free per sample once aligned.

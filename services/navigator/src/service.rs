@@ -211,7 +211,8 @@ pub fn run(
             state.version = PAYLOAD_VERSION;
             state.header.stamp(Stage::Navigator, monotonic_ns());
             output.publish(state)?;
-            if state.integrity != last.integrity {
+            let aligned = NavMode::from_u8(state.mode) != NavMode::Aligning;
+            if aligned && state.integrity != last.integrity {
                 log_integrity(&state);
             }
             if nav.resets() != resets {

@@ -181,3 +181,35 @@ fn static_filter_with_zero_velocity_updates_stays_bounded_and_learns_tilt() {
     // Velocity σ bounded by the ZUPT noise.
     assert!(ekf.sigma(VEL) < 0.01);
 }
+
+/// A tilt error of a filter that believes its tilt poorly (σ 30°) is removed by one gravity update
+/// of a precise force (σ 1e-4 m/s²) to the linearisation's second order (ε² = 7.6e-5 rad for
+/// ε = 0.5°), whatever the heading, and the heading is left alone to the same order.
+#[test]
+fn a_gravity_update_removes_a_tilt_error_and_leaves_the_heading() {
+    use rins_navigator::ekf::ATT;
+    for yaw_deg in [0.0f64, 75.0, -140.0] {
+        let truth = UnitQuaternion::from_euler_angles(0.02, -0.01, yaw_deg.to_radians());
+        let mut ekf = at_rest(quiet_noise());
+        let error =
+            UnitQuaternion::from_euler_angles(0.5f64.to_radians(), -0.3f64.to_radians(), 0.0);
+        ekf.state_mut().attitude = error * truth;
+        for i in ATT..ATT + 2 {
+            ekf.reset_component(i, 30f64.to_radians().powi(2));
+        }
+        let g = ekf.strapdown().gravity();
+        let force = truth.inverse() * Vector3::new(0.0, 0.0, -g);
+        let outcome = ekf.gravity_tilt(force.into(), 1e-4, f64::INFINITY);
+        assert!(outcome.is_accepted(), "{outcome:?}");
+        let residual = ekf.state().attitude * truth.inverse();
+        let (r, p, y) = residual.euler_angles();
+        let second_order = 0.5f64.to_radians().powi(2);
+        assert!(
+            r.abs() < second_order && p.abs() < second_order,
+            "yaw {yaw_deg}: {r} {p}"
+        );
+        assert!(y.abs() < second_order, "heading moved by {y}");
+        assert!(ekf.sigma(ATT) < 1e-4 / g * 1.01, "σ {}", ekf.sigma(ATT));
+        assert_eq!(ekf.counts(AidingSource::Gravity).accepted, 1);
+    }
+}

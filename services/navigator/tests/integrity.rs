@@ -126,7 +126,13 @@ fn an_imu_outage_is_invalid_from_its_limit_on_and_recovers_once_the_aiding_agree
             ok_at.get_or_insert(k);
         } else {
             assert!(ok_at.is_none(), "ok, then not ok again at {k}: {out:?}");
-            assert_eq!(out.integrity_reasons, why::RECOVERING, "{out:?}");
+            // Recovering; the attitude lost during the outage until gravity and the
+            // magnetometer have brought its σ back.
+            assert_eq!(
+                out.integrity_reasons & !why::COVARIANCE,
+                why::RECOVERING,
+                "{out:?}"
+            );
         }
     }
     let ok_at = ok_at.expect("back to ok");
@@ -251,5 +257,59 @@ fn without_resets_a_solution_every_source_rejects_is_invalid() {
         out.integrity_reasons & why::ALL_AIDING_REJECTED != 0,
         "{out:?}"
     );
-    assert_eq!(out.resets, [0; 4]);
+    assert_eq!(out.resets, [0; 5]);
+}
+
+#[test]
+fn a_vehicle_that_turned_during_an_outage_is_re_levelled_from_gravity_and_the_magnetometer() {
+    let mut nav = Navigator::new(config()).unwrap();
+    let (mut v, _) = Vehicle::aligned(&mut nav, 2000);
+    for k in 2001..=3000 {
+        v.aid(&mut nav, k);
+        let _ = nav.on_unusable_imu(Vehicle::time_us(k));
+    }
+    // Meanwhile the vehicle rolled by 10°, pitched by −5° and turned by 40°.
+    let (roll, pitch, yaw) = (
+        10f64.to_radians(),
+        -5f64.to_radians(),
+        (YAW_DEG + 40.0).to_radians(),
+    );
+    v.attitude = quaternion_from_euler(roll, pitch, yaw);
+    v.field_body = v.attitude.inverse() * earth_field_ned(21.0, 43.0, 0.0);
+    let first = v.step(&mut nav, 3001).expect("navigating");
+    // The attitude is lost: its σ says so on every axis.
+    let lost = IntegrityConfig::default()
+        .lost_attitude_sigma_deg
+        .to_radians();
+    for i in 0..3 {
+        assert!(
+            (first.covariance_diag[i].sqrt() - lost).abs() < 1e-9,
+            "{first:?}"
+        );
+    }
+    assert!(first.integrity_reasons & why::COVARIANCE != 0);
+    let mut last = first;
+    for k in 3002..=6000 {
+        last = v.step(&mut nav, k).expect("navigating");
+    }
+    let [w, x, y, z] = last.quaternion;
+    let e = euler_from_quaternion(&UnitQuaternion::new_normalize(Quaternion::new(w, x, y, z)));
+    // Tilt from gravity to its σ (0.1 m/s² over g ≈ 0.6°), heading from the magnetometer.
+    assert!(
+        (e[0] - roll).abs() < 0.5f64.to_radians(),
+        "roll {}",
+        e[0].to_degrees()
+    );
+    assert!(
+        (e[1] - pitch).abs() < 0.5f64.to_radians(),
+        "pitch {}",
+        e[1].to_degrees()
+    );
+    assert!(
+        angle_diff(e[2], yaw).abs() < 2f64.to_radians(),
+        "yaw {}",
+        e[2].to_degrees()
+    );
+    assert!(last.counts[AidingSource::Gravity as usize].accepted >= 1);
+    assert_eq!(last.integrity, Integrity::Ok, "{last:?}");
 }

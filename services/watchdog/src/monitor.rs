@@ -3,8 +3,8 @@
 
 use anyhow::Result;
 use ipc_types::{
-    Altitude, FaultApplied, FusedImu, Health, NavMode, NavState, RawBaro, RawImu, RawMag,
-    ServiceKind, Truth, names,
+    Altitude, FaultApplied, FusedImu, Health, Integrity, NavMode, NavState, RawBaro, RawImu,
+    RawMag, ServiceKind, Truth, names,
 };
 use rins_runtime::ipc::{IpcNode, TopicSubscriber};
 use rins_runtime::nav_subscriber::NavSubscriber;
@@ -53,6 +53,8 @@ pub struct Monitor {
     pub nav_gaps: SeqGaps,
     pub last_nav: Option<NavState>,
     pub accuracy: Accuracy,
+    /// Navigation samples after alignment per integrity level (ok, degraded, invalid).
+    pub integrity_samples: [u64; 3],
     /// Injected faults, their detection and isolation, and false alarms.
     pub faults: FaultTracker,
     truth_ring: Box<[Truth]>,
@@ -78,6 +80,7 @@ impl Monitor {
             nav_gaps: SeqGaps::default(),
             last_nav: None,
             accuracy: Accuracy::default(),
+            integrity_samples: [0; 3],
             faults: FaultTracker::new(),
             // version 0 marks an empty slot.
             truth_ring: vec![
@@ -165,6 +168,7 @@ impl Monitor {
         let seq = nav.header.origin_seq;
         self.nav_gaps.observe(seq);
         if NavMode::from_u8(nav.mode) != NavMode::Aligning {
+            self.integrity_samples[Integrity::from_u8(nav.integrity) as usize] += 1;
             let truth = &self.truth_ring[(seq as usize) % TRUTH_RING];
             if truth.header.origin_seq == seq && truth.version != 0 {
                 self.accuracy.push(

@@ -4,6 +4,24 @@ use serde::Serialize;
 
 use crate::fault_tracking::FaultRecord;
 
+/// Navigation samples per integrity level.
+#[derive(Debug, Clone, Copy, Default, Serialize, PartialEq, Eq)]
+pub struct IntegritySamples {
+    pub ok: u64,
+    pub degraded: u64,
+    pub invalid: u64,
+}
+
+impl From<[u64; 3]> for IntegritySamples {
+    fn from([ok, degraded, invalid]: [u64; 3]) -> Self {
+        Self {
+            ok,
+            degraded,
+            invalid,
+        }
+    }
+}
+
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct Summary {
     pub duration_s: f64,
@@ -30,6 +48,8 @@ pub struct Summary {
     pub nav_lane_samples: [u64; 2],
     pub nav_lane_switches: u64,
     pub nav_lane_filled: u64,
+    /// Navigation samples after alignment the navigator judged ok, degraded and invalid.
+    pub nav_integrity_samples: IntegritySamples,
     /// Attitude error against simulator truth after alignment, degrees (simulator mode only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub att_err_deg_rms: Option<f64>,

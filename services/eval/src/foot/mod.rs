@@ -15,6 +15,7 @@ use serde::Serialize;
 
 use crate::datasets::foot::{FootTrial, PeerResult};
 use crate::datasets::{pyshoe, xio};
+use crate::integrity_tally::IntegritySummary;
 use metrics::{aligned_rmse_2d, path_length_2d};
 use run::{FootRun, run_trial};
 
@@ -30,6 +31,7 @@ pub struct PyshoeTrial {
     pub heading_fit_deg: f64,
     pub stance_fraction: f64,
     pub zupt_rejected: u64,
+    pub integrity: IntegritySummary,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -53,6 +55,7 @@ pub struct XioWalk {
     pub dropped_duplicate_rows: usize,
     pub stance_fraction: f64,
     pub zupt_rejected: u64,
+    pub integrity: IntegritySummary,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -109,6 +112,7 @@ pub fn evaluate_pyshoe_trial(trial: &FootTrial, config: &AidedConfig) -> Result<
         heading_fit_deg: theta.to_degrees(),
         stance_fraction: run.stance_samples as f64 / trial.samples.len().max(1) as f64,
         zupt_rejected: run.zupt_rejected,
+        integrity: run.integrity.summary(),
     })
 }
 
@@ -162,6 +166,7 @@ pub fn evaluate_xio_walk(trial: &FootTrial, config: &AidedConfig) -> Result<XioW
         dropped_duplicate_rows: trial.dropped_duplicates,
         stance_fraction: run.stance_samples as f64 / trial.samples.len().max(1) as f64,
         zupt_rejected: run.zupt_rejected,
+        integrity: run.integrity.summary(),
     })
 }
 

@@ -12,20 +12,22 @@ pub fn pyshoe_table(r: &PyshoeReport) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<22} {:>7} {:>10} {:>14} {:>9} {:>8} {:>9}",
-        "trial", "s", "rmse2d m", "peer(tuned) m", "heading°", "stance", "zupt rej"
+        "{:<22} {:>7} {:>10} {:>14} {:>9} {:>8} {:>9} {:>6}  integrity reasons",
+        "trial", "s", "rmse2d m", "peer(tuned) m", "heading°", "stance", "zupt rej", "ok"
     );
     for t in &r.trials {
         let _ = writeln!(
             s,
-            "{:<22} {:>7.1} {:>10.3} {:>14} {:>9.1} {:>7.0}% {:>9}",
+            "{:<22} {:>7.1} {:>10.3} {:>14} {:>9.1} {:>7.0}% {:>9} {:>5.1}%  {}",
             t.trial,
             t.seconds,
             t.rmse_2d_m,
             opt(t.peer_rmse_2d_m, 1.0),
             t.heading_fit_deg,
             100.0 * t.stance_fraction,
-            t.zupt_rejected
+            t.zupt_rejected,
+            100.0 * t.integrity.ok_fraction,
+            t.integrity.reasons
         );
     }
     let _ = writeln!(
@@ -42,13 +44,13 @@ pub fn xio_table(r: &XioReport) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<14} {:>7} {:>10} {:>11} {:>10} {:>9} {:>8} {:>8}",
-        "walk", "s", "end err m", "distance m", "% dist", "peer m", "stance", "dup rows"
+        "{:<14} {:>7} {:>10} {:>11} {:>10} {:>9} {:>8} {:>8} {:>6}  integrity reasons",
+        "walk", "s", "end err m", "distance m", "% dist", "peer m", "stance", "dup rows", "ok"
     );
     for t in &r.trials {
         let _ = writeln!(
             s,
-            "{:<14} {:>7.1} {:>10.3} {:>11.1} {:>9.2}% {:>9} {:>7.0}% {:>8}",
+            "{:<14} {:>7.1} {:>10.3} {:>11.1} {:>9.2}% {:>9} {:>7.0}% {:>8} {:>5.1}%  {}",
             t.trial,
             t.seconds,
             t.end_error_m,
@@ -56,7 +58,9 @@ pub fn xio_table(r: &XioReport) -> String {
             t.pct_distance,
             opt(t.peer_end_error_m, 1.0),
             100.0 * t.stance_fraction,
-            t.dropped_duplicate_rows
+            t.dropped_duplicate_rows,
+            100.0 * t.integrity.ok_fraction,
+            t.integrity.reasons
         );
     }
     s

@@ -4,6 +4,7 @@ use rins_navigator::aided::{AidedConfig, AidedNavigator};
 use rins_navigator::earth::{meridian_radius, prime_vertical_radius};
 
 use crate::datasets::foot::FootTrial;
+use crate::integrity_tally::IntegrityTally;
 
 /// The navigator's output over one recording.
 #[derive(Debug, Clone, Default)]
@@ -19,10 +20,18 @@ pub struct FootRun {
     pub zupt_rejected: u64,
     /// Sample at which the alignment completed.
     pub aligned_at: Option<usize>,
+    /// The integrity verdict of every sample after alignment.
+    pub integrity: IntegrityTally,
 }
 
 /// Runs `trial` through a navigator made from `config`.
 pub fn run_trial(trial: &FootTrial, config: &AidedConfig) -> FootRun {
+    // The recordings carry neither a barometer nor a magnetometer: the profile's sources that
+    // never report would only read as silent (the navigation is the same either way).
+    let mut config = *config;
+    config.baro.enabled = false;
+    config.mag.enabled = false;
+    let config = &config;
     let mut nav = AidedNavigator::new(*config);
     let mut run = FootRun {
         ned_m: Vec::with_capacity(trial.samples.len()),
@@ -38,6 +47,9 @@ pub fn run_trial(trial: &FootTrial, config: &AidedConfig) -> FootRun {
     for (k, s) in trial.samples.iter().enumerate() {
         let t_us = ((s.t_s - t0) * 1e6).round().max(0.0) as u64;
         let step = nav.on_imu(t_us, s.gyro_rps, s.accel_mps2, None);
+        if nav.is_navigating() {
+            run.integrity.push(nav.evaluate_integrity());
+        }
         let p = nav.ekf().map_or([0.0; 3], |ekf| {
             let st = ekf.state();
             [

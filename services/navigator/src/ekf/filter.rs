@@ -18,15 +18,18 @@ pub enum AidingSource {
     Mag = 1,
     Zupt = 2,
     Hupt = 3,
+    /// The specific force of a quasi-static vehicle as the direction of gravity (tilt).
+    Gravity = 4,
 }
 
 impl AidingSource {
-    pub const COUNT: usize = 4;
+    pub const COUNT: usize = 5;
     pub const ALL: [AidingSource; Self::COUNT] = [
         AidingSource::Baro,
         AidingSource::Mag,
         AidingSource::Zupt,
         AidingSource::Hupt,
+        AidingSource::Gravity,
     ];
 
     pub fn name(self) -> &'static str {
@@ -35,6 +38,7 @@ impl AidingSource {
             AidingSource::Mag => "mag",
             AidingSource::Zupt => "zupt",
             AidingSource::Hupt => "hupt",
+            AidingSource::Gravity => "gravity",
         }
     }
 }

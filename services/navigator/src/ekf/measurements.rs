@@ -4,7 +4,7 @@
 use nalgebra::{Matrix3, SMatrix, SVector, Vector1};
 
 use super::filter::{AidingSource, ErrorStateEkf, UpdateOutcome};
-use super::{ATT, POS, STATES, VEL};
+use super::{ATT, BA, POS, STATES, VEL};
 use crate::attitude::wrap_pi;
 
 /// `∂ψ/∂δθ` for the yaw `ψ = atan2(C₁₀, C₀₀)` of `C = (I + [δθ×]) Ĉ`: with `[δθ×]` acting on Ĉ's
@@ -39,6 +39,37 @@ impl ErrorStateEkf {
         let innovation = Vector1::new(height_m - self.state().alt);
         let r = Vector1::new(sigma_m * sigma_m);
         self.update(AidingSource::Baro, &h, &innovation, &SMatrix::from(r), gate)
+    }
+
+    /// Tilt from gravity: the mean specific force `force_body` (m/s², FRD, as measured) of a
+    /// vehicle that is not accelerating points straight up, so its horizontal components in the
+    /// navigation frame are zero, each with σ `sigma_mps2`. With the true attitude
+    /// `C = (I + [δθ×]) Ĉ` and the true force `f̂ − δb_a` (f̂ bias-corrected), the predicted
+    /// horizontal force `Ĉ f̂` moves by `δθ × fⁿ − Ĉ δb_a`; with `fⁿ ≈ [0, 0, −g]` that is
+    /// `[−g δθ_y, g δθ_x]` from the tilt errors (the heading term vanishes with the horizontal
+    /// force) and the first two rows of `−Ĉ` from the bias.
+    pub fn gravity_tilt(
+        &mut self,
+        force_body: [f64; 3],
+        sigma_mps2: f64,
+        gate: f64,
+    ) -> UpdateOutcome {
+        let c = self.state().attitude.to_rotation_matrix().into_inner();
+        let corrected = nalgebra::Vector3::from(force_body) - self.bias().accel_mps2;
+        let f_n = c * corrected;
+        let mut h = SMatrix::<f64, 2, STATES>::zeros();
+        // Rows of δθ × fⁿ: [δθ_y f_z − δθ_z f_y, δθ_z f_x − δθ_x f_z].
+        h[(0, ATT + 1)] = f_n.z;
+        h[(0, ATT + 2)] = -f_n.y;
+        h[(1, ATT)] = -f_n.z;
+        h[(1, ATT + 2)] = f_n.x;
+        for k in 0..3 {
+            h[(0, BA + k)] = -c[(0, k)];
+            h[(1, BA + k)] = -c[(1, k)];
+        }
+        let innovation = SVector::<f64, 2>::new(-f_n.x, -f_n.y);
+        let r = SMatrix::<f64, 2, 2>::identity() * (sigma_mps2 * sigma_mps2);
+        self.update(AidingSource::Gravity, &h, &innovation, &r, gate)
     }
 
     /// Heading measurement, rad from north, σ `sigma_rad` (magnetometer heading, or the stance
