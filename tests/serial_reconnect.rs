@@ -79,10 +79,7 @@ struct Collector {
 
 impl Collector {
     fn start(ipc: &Isolated) -> Self {
-        let settings = IpcSettings {
-            prefix: ipc.prefix.clone(),
-            root: format!("{}/", ipc.root.display()),
-        };
+        let settings = IpcSettings::new(ipc.prefix.clone(), format!("{}/", ipc.root.display()));
         let seen = Arc::new(Mutex::new(Seen::default()));
         let stop = Arc::new(AtomicBool::new(false));
         let (s, st) = (seen.clone(), stop.clone());
