@@ -40,9 +40,9 @@ const SIM_START_TIMEOUT: Duration = Duration::from_secs(10);
 /// Period of the supervision loop: topics drained and children checked this often.
 const LOOP_PERIOD: Duration = Duration::from_millis(1);
 
-/// Refuses to start while another deployment runs on the prefix, or while another user's files are
-/// on it (never opened, never removed); otherwise removes what a dead run of ours left.
-fn ensure_no_live_deployment(settings: &IpcSettings) -> Result<()> {
+/// Refuses to start while another user's files are on the prefix in /dev/shm: they are never
+/// opened, never removed.
+fn refuse_foreign_entries(settings: &IpcSettings) -> Result<()> {
     let foreign = shm_cleanup::foreign_entries(settings, settings.owner);
     if !foreign.is_empty() {
         bail!(
@@ -54,6 +54,12 @@ fn ensure_no_live_deployment(settings: &IpcSettings) -> Result<()> {
             rins_runtime::ipc::PREFIX_ENV
         );
     }
+    Ok(())
+}
+
+/// Refuses to start while another deployment runs on the prefix; otherwise removes what a dead run
+/// of ours left.
+fn ensure_no_live_deployment(settings: &IpcSettings) -> Result<()> {
     let config = settings.iceoryx_config()?;
     let (mut alive, mut tools) = (0, 0);
     iceoryx2::prelude::Node::<iceoryx2::prelude::ipc::Service>::list(&config, |state| {
@@ -177,11 +183,16 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
         return Ok(std::process::ExitCode::SUCCESS);
     }
     let settings = IpcSettings::from_env();
+    refuse_foreign_entries(&settings)?;
     // Only a root this run created is removed at the end (and only when empty).
     let root_created = settings.ensure_root()?;
-    ensure_no_live_deployment(&settings)?;
-
-    let run_dir = settings.ensure_run_dir()?;
+    let run_dir = ensure_no_live_deployment(&settings)
+        .and_then(|()| settings.ensure_run_dir())
+        .inspect_err(|_| {
+            if root_created {
+                let _ = std::fs::remove_dir(&settings.root);
+            }
+        })?;
     // A new deployment numbers its frames afresh: the last one's resume point does not apply.
     let _ = std::fs::remove_file(rins_acquisition::resume_file::path_for(&settings));
     let simulate = cfg.acquisition.port.is_none();
@@ -261,7 +272,11 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     drop(monitor);
     drop(node);
     shm_cleanup::remove_all(&settings, root_created);
-    let leaked = shm_cleanup::shm_entries(&settings).len() as u64;
+    // Ours only: another user's files on the prefix are not a leak of this deployment.
+    let leaked = shm_cleanup::inspect(Path::new(shm_cleanup::SHM_DIR), &settings.prefix)
+        .iter()
+        .filter(|e| e.belongs_to(settings.owner))
+        .count() as u64;
     outcome?;
     if args.json {
         let summary = Summary {

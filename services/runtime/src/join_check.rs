@@ -23,7 +23,7 @@ pub fn settings_to_join() -> Result<IpcSettings> {
 /// is this process's user, who will create it) and every /dev/shm entry of the prefix is a regular
 /// file of that owner. The error says whose the deployment is and how to trust it.
 pub fn check_joinable(settings: &IpcSettings) -> Result<()> {
-    let root = Path::new(&settings.root);
+    let root = private_dir::without_trailing_slash(Path::new(&settings.root));
     match std::fs::symlink_metadata(root) {
         Ok(meta) => {
             if let Err(e) = private_dir::check(root, &meta, settings.owner) {

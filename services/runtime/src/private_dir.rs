@@ -61,17 +61,17 @@ impl fmt::Display for NotPrivate {
         if self.kind != "directory" {
             write!(
                 f,
-                "Another user may have planted it: remove it (it is not followed or used) or choose another directory"
+                "Another user may have planted it: remove it (it is not followed or used) or choose another directory."
             )
         } else if self.owner != self.expected_owner {
             write!(
                 f,
-                "It belongs to another user, who controls what is in it: choose another directory"
+                "It belongs to another user, who controls what is in it: choose another directory."
             )
         } else {
             write!(
                 f,
-                "Others may read or write it: `chmod 0700 {path}` or choose another directory"
+                "Others may read or write it: `chmod 0700 {path}` or choose another directory."
             )
         }
     }
@@ -79,9 +79,25 @@ impl fmt::Display for NotPrivate {
 
 impl std::error::Error for NotPrivate {}
 
+/// `path` without trailing slashes: `link/` names the directory a link points to, so a path
+/// inspected with a trailing slash would be followed after all.
+pub fn without_trailing_slash(path: &Path) -> &Path {
+    let bytes = path.as_os_str().as_encoded_bytes();
+    let mut end = bytes.len();
+    while end > 1 && bytes[end - 1] == b'/' {
+        end -= 1;
+    }
+    Path::new(
+        std::str::from_utf8(&bytes[..end])
+            .map(std::ffi::OsStr::new)
+            .unwrap_or(path.as_os_str()),
+    )
+}
+
 /// Checks, without following a symbolic link at `path`, that it is a directory owned by `owner`
 /// with no group or other permission.
 pub fn verify(path: &Path, owner: u32) -> anyhow::Result<()> {
+    let path = without_trailing_slash(path);
     let meta = std::fs::symlink_metadata(path)
         .map_err(|e| anyhow::anyhow!("cannot inspect {}: {e}", path.display()))?;
     check(path, &meta, owner).map_err(anyhow::Error::from)
@@ -108,6 +124,7 @@ pub fn check(path: &Path, meta: &Metadata, owner: u32) -> Result<(), NotPrivate>
 /// it. Returns whether this call created it: only its creator may remove it again. An entry that
 /// appears between the two steps is verified like any existing one: mkdir(2) never follows a link.
 pub fn ensure(path: &Path, owner: u32) -> anyhow::Result<bool> {
+    let path = without_trailing_slash(path);
     let created = match std::fs::DirBuilder::new().mode(0o700).create(path) {
         Ok(()) => true,
         Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => false,
@@ -175,6 +192,24 @@ mod tests {
         assert!(msg.contains("planted"), "{msg}");
         assert!(ensure(&link, me).is_err());
         assert!(target.join("keep").exists());
+        std::fs::remove_dir_all(&base).unwrap();
+    }
+
+    #[test]
+    fn a_trailing_slash_does_not_follow_a_link() {
+        assert_eq!(
+            without_trailing_slash(Path::new("/tmp/x//")),
+            Path::new("/tmp/x")
+        );
+        assert_eq!(without_trailing_slash(Path::new("/")), Path::new("/"));
+        let base = scratch("slash");
+        let link = base.join("root");
+        std::os::unix::fs::symlink(&base, &link).unwrap();
+        let with_slash = PathBuf::from(format!("{}/", link.display()));
+        assert_eq!(
+            not_private(&with_slash, user::effective_uid()).kind,
+            "symbolic link"
+        );
         std::fs::remove_dir_all(&base).unwrap();
     }
 

@@ -96,7 +96,7 @@ pub fn describe_entries(entries: &[ShmEntry]) -> String {
 pub fn remove_all(settings: &IpcSettings, remove_root: bool) -> usize {
     let uid = user::effective_uid();
     let removed = remove_owned_shm(Path::new(SHM_DIR), &settings.prefix, uid);
-    let root = Path::new(&settings.root);
+    let root = crate::private_dir::without_trailing_slash(Path::new(&settings.root));
     clean_root(root, &settings.prefix, uid);
     if remove_root {
         // rmdir(2): only an empty directory, never a link's target.
