@@ -117,6 +117,28 @@ fn signal(child: &Child, sig: libc::c_int) {
     assert_eq!(unsafe { libc::kill(pid, sig) }, 0);
 }
 
+/// A process of the test that is stopped with SIGTERM (and reaped) however the test ends, so a
+/// failing assertion leaves no deployment running.
+struct Stopped(Option<Child>);
+
+impl Stopped {
+    /// Stops it now and returns its output.
+    fn stop(mut self, limit: Duration) -> Output {
+        let child = self.0.take().expect("still running");
+        signal(&child, libc::SIGTERM);
+        wait_within(child, limit)
+    }
+}
+
+impl Drop for Stopped {
+    fn drop(&mut self) {
+        if let Some(mut child) = self.0.take() {
+            signal(&child, libc::SIGTERM);
+            let _ = child.wait();
+        }
+    }
+}
+
 /// Waits for `child` to end, killing it (and failing) after `limit`.
 fn wait_within(mut child: Child, limit: Duration) -> Output {
     let deadline = Instant::now() + limit;
@@ -329,7 +351,7 @@ fn another_users_deployment_on_our_prefix_is_neither_joined_nor_removed() {
         .gid(NOBODY)
         .stdout(Stdio::null())
         .stderr(Stdio::piped());
-    let attacker = attacker.spawn().expect("rins up as nobody");
+    let attacker = Stopped(Some(attacker.spawn().expect("rins up as nobody")));
     let deadline = Instant::now() + Duration::from_secs(60);
     let theirs = || {
         ipc.shm_entries()
@@ -363,8 +385,7 @@ fn another_users_deployment_on_our_prefix_is_neither_joined_nor_removed() {
     for name in &before {
         assert!(after.contains(name), "{name} of the attacker was removed");
     }
-    signal(&attacker, libc::SIGTERM);
-    let out = wait_within(attacker, Duration::from_secs(30));
+    let out = attacker.stop(Duration::from_secs(30));
     assert!(out.status.success(), "attacker: {}", stderr(&out));
     let _ = std::fs::remove_dir_all(&their_root);
 }
