@@ -3,11 +3,12 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Result, anyhow};
 use rins_acquisition::config::AcquisitionConfig;
 use rins_altimeter::AltimeterConfig;
 use rins_fusion::FusionConfig;
 use rins_navigator::config::NavigatorConfig;
+use rins_runtime::bounded_file;
 use rins_sim::SimConfig;
 use rins_watchdog::config::WatchdogConfig;
 use serde::Deserialize;
@@ -210,13 +211,14 @@ fn load_profile(built_in: &str, origin: &str, path: Option<&Path>) -> Result<Rin
     }
 }
 
-/// Reads `path`, or the built-in configuration when none is given.
+/// Reads `path` (a regular file of at most [`bounded_file::DEFAULT_LIMIT`] bytes: a FIFO or a device
+/// is refused at once), or the built-in configuration when none is given.
 pub fn load(path: Option<&Path>) -> Result<RinsConfig> {
     match path {
         None => RinsConfig::parse(BUILT_IN, "built-in configuration"),
         Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("cannot read configuration file {}", path.display()))?;
+            let text =
+                bounded_file::read_text(path, "configuration file", bounded_file::DEFAULT_LIMIT)?;
             RinsConfig::parse(&text, &path.display().to_string())
         }
     }

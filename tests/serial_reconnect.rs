@@ -79,10 +79,7 @@ struct Collector {
 
 impl Collector {
     fn start(ipc: &Isolated) -> Self {
-        let settings = IpcSettings {
-            prefix: ipc.prefix.clone(),
-            root: format!("{}/", ipc.root.display()),
-        };
+        let settings = IpcSettings::new(ipc.prefix.clone(), format!("{}/", ipc.root.display()));
         let seen = Arc::new(Mutex::new(Seen::default()));
         let stop = Arc::new(AtomicBool::new(false));
         let (s, st) = (seen.clone(), stop.clone());
@@ -314,7 +311,10 @@ fn terminate(child: &mut Child) {
 #[test]
 fn acquisition_waits_for_a_device_that_comes_late() {
     let ipc = Isolated::new("late_device");
-    std::fs::create_dir_all(&ipc.root).expect("root");
+    // The root is private to the deployment's user: every process refuses one others may read.
+    std::os::unix::fs::DirBuilderExt::mode(&mut std::fs::DirBuilder::new(), 0o700)
+        .create(&ipc.root)
+        .expect("root");
     let link = ipc.root.join("late-tty");
     let link_text = link.to_string_lossy().into_owned();
     let mut acq = Guard(Some(

@@ -8,7 +8,7 @@ use ipc_types::{
     Altitude, FusedImu, Health, HealthReport, NavState, RawAux, RawBaro, RawImu, RawMag, Truth,
     names,
 };
-use rins_runtime::ipc::{IpcNode, IpcSettings, SampleSource, TopicSubscriber, create_node};
+use rins_runtime::ipc::{IpcNode, SampleSource, TopicSubscriber, create_node};
 use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::shutdown::Shutdown;
 use serde::Serialize;
@@ -91,7 +91,7 @@ where
 {
     let started_ns = rins_runtime::clock::monotonic_ns();
     let shutdown = Shutdown::install()?;
-    let settings = IpcSettings::from_env();
+    let settings = rins_runtime::join_check::settings_to_join()?;
     let node = create_node(&format!("echo-{}", std::process::id()), &settings)?;
     let mut sub = open(&node)?;
     let stdout = std::io::stdout();

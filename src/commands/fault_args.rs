@@ -1,7 +1,7 @@
 //! Timed faults from the command line (`--inject SPEC`, `--faults FILE`), checked against the
 //! configured sensor block.
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Result, anyhow};
 use rins_sim::fault_command::FaultParseError;
 use rins_sim::fault_schedule::{FaultFile, ScheduledFault};
 
@@ -30,8 +30,11 @@ pub fn schedule(args: &FaultArgs, n_gyro: usize, n_accel: usize) -> Result<Vec<S
         faults.push(fault);
     }
     if let Some(path) = &args.faults {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read fault file {}", path.display()))?;
+        let text = rins_runtime::bounded_file::read_text(
+            path,
+            "fault file",
+            rins_runtime::bounded_file::DEFAULT_LIMIT,
+        )?;
         let file: FaultFile = toml::from_str(&text)
             .map_err(|e| anyhow!("{}: {}", path.display(), e.to_string().trim_end()))?;
         let scheduled = file

@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow, bail};
 use ipc_types::{FaultApplied, FaultOutcome, SimControl, names};
-use rins_runtime::ipc::{IpcSettings, TopicSubscriber, create_node};
+use rins_runtime::ipc::{TopicSubscriber, create_node};
 use rins_sim::sim_command::SimCommand;
 
 use crate::cli::InjectArgs;
@@ -33,7 +33,7 @@ pub fn run(args: &InjectArgs) -> Result<()> {
         args.duration.as_deref(),
     )
     .map_err(|e| anyhow!("{e}"))?;
-    let settings = IpcSettings::from_env();
+    let settings = rins_runtime::join_check::settings_to_join()?;
     let node = create_node(&format!("inject-{}", std::process::id()), &settings)?;
     // Subscribe to the confirmations before sending, so the answer cannot be missed.
     let confirmations = TopicSubscriber::<FaultApplied>::new(&node, names::SIM_FAULT_APPLIED)?;

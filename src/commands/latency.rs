@@ -6,7 +6,7 @@ use anyhow::{Result, bail};
 use hdrhistogram::Histogram;
 use ipc_types::{Altitude, Header, Stage, names};
 use rins_runtime::clock::monotonic_ns;
-use rins_runtime::ipc::{IpcSettings, TopicSubscriber, create_node};
+use rins_runtime::ipc::{TopicSubscriber, create_node};
 use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::shutdown::Shutdown;
 use serde::Serialize;
@@ -66,7 +66,7 @@ pub fn run(seconds: f64, json: bool) -> Result<()> {
         bail!("--seconds {seconds}: must be a positive number");
     }
     let shutdown = Shutdown::install()?;
-    let settings = IpcSettings::from_env();
+    let settings = rins_runtime::join_check::settings_to_join()?;
     let node = create_node(&format!("latency-{}", std::process::id()), &settings)?;
     // The stream consumers see: both navigator lanes through the lane selector.
     let mut nav = NavSubscriber::new(&node)?;

@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use anyhow::{Result, anyhow};
 use ipc_types::{FusionControl, PAYLOAD_VERSION, names};
-use rins_runtime::ipc::{IpcSettings, create_node};
+use rins_runtime::ipc::create_node;
 use rins_sim::fault_command::ChannelId;
 
 use crate::commands::control;
@@ -17,7 +17,7 @@ const DELIVERY_GRACE: Duration = Duration::from_millis(500);
 
 pub fn run(channel: &str) -> Result<()> {
     let channel = ChannelId::parse(channel).map_err(|e| anyhow!("{e}"))?;
-    let settings = IpcSettings::from_env();
+    let settings = rins_runtime::join_check::settings_to_join()?;
     let node = create_node(&format!("readmit-{}", std::process::id()), &settings)?;
     let command = FusionControl {
         version: PAYLOAD_VERSION,

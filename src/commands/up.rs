@@ -40,6 +40,25 @@ const SIM_START_TIMEOUT: Duration = Duration::from_secs(10);
 /// Period of the supervision loop: topics drained and children checked this often.
 const LOOP_PERIOD: Duration = Duration::from_millis(1);
 
+/// Refuses to start while another user's files are on the prefix in /dev/shm: they are never
+/// opened, never removed.
+fn refuse_foreign_entries(settings: &IpcSettings) -> Result<()> {
+    let foreign = shm_cleanup::foreign_entries(settings, settings.owner);
+    if !foreign.is_empty() {
+        bail!(
+            "IPC prefix {:?} is in use by someone else: {}. Another user runs a deployment on this \
+             prefix or planted these files; they are left alone. Set {} to a prefix of your own \
+             (the default is per user), or have their owner remove them",
+            settings.prefix,
+            shm_cleanup::describe_entries(&foreign),
+            rins_runtime::ipc::PREFIX_ENV
+        );
+    }
+    Ok(())
+}
+
+/// Refuses to start while another deployment runs on the prefix; otherwise removes what a dead run
+/// of ours left.
 fn ensure_no_live_deployment(settings: &IpcSettings) -> Result<()> {
     let config = settings.iceoryx_config()?;
     let (mut alive, mut tools) = (0, 0);
@@ -72,7 +91,7 @@ fn ensure_no_live_deployment(settings: &IpcSettings) -> Result<()> {
     // tool is already waiting on the prefix its shared memory must stay, so only the resources of
     // dead nodes go then.
     if tools == 0 {
-        let removed = shm_cleanup::remove_all(settings);
+        let removed = shm_cleanup::remove_all(settings, false);
         if removed > 0 {
             tracing::info!(removed, "removed shared memory left by an earlier run");
         }
@@ -88,10 +107,15 @@ fn ensure_no_live_deployment(settings: &IpcSettings) -> Result<()> {
     Ok(())
 }
 
-fn wait_for_path(path: &Path, supervisor: &mut Supervisor, shutdown: &Shutdown) -> Result<()> {
+/// Waits for the simulator's terminal link; returns false when a stop was requested meanwhile (a
+/// clean stop, not a failure).
+fn wait_for_path(path: &Path, supervisor: &mut Supervisor, shutdown: &Shutdown) -> Result<bool> {
     let deadline = Instant::now() + SIM_START_TIMEOUT;
     let mut events = Vec::new();
     while !path.exists() {
+        if shutdown.requested() {
+            return Ok(false);
+        }
         supervisor.poll(&mut events);
         // A child given up (a restart limit of 0) stops the start-up too rather than being lost.
         if let Some(
@@ -103,7 +127,7 @@ fn wait_for_path(path: &Path, supervisor: &mut Supervisor, shutdown: &Shutdown) 
                 path.display()
             );
         }
-        if Instant::now() >= deadline || shutdown.requested() {
+        if Instant::now() >= deadline {
             bail!(
                 "simulator did not create {} in {:?}",
                 path.display(),
@@ -112,7 +136,7 @@ fn wait_for_path(path: &Path, supervisor: &mut Supervisor, shutdown: &Shutdown) 
         }
         std::thread::sleep(Duration::from_millis(5));
     }
-    Ok(())
+    Ok(true)
 }
 
 fn apply_overrides(cfg: &mut RinsConfig, args: &UpArgs) -> Result<()> {
@@ -148,17 +172,27 @@ fn apply_overrides(cfg: &mut RinsConfig, args: &UpArgs) -> Result<()> {
 }
 
 pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
+    // First of all: a stop requested at any moment from here on is a clean stop, not a death by
+    // signal that leaves children and shared memory behind.
+    let shutdown = Shutdown::install()?;
     let mut cfg = config::load(args.config.as_deref())?;
     apply_overrides(&mut cfg, args)?;
     // Refused here, before any child runs, rather than by a child in a restart loop.
     cfg.build_services()?;
-    let shutdown = Shutdown::install()?;
+    if shutdown.requested() {
+        return Ok(std::process::ExitCode::SUCCESS);
+    }
     let settings = IpcSettings::from_env();
-    ensure_no_live_deployment(&settings)?;
-
-    let run_dir = settings.run_dir();
-    std::fs::create_dir_all(&run_dir)
-        .with_context(|| format!("cannot create {}", run_dir.display()))?;
+    refuse_foreign_entries(&settings)?;
+    // Only a root this run created is removed at the end (and only when empty).
+    let root_created = settings.ensure_root()?;
+    let run_dir = ensure_no_live_deployment(&settings)
+        .and_then(|()| settings.ensure_run_dir())
+        .inspect_err(|_| {
+            if root_created {
+                let _ = std::fs::remove_dir(&settings.root);
+            }
+        })?;
     // A new deployment numbers its frames afresh: the last one's resume point does not apply.
     let _ = std::fs::remove_file(rins_acquisition::resume_file::path_for(&settings));
     let simulate = cfg.acquisition.port.is_none();
@@ -189,6 +223,9 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     let mut timing = RestartTiming::default();
     let outcome = (|| -> Result<()> {
         for name in services(&cfg) {
+            if shutdown.requested() {
+                return Ok(());
+            }
             let mut child_args = vec!["service".to_string(), name.to_string()];
             child_args.extend(config_args.iter().cloned());
             if name == "acquisition" {
@@ -208,7 +245,9 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
                 args: sim_args(&cfg, &config_args, &link, args),
                 policy: cfg.watchdog.policy_for("sim"),
             })?;
-            wait_for_path(&link, &mut supervisor, &shutdown)?;
+            if !wait_for_path(&link, &mut supervisor, &shutdown)? {
+                return Ok(());
+            }
         }
         supervise(
             &cfg,
@@ -232,8 +271,12 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     drop(health);
     drop(monitor);
     drop(node);
-    shm_cleanup::remove_all(&settings);
-    let leaked = shm_cleanup::shm_entries(&settings).len() as u64;
+    shm_cleanup::remove_all(&settings, root_created);
+    // Ours only: another user's files on the prefix are not a leak of this deployment.
+    let leaked = shm_cleanup::inspect(Path::new(shm_cleanup::SHM_DIR), &settings.prefix)
+        .iter()
+        .filter(|e| e.belongs_to(settings.owner))
+        .count() as u64;
     outcome?;
     if args.json {
         let summary = Summary {

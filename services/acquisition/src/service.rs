@@ -89,14 +89,22 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
     let publishers = Publishers::new(&node)?;
     let mut heartbeat = Heartbeat::new(&node, ServiceKind::Acquisition)?;
     let mut decoder = Decoder::new();
-    // Continue the numbering of the run this one replaces (see `resume_file`).
+    // Continue the numbering of the run this one replaces (see `resume_file`), from the verified
+    // run directory only.
+    settings.ensure_run_dir()?;
     let resume_path = resume_file::path_for(settings);
-    if let Some(point) = resume_file::load(&resume_path) {
-        decoder.resume_from(&point);
-        tracing::info!(
-            imu_seq = point.seq[FrameType::Imu.index()],
-            "continuing the sequence numbers of the previous run"
-        );
+    match resume_file::load(&resume_path) {
+        resume_file::Loaded::Point(point) => {
+            decoder.resume_from(&point);
+            tracing::info!(
+                imu_seq = point.seq[FrameType::Imu.index()],
+                "continuing the sequence numbers of the previous run"
+            );
+        }
+        resume_file::Loaded::Missing => {}
+        resume_file::Loaded::Ignored(why) => {
+            tracing::warn!("resume point ignored, numbering starts afresh: {why}");
+        }
     }
     let mut next_save_ns = 0u64;
     let mut counters = Health::default();
@@ -219,8 +227,8 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
     Ok(())
 }
 
-/// Saves where the numbering stands (once a second, off the per-frame path). A service started by
-/// hand without `rins up` has no run directory: nothing to continue, logged at debug level.
+/// Saves where the numbering stands (once a second, off the per-frame path); a failure is logged at
+/// debug level: the next save tries again, and a restart without a point only renumbers.
 fn save_resume_point(path: &std::path::Path, decoder: &Decoder) {
     if let Err(e) = resume_file::save(path, &decoder.resume_point()) {
         tracing::debug!(path = %path.display(), error = %e, "cannot save the resume point");

@@ -35,7 +35,8 @@ pub enum GeometryConfig {
         /// Azimuth β0 of the first axis, degrees.
         beta0_deg: f64,
     },
-    /// Explicit axes, one `[x, y, z]` per channel (normalised on construction).
+    /// Explicit axes, one `[x, y, z]` unit vector per channel: a norm within
+    /// [`UNIT_NORM_TOLERANCE`] of 1 (rounded decimals) is normalised, anything else refused.
     Axes { axes: Vec<[f64; 3]> },
     /// Orthogonal triad: the body x, y and z axes (N = 3, no redundancy).
     Triad {},
@@ -72,7 +73,10 @@ impl GeometryConfig {
                 alpha_deg,
                 beta0_deg,
             } => pyramid(*n, *alpha_deg, *beta0_deg),
-            GeometryConfig::Axes { axes } => Geometry::from_axes(axes),
+            GeometryConfig::Axes { axes } => {
+                check_unit_axes(axes)?;
+                Geometry::from_axes(axes)
+            }
             GeometryConfig::Triad {} => Geometry::from_axes(&TRIAD_AXES),
             GeometryConfig::Dodecahedron {} => Geometry::from_axes(&dodecahedron_axes()),
             GeometryConfig::Stacked {
@@ -87,6 +91,32 @@ impl Default for GeometryConfig {
     fn default() -> Self {
         Self::seed_pyramid()
     }
+}
+
+/// How far from 1 the norm of a configured axis may be: decimals rounded to a few places are
+/// normalised; a vector of another length is a mistake (a scale factor or a typing error would
+/// otherwise be silently accepted as a direction).
+pub const UNIT_NORM_TOLERANCE: f64 = 0.01;
+
+/// Refuses a configured axis whose norm is not within [`UNIT_NORM_TOLERANCE`] of 1, naming it, its
+/// value and its norm. A zero or non-finite vector is left to [`Geometry::from_axes`], which says so.
+fn check_unit_axes(axes: &[[f64; 3]]) -> Result<(), ConfigError> {
+    for (i, a) in axes.iter().enumerate() {
+        let norm = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+        if norm.is_finite() && norm > 1e-9 && (norm - 1.0).abs() > UNIT_NORM_TOLERANCE {
+            return Err(ConfigError::new(
+                format!("axes[{i}]"),
+                format!("[{}, {}, {}]", a[0], a[1], a[2]),
+                format!("must be a unit vector (norm {})", round_for_display(norm)),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// `norm` with at most 4 decimals and no trailing zeros: `5`, `1.4142`.
+fn round_for_display(norm: f64) -> f64 {
+    (norm * 1e4).round() / 1e4
 }
 
 fn pyramid(n: usize, alpha_deg: f64, beta0_deg: f64) -> Result<Geometry, ConfigError> {

@@ -203,7 +203,7 @@ fn config_parses_from_toml_and_errors_name_fields() {
     let text = r#"
         [geometry.gyro]
         kind = "axes"
-        axes = [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1], [1, -1, 1]]
+        axes = [[1, 0, 0], [0, 1, 0], [0, 0, 1], [0.57735, 0.57735, 0.57735], [0.57735, -0.57735, 0.57735]]
         [noise]
         gyro_sigma_rps = [0.005, 0.005, 0.005, 0.006, 0.007]
         accel_sigma_mps2 = 0.05

@@ -108,10 +108,12 @@ fn parses_both_kinds_from_toml() {
         toml::from_str("kind = \"pyramid\"\nn = 4\nalpha_deg = 28.7\nbeta0_deg = 45.0").unwrap();
     assert_eq!(cfg, GeometryConfig::seed_pyramid());
     assert_eq!(cfg, GeometryConfig::default());
-    let cfg: GeometryConfig =
-        toml::from_str("kind = \"axes\"\naxes = [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]]")
-            .unwrap();
+    let cfg: GeometryConfig = toml::from_str(
+        "kind = \"axes\"\naxes = [[1, 0, 0], [0, 1, 0], [0, 0, 1], [0.577, 0.577, 0.577]]",
+    )
+    .unwrap();
     let g = cfg.build().unwrap();
+    // Rounded to three decimals (norm 0.9994), normalised to the exact diagonal.
     let s = 1.0 / 3f64.sqrt();
     assert_close(g.axes()[3], [s, s, s], 1e-15);
 }
@@ -179,15 +181,45 @@ fn errors_name_field_and_value() {
     let e = axes(vec![[1.0, 0.0, 0.0], [0.0, f64::NAN, 0.0], [0.0, 0.0, 1.0]]);
     assert_eq!(e.field, "axes[1]");
     // Exactly and nearly coplanar (cond(H) far above 1000).
+    let d = std::f64::consts::FRAC_1_SQRT_2;
     let e = axes(vec![
         [1.0, 0.0, 0.0],
         [0.0, 1.0, 0.0],
-        [1.0, 1.0, 0.0],
-        [1.0, -1.0, 0.0],
+        [d, d, 0.0],
+        [d, -d, 0.0],
     ]);
     assert!(e.reason.contains("coplanar"), "{e}");
-    let e = axes(vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 1e-5]]);
+    let e = axes(vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [d, d, 1e-5]]);
     assert!(e.reason.contains("coplanar"), "{e}");
+}
+
+#[test]
+fn configured_axes_must_be_unit_vectors_within_one_percent() {
+    let build = |a: Vec<[f64; 3]>| GeometryConfig::Axes { axes: a }.build();
+    let e = build(vec![[5.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]).unwrap_err();
+    assert_eq!(
+        e.within("fusion.geometry.gyro").to_string(),
+        "fusion.geometry.gyro.axes[0] = [5, 0, 0]: must be a unit vector (norm 5)"
+    );
+    // Just beyond the tolerance on either side, on another axis.
+    let e = build(vec![[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0111, 0.0]]).unwrap_err();
+    assert_eq!(e.field, "axes[2]");
+    assert!(e.reason.contains("norm 1.0111"), "{e}");
+    let e = build(vec![[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.989, 0.0]]).unwrap_err();
+    assert!(e.reason.contains("norm 0.989"), "{e}");
+    // Rounded decimals (norm 0.99995..1.00005) and anything within 1 % are normalised.
+    let r = 0.57735;
+    let g = build(vec![
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.009],
+        [r, r, r],
+    ])
+    .unwrap();
+    for h in g.axes() {
+        assert!((dot(*h, *h) - 1.0).abs() < 1e-12, "{h:?}");
+    }
+    assert!((g.axes()[2][2] - 1.0).abs() < 1e-12);
 }
 
 fn stacked(count: usize, rotations_deg: Vec<[f64; 3]>) -> Geometry {

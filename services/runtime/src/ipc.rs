@@ -12,36 +12,98 @@ use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 
+use crate::{private_dir, user};
+
 /// Environment variable naming the shared-memory prefix; every process of one deployment uses the same.
 pub const PREFIX_ENV: &str = "RINS_IPC_PREFIX";
 /// Environment variable naming the iceoryx2 root directory (node and service records).
 pub const ROOT_ENV: &str = "RINS_IPC_ROOT";
-pub const DEFAULT_PREFIX: &str = "rins_";
-pub const DEFAULT_ROOT: &str = "/tmp/rins/";
+/// Environment variable naming the user (name or uid) whose deployment a tool may join; the tool's
+/// own effective user when unset.
+pub const OWNER_ENV: &str = "RINS_IPC_OWNER";
+/// Environment variable iceoryx2-style per-user runtime directories come from.
+const XDG_RUNTIME_DIR: &str = "XDG_RUNTIME_DIR";
 
-/// Where this deployment's shared memory and iceoryx2 records live.
+/// The default prefix of user `uid`: iceoryx2 names its /dev/shm segments by the prefix alone, so
+/// two users' deployments on one prefix would share (and fight over) one set of names.
+pub fn default_prefix(uid: u32) -> String {
+    format!("rins_{uid}_")
+}
+
+/// The default root of user `uid`: the per-user runtime directory when the session has one, `/run`
+/// for root, else a directory of the user's own in /tmp (created private and verified before use,
+/// so a name planted there by another user is refused, not used).
+pub fn default_root(uid: u32, xdg_runtime_dir: Option<&str>) -> String {
+    match xdg_runtime_dir.filter(|d| !d.is_empty()) {
+        Some(dir) => format!("{}/rins/", dir.trim_end_matches('/')),
+        None if uid == 0 => "/run/rins/".to_string(),
+        None => format!("/tmp/rins-{uid}/"),
+    }
+}
+
+/// Where this deployment's shared memory and iceoryx2 records live, and whose they must be.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct IpcSettings {
     pub prefix: String,
     pub root: String,
+    /// The user every directory and shared-memory entry of the deployment must belong to.
+    pub owner: u32,
 }
 
 impl IpcSettings {
-    /// From `RINS_IPC_PREFIX` / `RINS_IPC_ROOT`, with defaults. Children inherit the environment, so a
-    /// whole process tree shares one setting.
-    pub fn from_env() -> Self {
-        let prefix = std::env::var(PREFIX_ENV).unwrap_or_else(|_| DEFAULT_PREFIX.to_string());
-        let mut root = std::env::var(ROOT_ENV).unwrap_or_else(|_| DEFAULT_ROOT.to_string());
+    /// Settings of a deployment of this process's own user on `prefix` and `root`.
+    pub fn new(prefix: impl Into<String>, root: impl Into<String>) -> Self {
+        let mut root = root.into();
         if !root.ends_with('/') {
             root.push('/');
         }
-        Self { prefix, root }
+        Self {
+            prefix: prefix.into(),
+            root,
+            owner: user::effective_uid(),
+        }
+    }
+
+    /// From `RINS_IPC_PREFIX` / `RINS_IPC_ROOT`, with per-user defaults; the deployment is this
+    /// process's user's. Children inherit the environment, so a whole process tree shares one
+    /// setting.
+    pub fn from_env() -> Self {
+        let uid = user::effective_uid();
+        let prefix = std::env::var(PREFIX_ENV).unwrap_or_else(|_| default_prefix(uid));
+        let root = std::env::var(ROOT_ENV)
+            .unwrap_or_else(|_| default_root(uid, std::env::var(XDG_RUNTIME_DIR).ok().as_deref()));
+        Self::new(prefix, root)
+    }
+
+    /// [`Self::from_env`] for a tool that joins a running deployment: its owner is
+    /// `RINS_IPC_OWNER` (a user name or uid) when set, else this process's user.
+    pub fn joining_from_env() -> Result<Self> {
+        let mut settings = Self::from_env();
+        if let Ok(spec) = std::env::var(OWNER_ENV) {
+            settings.owner = user::resolve(&spec).map_err(|e| anyhow!("{OWNER_ENV} = {e}"))?;
+        }
+        Ok(settings)
+    }
+
+    /// Creates the root when it is missing (mode 0700) and checks that it is a private directory
+    /// of the owner; returns whether this call created it.
+    pub fn ensure_root(&self) -> Result<bool> {
+        private_dir::ensure(std::path::Path::new(&self.root), self.owner)
+            .map_err(|e| anyhow!("IPC root ({ROOT_ENV}): {e:#}"))
     }
 
     /// The deployment's own directory under the root (the simulator's terminal link, the
     /// acquisition's resume point), created by `rins up`.
     pub fn run_dir(&self) -> std::path::PathBuf {
         std::path::PathBuf::from(&self.root).join(format!("{}run", self.prefix))
+    }
+
+    /// [`Self::run_dir`], created when missing and verified like the root (which it verifies first).
+    pub fn ensure_run_dir(&self) -> Result<std::path::PathBuf> {
+        self.ensure_root()?;
+        let dir = self.run_dir();
+        private_dir::ensure(&dir, self.owner).map_err(|e| anyhow!("run directory: {e:#}"))?;
+        Ok(dir)
     }
 
     pub fn iceoryx_config(&self) -> Result<Config> {
@@ -63,26 +125,56 @@ pub type IpcNode = Node<ipc::Service>;
 
 /// Makes this deployment's settings iceoryx2's process-wide configuration too. A few internal paths
 /// (cleaning up after a dead peer whose records are gone) fall back to the global configuration;
-/// without this they would look under the default root and prefix.
+/// without this they would look under the default root and prefix. Checks the root first: every
+/// process of a deployment refuses a root that is not a private directory of the owner.
 fn install_global_config(settings: &IpcSettings, config: &Config) -> Result<()> {
-    let dir = std::path::Path::new(&settings.root);
-    std::fs::create_dir_all(dir).map_err(|e| anyhow!("cannot create {}: {e}", settings.root))?;
+    settings.ensure_root()?;
+    // iceoryx2 takes the first global configuration of a process and ignores later ones.
+    if GLOBAL_CONFIG_INSTALLED.load(std::sync::atomic::Ordering::Relaxed) {
+        return Ok(());
+    }
     let text =
         toml::to_string(config).map_err(|e| anyhow!("cannot encode iceoryx2 config: {e}"))?;
-    let file = dir.join(format!("{}iceoryx2.toml", settings.prefix));
-    // Write then rename: every process of the deployment does this, and none may read a half file.
-    let tmp = dir.join(format!(
-        "{}iceoryx2.toml.{}",
+    // iceoryx2 reads its global configuration from a file, once per process, and keeps it in memory:
+    // a file of this process's own, gone again once read, so no process reads another's.
+    let file = std::path::Path::new(&settings.root).join(format!(
+        "{}iceoryx2.{}.toml",
         settings.prefix,
         std::process::id()
     ));
-    std::fs::write(&tmp, text).map_err(|e| anyhow!("cannot write {}: {e}", tmp.display()))?;
-    std::fs::rename(&tmp, &file).map_err(|e| anyhow!("cannot write {}: {e}", file.display()))?;
-    let path = FilePath::new(file.to_string_lossy().as_bytes())
-        .map_err(|e| anyhow!("{}: not a valid path ({e:?})", file.display()))?;
-    Config::setup_global_config_from_file(&path)
-        .map_err(|e| anyhow!("cannot load {}: {e:?}", file.display()))?;
+    write_new_private_file(&file, text.as_bytes())?;
+    let loaded = FilePath::new(file.to_string_lossy().as_bytes())
+        .map_err(|e| anyhow!("{}: not a valid path ({e:?})", file.display()))
+        .and_then(|path| {
+            Config::setup_global_config_from_file(&path)
+                .map(|_| ())
+                .map_err(|e| anyhow!("cannot load {}: {e:?}", file.display()))
+        });
+    let _ = std::fs::remove_file(&file);
+    loaded?;
+    GLOBAL_CONFIG_INSTALLED.store(true, std::sync::atomic::Ordering::Relaxed);
     Ok(())
+}
+
+/// Set once this process has handed iceoryx2 its global configuration.
+static GLOBAL_CONFIG_INSTALLED: std::sync::atomic::AtomicBool =
+    std::sync::atomic::AtomicBool::new(false);
+
+/// Writes `bytes` to a file that must not exist yet (a stale one of a dead process with our pid is
+/// unlinked first: unlink never follows a link), opened without following a link, mode 0600.
+fn write_new_private_file(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
+    use std::io::Write;
+    use std::os::unix::fs::OpenOptionsExt;
+    let _ = std::fs::remove_file(path);
+    let mut file = std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .mode(0o600)
+        .custom_flags(libc::O_NOFOLLOW)
+        .open(path)
+        .map_err(|e| anyhow!("cannot create {}: {e}", path.display()))?;
+    file.write_all(bytes)
+        .map_err(|e| anyhow!("cannot write {}: {e}", path.display()))
 }
 
 /// Removes the shared memory and other resources of every dead node of this deployment (a
@@ -372,4 +464,51 @@ pub fn wait_any<T: Debug + ZeroCopySend + Copy + 'static>(
         sub.clear_signals()?;
     }
     Ok(ready > 0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_per_user() {
+        assert_eq!(default_prefix(0), "rins_0_");
+        assert_eq!(default_prefix(1000), "rins_1000_");
+        // A prefix is never the start of another user's: uid 1 and uid 10.
+        assert!(!default_prefix(10).starts_with(&default_prefix(1)));
+        assert_eq!(
+            default_root(1000, Some("/run/user/1000")),
+            "/run/user/1000/rins/"
+        );
+        assert_eq!(default_root(0, Some("/run/user/0/")), "/run/user/0/rins/");
+        assert_eq!(default_root(0, None), "/run/rins/");
+        assert_eq!(default_root(1000, None), "/tmp/rins-1000/");
+        assert_eq!(default_root(1000, Some("")), "/tmp/rins-1000/");
+    }
+
+    #[test]
+    fn the_root_and_run_directory_are_created_private_and_a_planted_link_is_refused() {
+        use std::os::unix::fs::MetadataExt;
+        let base = std::env::temp_dir().join(format!("rins-ipc-root-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&base);
+        std::fs::create_dir(&base).unwrap();
+        let settings = IpcSettings::new("p_", base.join("root").to_string_lossy().into_owned());
+        assert!(settings.root.ends_with('/'));
+        let run = settings.ensure_run_dir().unwrap();
+        for dir in [std::path::Path::new(&settings.root), run.as_path()] {
+            assert_eq!(
+                std::fs::symlink_metadata(dir).unwrap().mode() & 0o777,
+                0o700
+            );
+        }
+        // A run directory replaced by a link to elsewhere is refused, naming it.
+        std::fs::remove_dir(&run).unwrap();
+        std::os::unix::fs::symlink(&base, &run).unwrap();
+        let err = format!("{:#}", settings.ensure_run_dir().unwrap_err());
+        assert!(
+            err.contains("run directory") && err.contains("symbolic link"),
+            "{err}"
+        );
+        std::fs::remove_dir_all(&base).unwrap();
+    }
 }

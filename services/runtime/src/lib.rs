@@ -1,13 +1,18 @@
 //! Runtime shared by every rins process: iceoryx2 node and topic set-up on an isolated prefix,
-//! the monotonic clock, termination signals, heartbeats and log set-up.
+//! the monotonic clock, termination signals, heartbeats and log set-up, and the checks that keep
+//! another local user's files out of a deployment (private directories, owners, bounded files).
 
+pub mod bounded_file;
 pub mod clock;
 pub mod config_error;
 pub mod heartbeat;
 pub mod input_watch;
 pub mod ipc;
+pub mod join_check;
 pub mod lane_selector;
 pub mod logging;
 pub mod nav_subscriber;
+pub mod private_dir;
 pub mod shm_cleanup;
 pub mod shutdown;
+pub mod user;

@@ -1,17 +1,28 @@
-//! Termination requests (SIGINT, SIGTERM) as a flag the process loops poll.
+//! Termination requests as a flag the process loops poll: SIGINT and SIGTERM, and SIGHUP, SIGUSR1
+//! and SIGUSR2, whose default action would end the process on the spot, leaving its children
+//! running and its shared memory behind; rins has no other use for them, so they stop it cleanly.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// Set once SIGINT or SIGTERM arrived. Cheap to poll from a hot loop (one relaxed load).
+/// The signals that request a clean stop.
+pub const STOP_SIGNALS: [i32; 5] = [
+    signal_hook::consts::SIGINT,
+    signal_hook::consts::SIGTERM,
+    signal_hook::consts::SIGHUP,
+    signal_hook::consts::SIGUSR1,
+    signal_hook::consts::SIGUSR2,
+];
+
+/// Set once one of [`STOP_SIGNALS`] arrived. Cheap to poll from a hot loop (one relaxed load).
 #[derive(Clone)]
 pub struct Shutdown(Arc<AtomicBool>);
 
 impl Shutdown {
-    /// Installs handlers for SIGINT and SIGTERM that set the flag.
+    /// Installs handlers for [`STOP_SIGNALS`] that set the flag.
     pub fn install() -> anyhow::Result<Self> {
         let flag = Arc::new(AtomicBool::new(false));
-        for signal in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        for signal in STOP_SIGNALS {
             signal_hook::flag::register(signal, Arc::clone(&flag))?;
         }
         Ok(Self(flag))

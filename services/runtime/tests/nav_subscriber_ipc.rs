@@ -19,13 +19,13 @@ fn nav(lane: u8, seq: u64) -> NavState {
 
 #[test]
 fn a_backlog_of_both_lanes_is_delivered_whole() {
-    let settings = IpcSettings {
-        prefix: format!("rtnav{}_", std::process::id()),
-        root: std::env::temp_dir()
+    let settings = IpcSettings::new(
+        format!("rtnav{}_", std::process::id()),
+        std::env::temp_dir()
             .join(format!("rtnav{}root/", std::process::id()))
             .to_string_lossy()
             .into_owned(),
-    };
+    );
     {
         let node = create_node("lanes", &settings).expect("node");
         let mut sub = NavSubscriber::new(&node).expect("subscriber");
@@ -59,7 +59,7 @@ fn a_backlog_of_both_lanes_is_delivered_whole() {
         assert_eq!(after, (301..=320).collect::<Vec<_>>());
         assert_eq!(sub.selected_lane(), 1);
     }
-    shm_cleanup::remove_all(&settings);
+    shm_cleanup::remove_all(&settings, true);
     let _ = std::fs::remove_dir_all(&settings.root);
     assert!(shm_cleanup::shm_entries(&settings).is_empty());
 }

@@ -312,7 +312,15 @@ pub fn run(args: &SoakArgs) -> Result<()> {
         let status = up.wait()?;
         bail!("rins up printed nothing within 120 s ({status})");
     }
+    // The deployment is the one this soak started, so its own user's: checked like any other
+    // before it is joined (another user's files on the prefix are never read).
     let settings = IpcSettings::from_env();
+    if let Err(e) = rins_runtime::join_check::check_joinable(&settings) {
+        // SAFETY: SIGTERM to our own child, not reaped yet.
+        unsafe { libc::kill(up.id() as libc::pid_t, libc::SIGTERM) };
+        let _ = up.wait();
+        return Err(e);
+    }
     let node = create_node(&format!("soak-{}", std::process::id()), &settings)?;
     let mut nav_in = NavSubscriber::new(&node)?;
     let health_in = TopicSubscriber::<HealthReport>::new(&node, names::HEALTH)?;

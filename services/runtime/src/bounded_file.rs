@@ -1,0 +1,116 @@
+//! Reading a small text file given on the command line (`--config`, `--faults`) without trusting
+//! what is at the path: a FIFO would block the open or the read for ever, a device such as
+//! /dev/zero would be read until memory runs out, a directory is no file at all. The path is opened
+//! non-blocking, the open descriptor is inspected, and at most one byte more than the limit is read.
+
+use std::io::Read;
+use std::os::unix::fs::OpenOptionsExt;
+use std::path::Path;
+
+use anyhow::{Result, anyhow, bail};
+
+/// Largest file [`read_text`] accepts by default: far above any configuration rins has, far below
+/// anything that strains memory.
+pub const DEFAULT_LIMIT: u64 = 1 << 20;
+
+/// The text of the regular file at `path`, at most `limit` bytes. `what` names the file in errors
+/// (e.g. "configuration file"), which also name the path and what was found there.
+pub fn read_text(path: &Path, what: &str, limit: u64) -> Result<String> {
+    let shown = path.display();
+    // O_NONBLOCK: opening a FIFO for reading does not wait for a writer; O_NOCTTY: a terminal never
+    // becomes our controlling terminal. Neither changes anything for a regular file.
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK | libc::O_NOCTTY)
+        .open(path)
+        .map_err(|e| anyhow!("cannot read {what} {shown}: {e}"))?;
+    let meta = file
+        .metadata()
+        .map_err(|e| anyhow!("cannot inspect {what} {shown}: {e}"))?;
+    if !meta.file_type().is_file() {
+        bail!(
+            "{what} {shown} is a {}, not a regular file",
+            crate::private_dir::kind_of(&meta)
+        );
+    }
+    if meta.len() > limit {
+        bail!(
+            "{what} {shown} has {} bytes, more than the {limit} allowed",
+            meta.len()
+        );
+    }
+    // The size can change after the check (a file still being written): the read is bounded too.
+    let mut bytes = Vec::new();
+    file.take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| anyhow!("cannot read {what} {shown}: {e}"))?;
+    if bytes.len() as u64 > limit {
+        bail!("{what} {shown} has more than the {limit} bytes allowed");
+    }
+    String::from_utf8(bytes).map_err(|e| anyhow!("{what} {shown} is not UTF-8 text: {e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> std::path::PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("rins-bounded-file-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir(&dir).unwrap();
+        dir
+    }
+
+    fn error(path: &Path, limit: u64) -> String {
+        format!(
+            "{:#}",
+            read_text(path, "configuration file", limit).unwrap_err()
+        )
+    }
+
+    #[test]
+    fn a_small_regular_file_is_read() {
+        let dir = scratch("ok");
+        let path = dir.join("a.toml");
+        std::fs::write(&path, "x = 1\n").unwrap();
+        assert_eq!(read_text(&path, "f", 6).unwrap(), "x = 1\n");
+        let msg = error(&path, 5);
+        assert!(
+            msg.contains("6 bytes") && msg.contains("5 allowed"),
+            "{msg}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn devices_fifos_and_directories_are_refused_at_once() {
+        let msg = error(Path::new("/dev/zero"), DEFAULT_LIMIT);
+        assert!(
+            msg.contains("/dev/zero is a character device, not a regular file"),
+            "{msg}"
+        );
+        let dir = scratch("fifo");
+        let fifo = dir.join("fifo");
+        let c = std::ffi::CString::new(fifo.to_string_lossy().as_bytes()).unwrap();
+        // SAFETY: a valid NUL-terminated path.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        // No writer: a blocking open would never return.
+        let msg = error(&fifo, DEFAULT_LIMIT);
+        assert!(msg.contains("is a FIFO, not a regular file"), "{msg}");
+        let msg = error(&dir, DEFAULT_LIMIT);
+        assert!(msg.contains("is a directory"), "{msg}");
+        let msg = error(&dir.join("missing"), DEFAULT_LIMIT);
+        assert!(msg.contains("cannot read configuration file") && msg.contains("missing"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn binary_content_is_refused_naming_the_file() {
+        let dir = scratch("binary");
+        let path = dir.join("b");
+        std::fs::write(&path, [0xff, 0xfe]).unwrap();
+        assert!(error(&path, 10).contains("not UTF-8"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
