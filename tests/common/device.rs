@@ -11,6 +11,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+use rins_acquisition::protocol::layout::{HEADER_LEN, SYNC, TYPE_OFFSET};
 use rins_acquisition::protocol::{Frame, MAX_FRAME_LEN, encode};
 use rins_sim::{Scenario, Simulator, TickOutput};
 use serialport::{SerialPort, TTYPort};
@@ -33,6 +34,57 @@ pub struct FakeDevice {
     /// Device time reached, µs (for tests that wait on the device's clock).
     device_us: Arc<AtomicU64>,
     thread: Option<JoinHandle<()>>,
+}
+
+/// Content no healthy device sends, inside a frame whose CRC is valid (docs/protocol.md, decoding
+/// steps 1 and 4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Malformed {
+    /// Type byte 9: no such frame type.
+    UnknownType,
+    /// A baro frame announcing 7 payload bytes (it has 6).
+    BadLength,
+    /// An IMU frame with one gyro channel at 3000 counts (12 bits reach 2047).
+    CountBeyond12Bits,
+    /// An IMU frame announcing 17 gyro channels (16 at most).
+    TooManyChannels,
+}
+
+impl Malformed {
+    pub const ALL: [Malformed; 4] = [
+        Malformed::UnknownType,
+        Malformed::BadLength,
+        Malformed::CountBeyond12Bits,
+        Malformed::TooManyChannels,
+    ];
+}
+
+/// The bytes of one frame with a valid CRC-32C around `kind`'s malformed content; sequence number
+/// and device time 0. The bytes hold no second sync word, so a decoder rejects exactly one frame.
+pub fn malformed_frame(kind: Malformed) -> Vec<u8> {
+    let (frame_type, payload): (u8, Vec<u8>) = match kind {
+        Malformed::UnknownType => (9, vec![1, 2]),
+        Malformed::BadLength => (2, vec![0; 7]),
+        Malformed::CountBeyond12Bits => {
+            // n_gyro 1, n_accel 0, n_temperature 0, status 0, valid_mask 1, then the count.
+            let mut p = vec![1, 0, 0, 0, 0, 1, 0, 0, 0];
+            p.extend(3000i16.to_le_bytes());
+            (1, p)
+        }
+        Malformed::TooManyChannels => (1, vec![17, 0, 0, 0, 0, 0, 0, 0, 0]),
+    };
+    let mut bytes = SYNC.to_vec();
+    bytes.push(frame_type);
+    bytes.push(u8::try_from(payload.len()).expect("short payload"));
+    bytes.extend([0u8; HEADER_LEN - 4]); // sequence number and device time
+    bytes.extend(&payload);
+    let crc = crc::Crc::<u32>::new(&crc::CRC_32_ISCSI).checksum(&bytes[TYPE_OFFSET..]);
+    bytes.extend(crc.to_le_bytes());
+    assert!(
+        !bytes[1..].windows(2).any(|w| w == SYNC),
+        "{kind:?}: a second sync word in {bytes:02X?}"
+    );
+    bytes
 }
 
 /// How long one write may wait for the reader before the tick's bytes are dropped (the terminal
