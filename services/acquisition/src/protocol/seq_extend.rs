@@ -16,8 +16,12 @@
 //!   serial link delivers a frame that late (a second at 1 kHz), while a restarted counter lands
 //!   there: it is taken as a **sequence jump** too — re-based, delivered.
 //!
-//! A counter that restarts to a number less than [`WINDOW`] behind the newest is indistinguishable
-//! from reordering: its frames count as duplicates or late until its numbers pass the newest.
+//! - a number behind the newest after the type was silent for longer than the window lasts (an
+//!   outage of more than 2^15 frames reads backwards) is a sequence jump too.
+//!
+//! A counter that restarts to a number less than [`WINDOW`] behind the newest, without an outage,
+//! is indistinguishable from reordering: its frames count as duplicates or late until its numbers
+//! pass the newest.
 
 use super::arrival::ArrivalAnchor;
 use super::continuity::Continuity;
@@ -54,6 +58,7 @@ const RESUME_MAX_STEP: u16 = 1 << 15;
 struct Newest {
     seq: u64,
     wire: u16,
+    rx_ns: u64,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -93,7 +98,7 @@ impl SeqExtender {
             };
         }
         let behind = u64::from(step.unsigned_abs());
-        if behind >= WINDOW {
+        if behind >= WINDOW || self.silent_beyond_the_window(newest.rx_ns, rx_ns) {
             return self.rebase(wire, rx_ns);
         }
         if self.window.received(behind) {
@@ -159,7 +164,7 @@ impl SeqExtender {
         self.window = ReceivedWindow::newest_only();
         self.counted_from = seq;
         self.period.discard_block();
-        self.newest = Some(Newest { seq, wire });
+        self.newest = Some(Newest { seq, wire, rx_ns });
         if let Some(p) = self.period.period_ns() {
             self.anchor.observe(seq, p, rx_ns);
         }
@@ -171,11 +176,20 @@ impl SeqExtender {
     }
 
     fn accept(&mut self, seq: u64, wire: u16, rx_ns: u64) {
-        self.newest = Some(Newest { seq, wire });
+        self.newest = Some(Newest { seq, wire, rx_ns });
         self.period.observe(seq, rx_ns);
         if let Some(p) = self.period.period_ns() {
             self.anchor.observe(seq, p, rx_ns);
         }
+    }
+
+    /// Whether the type was silent for longer than the window lasts, so that a number behind the
+    /// newest cannot be a late frame (after an outage of more than 2^15 frames, the step reads
+    /// backwards). Never before the period is learnt.
+    fn silent_beyond_the_window(&self, newest_rx_ns: u64, rx_ns: u64) -> bool {
+        self.period.period_ns().is_some_and(|p| {
+            rx_ns.saturating_sub(newest_rx_ns) > WINDOW.saturating_mul(p).saturating_add(SLACK_NS)
+        })
     }
 
     /// Whether numbering the frame `seq` puts the counter implausibly far ahead of the receive
@@ -295,6 +309,23 @@ mod tests {
         }
         assert_eq!(s.extend(8_000, rx + MS / 2), new(8_000, 2_000));
         assert_eq!(s.extend(8_001, rx + MS), new(8_001, 0));
+    }
+
+    #[test]
+    fn behind_after_a_silence_longer_than_the_window_is_a_jump() {
+        let mut s = SeqExtender::default();
+        feed(&mut s, 0, 5_000, 0);
+        // Unplugged 65 s: 65 000 frames on, the step reads 536 back.
+        let wire = (4_999 + 65_000) as u16;
+        assert_eq!(
+            s.extend(wire, (4_999 + 65_000) * MS),
+            SeqVerdict::New {
+                seq: 5_000,
+                lost: 0,
+                continuity: Continuity::Rebased
+            }
+        );
+        assert_eq!(s.extend(wire.wrapping_add(1), 70_000 * MS), new(5_001, 0));
     }
 
     #[test]
