@@ -95,6 +95,23 @@ impl FakeDevice {
     /// Starts the built-in sensor block flying `scenario` (seed 1), each tick passed through
     /// `tamper` before it is written.
     pub fn start(scenario: Scenario, tamper: impl FnMut(DeviceTick) + Send + 'static) -> Self {
+        Self::start_with(scenario, Link::Lossy, tamper)
+    }
+
+    /// [`FakeDevice::start`] on a line that waits for a slow reader instead of dropping bytes (a
+    /// device with flow control), for tests that count losses exactly on a loaded machine.
+    pub fn start_lossless(
+        scenario: Scenario,
+        tamper: impl FnMut(DeviceTick) + Send + 'static,
+    ) -> Self {
+        Self::start_with(scenario, Link::Lossless, tamper)
+    }
+
+    fn start_with(
+        scenario: Scenario,
+        link: Link,
+        tamper: impl FnMut(DeviceTick) + Send + 'static,
+    ) -> Self {
         let mut cfg = rins::config::load(None).expect("built-in configuration");
         cfg.sim.scenario = scenario;
         let (gyro, accel) = cfg.geometries().expect("built-in geometries");
@@ -111,7 +128,7 @@ impl FakeDevice {
             std::thread::spawn(move || {
                 // Held open so that the terminal outlives a reader that closes it.
                 let _slave = slave;
-                write_loop(sim, master, tamper, &stop, &device_us);
+                write_loop(sim, master, link, tamper, &stop, &device_us);
             })
         };
         Self {
@@ -142,9 +159,19 @@ impl Drop for FakeDevice {
     }
 }
 
+/// What the line does with bytes a reader does not take within [`WRITE_TIMEOUT`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Link {
+    /// Drops them, as a serial line without flow control.
+    Lossy,
+    /// Waits (until the device is dropped).
+    Lossless,
+}
+
 fn write_loop(
     mut sim: Simulator,
     mut port: TTYPort,
+    link: Link,
     mut tamper: impl FnMut(DeviceTick),
     stop: &AtomicBool,
     device_us: &AtomicU64,
@@ -179,7 +206,22 @@ fn write_loop(
             device_us.store(out.truth.device_time_us, Ordering::Relaxed);
         }
         // A reader that is not there yet (or too slow) loses these bytes, as on a real line.
-        let _ = port.write_all(&bytes);
+        match link {
+            Link::Lossy => {
+                let _ = port.write_all(&bytes);
+            }
+            Link::Lossless => {
+                let mut rest = bytes.as_slice();
+                while !rest.is_empty() && !stop.load(Ordering::Relaxed) {
+                    match port.write(rest) {
+                        Ok(n) => rest = &rest[n..],
+                        Err(e) if e.kind() == std::io::ErrorKind::TimedOut => {}
+                        Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                        Err(_) => break,
+                    }
+                }
+            }
+        }
         std::thread::sleep(Duration::from_millis(1));
     }
 }

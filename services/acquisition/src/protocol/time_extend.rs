@@ -10,8 +10,9 @@
 //! ahead of the receive clock by more than that (see [`crate::protocol::arrival`]; checked once the
 //! receive clock has run for [`WARMUP_NS`] after the first frame, as the first reads may be a
 //! backlog), or a time that would fall before zero — is **re-based**: the extended time continues
-//! from the previous frame's by the receive-clock time elapsed between them, and later frames
-//! follow on the new base. The extended time is never clamped and never jumps.
+//! from the previous frame's by the receive-clock time elapsed between them (at least 1 µs, as the
+//! frames of one read share its receive time), and later frames follow on the new base. The
+//! extended time is never clamped and never jumps.
 //!
 //! The tolerance, 0.5 s: frame types stamped out of order differ by at most a baro period (20 ms);
 //! frames arrive late (never early) by the read scheduling, milliseconds, or a backlog; a learnt
@@ -74,7 +75,9 @@ impl TimeExtender {
         let (time_us, continuity) = match continued {
             Some(t) => (t, Continuity::Continued),
             None => {
-                let elapsed_us = rx_ns.saturating_sub(last.rx_ns) / NS_PER_US;
+                // At least 1 µs: the frames of one read share its receive time, and a re-based
+                // time must still advance past the previous frame's.
+                let elapsed_us = (rx_ns.saturating_sub(last.rx_ns) / NS_PER_US).max(1);
                 (last.time_us.saturating_add(elapsed_us), Continuity::Rebased)
             }
         };
@@ -197,6 +200,18 @@ mod tests {
         assert_eq!(e.time_us, last + 4_000);
         wire = wire.wrapping_add(1_000);
         assert_eq!(t.extend(wire, 2_004 * MS), continued(last + 5_000));
+    }
+
+    #[test]
+    fn a_jump_within_one_read_still_advances() {
+        let mut t = TimeExtender::default();
+        for k in 0..2_000u64 {
+            t.extend((k * 1_000) as u32, k * MS);
+        }
+        // The jumped frame came in the same read as the one before it.
+        let e = t.extend(2_000_000 + 600_000_000, 1_999 * MS);
+        assert_eq!(e.continuity, Continuity::Rebased);
+        assert_eq!(e.time_us, 1_999_000 + 1);
     }
 
     #[test]
