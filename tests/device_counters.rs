@@ -121,6 +121,8 @@ fn reordered_repeated_jumped_and_malformed_frames_are_counted_exactly() {
     drop(nav);
     let summary = stop_up(&ipc, up);
     drop(device);
+    // The figures for the record (`cargo test --test device_counters -- --nocapture`).
+    eprintln!("{summary}");
 
     // Counted exactly, and nothing lost that was not.
     for (key, expected) in [
