@@ -821,6 +821,18 @@ pub struct Health {
     pub crc_errors: u64,
     /// Frames missing from the device's sequence (acquisition), or input samples lost (others).
     pub lost: u64,
+    /// Serial frames with a valid CRC but malformed content: unknown type, bad length, channel
+    /// counts or samples out of range (acquisition).
+    pub malformed: u64,
+    /// Serial frames whose sequence number was received before, not published (acquisition).
+    pub duplicates: u64,
+    /// Serial frames that arrived after a later one of their type (reordered), not published and
+    /// not counted in `lost` (acquisition).
+    pub late: u64,
+    /// Device sequence-counter discontinuities, re-based without counting losses (acquisition).
+    pub seq_jumps: u64,
+    /// Device-clock discontinuities, re-based on the receive clock (acquisition).
+    pub time_rebases: u64,
     /// Bytes skipped while resynchronising (acquisition).
     pub resync_bytes: u64,
     /// Times the input device was reopened (acquisition).

@@ -11,6 +11,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+use rins_acquisition::protocol::layout::{HEADER_LEN, SYNC, TYPE_OFFSET};
 use rins_acquisition::protocol::{Frame, MAX_FRAME_LEN, encode};
 use rins_sim::{Scenario, Simulator, TickOutput};
 use serialport::{SerialPort, TTYPort};
@@ -35,6 +36,57 @@ pub struct FakeDevice {
     thread: Option<JoinHandle<()>>,
 }
 
+/// Content no healthy device sends, inside a frame whose CRC is valid (docs/protocol.md, decoding
+/// steps 1 and 4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Malformed {
+    /// Type byte 9: no such frame type.
+    UnknownType,
+    /// A baro frame announcing 7 payload bytes (it has 6).
+    BadLength,
+    /// An IMU frame with one gyro channel at 3000 counts (12 bits reach 2047).
+    CountBeyond12Bits,
+    /// An IMU frame announcing 17 gyro channels (16 at most).
+    TooManyChannels,
+}
+
+impl Malformed {
+    pub const ALL: [Malformed; 4] = [
+        Malformed::UnknownType,
+        Malformed::BadLength,
+        Malformed::CountBeyond12Bits,
+        Malformed::TooManyChannels,
+    ];
+}
+
+/// The bytes of one frame with a valid CRC-32C around `kind`'s malformed content; sequence number
+/// and device time 0. The bytes hold no second sync word, so a decoder rejects exactly one frame.
+pub fn malformed_frame(kind: Malformed) -> Vec<u8> {
+    let (frame_type, payload): (u8, Vec<u8>) = match kind {
+        Malformed::UnknownType => (9, vec![1, 2]),
+        Malformed::BadLength => (2, vec![0; 7]),
+        Malformed::CountBeyond12Bits => {
+            // n_gyro 1, n_accel 0, n_temperature 0, status 0, valid_mask 1, then the count.
+            let mut p = vec![1, 0, 0, 0, 0, 1, 0, 0, 0];
+            p.extend(3000i16.to_le_bytes());
+            (1, p)
+        }
+        Malformed::TooManyChannels => (1, vec![17, 0, 0, 0, 0, 0, 0, 0, 0]),
+    };
+    let mut bytes = SYNC.to_vec();
+    bytes.push(frame_type);
+    bytes.push(u8::try_from(payload.len()).expect("short payload"));
+    bytes.extend([0u8; HEADER_LEN - 4]); // sequence number and device time
+    bytes.extend(&payload);
+    let crc = crc::Crc::<u32>::new(&crc::CRC_32_ISCSI).checksum(&bytes[TYPE_OFFSET..]);
+    bytes.extend(crc.to_le_bytes());
+    assert!(
+        !bytes[1..].windows(2).any(|w| w == SYNC),
+        "{kind:?}: a second sync word in {bytes:02X?}"
+    );
+    bytes
+}
+
 /// How long one write may wait for the reader before the tick's bytes are dropped (the terminal
 /// holds a few dozen ms of frames; the pipeline may not have opened it yet).
 const WRITE_TIMEOUT: Duration = Duration::from_millis(50);
@@ -43,6 +95,23 @@ impl FakeDevice {
     /// Starts the built-in sensor block flying `scenario` (seed 1), each tick passed through
     /// `tamper` before it is written.
     pub fn start(scenario: Scenario, tamper: impl FnMut(DeviceTick) + Send + 'static) -> Self {
+        Self::start_with(scenario, Link::Lossy, tamper)
+    }
+
+    /// [`FakeDevice::start`] on a line that waits for a slow reader instead of dropping bytes (a
+    /// device with flow control), for tests that count losses exactly on a loaded machine.
+    pub fn start_lossless(
+        scenario: Scenario,
+        tamper: impl FnMut(DeviceTick) + Send + 'static,
+    ) -> Self {
+        Self::start_with(scenario, Link::Lossless, tamper)
+    }
+
+    fn start_with(
+        scenario: Scenario,
+        link: Link,
+        tamper: impl FnMut(DeviceTick) + Send + 'static,
+    ) -> Self {
         let mut cfg = rins::config::load(None).expect("built-in configuration");
         cfg.sim.scenario = scenario;
         let (gyro, accel) = cfg.geometries().expect("built-in geometries");
@@ -59,7 +128,7 @@ impl FakeDevice {
             std::thread::spawn(move || {
                 // Held open so that the terminal outlives a reader that closes it.
                 let _slave = slave;
-                write_loop(sim, master, tamper, &stop, &device_us);
+                write_loop(sim, master, link, tamper, &stop, &device_us);
             })
         };
         Self {
@@ -90,9 +159,19 @@ impl Drop for FakeDevice {
     }
 }
 
+/// What the line does with bytes a reader does not take within [`WRITE_TIMEOUT`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Link {
+    /// Drops them, as a serial line without flow control.
+    Lossy,
+    /// Waits (until the device is dropped).
+    Lossless,
+}
+
 fn write_loop(
     mut sim: Simulator,
     mut port: TTYPort,
+    link: Link,
     mut tamper: impl FnMut(DeviceTick),
     stop: &AtomicBool,
     device_us: &AtomicU64,
@@ -127,7 +206,22 @@ fn write_loop(
             device_us.store(out.truth.device_time_us, Ordering::Relaxed);
         }
         // A reader that is not there yet (or too slow) loses these bytes, as on a real line.
-        let _ = port.write_all(&bytes);
+        match link {
+            Link::Lossy => {
+                let _ = port.write_all(&bytes);
+            }
+            Link::Lossless => {
+                let mut rest = bytes.as_slice();
+                while !rest.is_empty() && !stop.load(Ordering::Relaxed) {
+                    match port.write(rest) {
+                        Ok(n) => rest = &rest[n..],
+                        Err(e) if e.kind() == std::io::ErrorKind::TimedOut => {}
+                        Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                        Err(_) => break,
+                    }
+                }
+            }
+        }
         std::thread::sleep(Duration::from_millis(1));
     }
 }

@@ -15,7 +15,7 @@ use rins_runtime::shutdown::Shutdown;
 use crate::backoff::Backoff;
 use crate::config::AcquisitionConfig;
 use crate::presence::{Opened, Presence};
-use crate::protocol::{DecodedFrame, Decoder, FrameType, Payload};
+use crate::protocol::{DecodedFrame, Decoder, DecoderStats, FrameType, Payload};
 use crate::resume_file;
 use crate::to_ipc;
 
@@ -94,18 +94,25 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
     settings.ensure_run_dir()?;
     let resume_path = resume_file::path_for(settings);
     match resume_file::load(&resume_path) {
-        resume_file::Loaded::Point(point) => {
-            decoder.resume_from(&point);
-            tracing::info!(
+        resume_file::Loaded::Point(point) => match decoder.resume_from(&point) {
+            Ok(()) => tracing::info!(
                 imu_seq = point.seq[FrameType::Imu.index()],
+                time_us = point.time_us,
                 "continuing the sequence numbers of the previous run"
-            );
-        }
+            ),
+            Err(e) => tracing::warn!(
+                path = %resume_path.display(),
+                error = %e,
+                "resume point out of bounds: ignored, numbering starts from the device's values"
+            ),
+        },
         resume_file::Loaded::Missing => {}
         resume_file::Loaded::Ignored(why) => {
             tracing::warn!("resume point ignored, numbering starts afresh: {why}");
         }
     }
+    // The first frames judge the rest of the point: a part that does not fit them is counted.
+    let mut resume_rejected = decoder.stats().resume_rejected;
     let mut next_save_ns = 0u64;
     let mut counters = Health::default();
     let mut presence = Presence::new(Backoff::new(
@@ -181,7 +188,7 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
                         save_resume_point(&resume_path, &decoder);
                     }
                     let mut failed = None;
-                    decoder.push(&buf[..n], |frame| {
+                    decoder.push(&buf[..n], rx_ns, |frame| {
                         if let Err(e) = publishers.publish(&frame, rx_ns) {
                             counters.rejected += 1;
                             failed.get_or_insert(e);
@@ -201,10 +208,11 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
                 }
             }
             let stats = decoder.stats();
-            counters.received = stats.frames;
-            counters.crc_errors = stats.crc_errors;
-            counters.lost = stats.lost_frames;
-            counters.resync_bytes = stats.resync_bytes;
+            if stats.resume_rejected != resume_rejected {
+                resume_rejected = stats.resume_rejected;
+                warn_resume_ignored(&decoder, resume_rejected);
+            }
+            fill_counters(&mut counters, &stats);
             heartbeat.tick(&counters)?;
         }
         drop(port);
@@ -225,6 +233,32 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
     save_resume_point(&resume_path, &decoder);
     tracing::info!(frames = counters.received, "acquisition stopped");
     Ok(())
+}
+
+/// The decoder's counters in the heartbeat.
+fn fill_counters(counters: &mut Health, stats: &DecoderStats) {
+    counters.received = stats.frames;
+    counters.crc_errors = stats.crc_errors;
+    counters.malformed = stats.malformed;
+    counters.lost = stats.lost_frames;
+    counters.duplicates = stats.duplicates;
+    counters.late = stats.late;
+    counters.seq_jumps = stats.seq_jumps;
+    counters.time_rebases = stats.time_rebases;
+    counters.resync_bytes = stats.resync_bytes;
+}
+
+/// A part of the resume point did not fit the device's first frames (a device restarted, or a
+/// point from another deployment): that numbering started from the device's values. Once per
+/// part, off the per-frame path.
+fn warn_resume_ignored(decoder: &Decoder, rejected: u64) {
+    let now = decoder.resume_point();
+    tracing::warn!(
+        rejected,
+        imu_seq = now.seq[FrameType::Imu.index()],
+        time_us = now.time_us,
+        "resume point far from the device's actual time: ignored"
+    );
 }
 
 /// Saves where the numbering stands (once a second, off the per-frame path); a failure is logged at

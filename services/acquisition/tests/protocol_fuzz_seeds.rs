@@ -64,6 +64,19 @@ fn seeds() -> Vec<(&'static str, Vec<u8>, usize)> {
     // Enough trailing bytes to resolve the fake header's candidate.
     garbage.extend([0u8; MAX_FRAME_LEN]);
 
+    // Device time stepping back 1 s (re-based), a sequence number far behind (a jump), repeated
+    // and reordered numbers (withheld).
+    let at = |seq: u16, device_time_us: u32| Frame {
+        seq,
+        device_time_us,
+        payload: Payload::Aux(AuxFrame { foot_pressure: 7 }),
+    };
+    let stream_of = |frames: &[Frame]| -> Vec<u8> { frames.iter().flat_map(encode_one).collect() };
+    let time_back = stream_of(&[at(5, 1_000_000), at(6, 0), at(7, 1_000)]);
+    let seq_far_back = stream_of(&[at(5_000, 0), at(100, 1), at(101, 2), at(5_000, 3)]);
+    let repeated_and_late =
+        stream_of(&[at(1, 0), at(3, 2), at(3, 2), at(2, 1), at(2, 1), at(4, 3)]);
+
     let with_chunks = |sizes: &[u8], stream: &[u8]| {
         let mut v = vec![sizes.len() as u8];
         v.extend(sizes);
@@ -81,6 +94,9 @@ fn seeds() -> Vec<(&'static str, Vec<u8>, usize)> {
             with_chunks(&[2, 9, 40], &garbage),
             2,
         ),
+        ("time_back_rebased", with_chunks(&[], &time_back), 3),
+        ("seq_far_back_jump", with_chunks(&[16], &seq_far_back), 4),
+        ("repeated_and_late", with_chunks(&[], &repeated_and_late), 3),
     ]
 }
 

@@ -46,7 +46,8 @@ proptest! {
     #![proptest_config(common::config(512))]
 
     /// Random bytes: no panic, and anything handed out is a frame that literally occurs, CRC and
-    /// all, in the input (re-encoding it gives bytes found there). Every byte is accounted for.
+    /// all, in the input (re-encoding it gives bytes found there). Every byte is accounted for
+    /// (handed out, withheld as a duplicate or late frame, discarded, or buffered).
     #[test]
     fn garbage_alone_yields_only_frames_present_in_it(
         garbage in prop_oneof![vec(any::<u8>(), 0..2000), arb_garbage()],
@@ -64,7 +65,10 @@ proptest! {
         prop_assert_eq!(stats.frames, decoded.len() as u64);
         prop_assert!(decoder.buffered_len() < MAX_FRAME_LEN);
         prop_assert_eq!(
-            frame_bytes as u64 + stats.resync_bytes + decoder.buffered_len() as u64,
+            frame_bytes as u64
+                + stats.withheld_bytes
+                + stats.resync_bytes
+                + decoder.buffered_len() as u64,
             garbage.len() as u64
         );
     }
@@ -188,11 +192,11 @@ fn a_sync_word_in_garbage_does_not_swallow_the_frame_after_it() {
     stream.extend(&bytes);
     let mut decoder = Decoder::new();
     let mut got = Vec::new();
-    decoder.push(&stream, |d| got.push(to_wire(&d)));
+    decoder.push(&stream, 0, |d| got.push(to_wire(&d)));
     // The fake candidate needs 95 bytes; only 49 are there, so the real frame waits...
     assert!(got.is_empty());
     // ...until enough bytes arrive to reject the candidate: MAX_FRAME_LEN from the fake start.
-    decoder.push(&[0u8; MAX_FRAME_LEN - 49], |d| got.push(to_wire(&d)));
+    decoder.push(&[0u8; MAX_FRAME_LEN - 49], 0, |d| got.push(to_wire(&d)));
     assert_eq!(got, vec![frame]);
     let stats = decoder.stats();
     assert_eq!(stats.crc_errors, 1);
@@ -205,15 +209,15 @@ fn reset_drops_buffered_bytes_but_keeps_counters() {
     let bytes = encode_one(&frame);
     let mut decoder = Decoder::new();
     let mut got = Vec::new();
-    decoder.push(&[1, 2, 3], |d| got.push(d));
-    decoder.push(&bytes[..20], |d| got.push(d));
+    decoder.push(&[1, 2, 3], 0, |d| got.push(d));
+    decoder.push(&bytes[..20], 0, |d| got.push(d));
     assert_eq!(decoder.buffered_len(), 20);
     decoder.reset();
     assert_eq!(decoder.buffered_len(), 0);
     assert_eq!(decoder.stats().resync_bytes, 23);
     // The tail of the interrupted frame is garbage now; the next whole frame decodes.
-    decoder.push(&bytes[20..], |d| got.push(d));
-    decoder.push(&bytes, |d| got.push(d));
+    decoder.push(&bytes[20..], 0, |d| got.push(d));
+    decoder.push(&bytes, 0, |d| got.push(d));
     assert_eq!(got.len(), 1);
     assert_eq!(to_wire(&got[0]), frame);
     assert_eq!(decoder.stats().resync_bytes, 23 + 23);

@@ -52,7 +52,7 @@ proptest! {
             let bytes = encode_one(f);
             let mut got = 0;
             for (k, b) in bytes.iter().enumerate() {
-                decoder.push(std::slice::from_ref(b), |d| {
+                decoder.push(std::slice::from_ref(b), 0, |d| {
                     assert_eq!(to_wire(&d), *f);
                     got += 1;
                 });

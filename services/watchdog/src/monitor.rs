@@ -29,12 +29,53 @@ pub struct HeartbeatSeen {
     pub input_stale: bool,
 }
 
-#[derive(Debug, Clone, Copy, Default)]
+/// The serial device's counters, as acquisition reports them (see the decoder's `DecoderStats`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct DeviceCounters {
     pub crc_errors: u64,
+    /// Valid CRC, malformed content.
+    pub malformed_frames: u64,
     pub lost_frames: u64,
+    /// Repeated sequence numbers, not published.
+    pub duplicate_frames: u64,
+    /// Reordered frames that came after a later one, not published, not lost.
+    pub late_frames: u64,
+    pub seq_jumps: u64,
+    pub time_rebases: u64,
     pub resync_bytes: u64,
     pub reconnects: u64,
+}
+
+impl DeviceCounters {
+    /// The counters a heartbeat of acquisition carries.
+    pub fn from_heartbeat(h: &Health) -> Self {
+        Self {
+            crc_errors: h.crc_errors,
+            malformed_frames: h.malformed,
+            lost_frames: h.lost,
+            duplicate_frames: h.duplicates,
+            late_frames: h.late,
+            seq_jumps: h.seq_jumps,
+            time_rebases: h.time_rebases,
+            resync_bytes: h.resync_bytes,
+            reconnects: h.reconnects,
+        }
+    }
+
+    /// The sum of two processes' counters.
+    pub fn plus(&self, o: &Self) -> Self {
+        Self {
+            crc_errors: self.crc_errors + o.crc_errors,
+            malformed_frames: self.malformed_frames + o.malformed_frames,
+            lost_frames: self.lost_frames + o.lost_frames,
+            duplicate_frames: self.duplicate_frames + o.duplicate_frames,
+            late_frames: self.late_frames + o.late_frames,
+            seq_jumps: self.seq_jumps + o.seq_jumps,
+            time_rebases: self.time_rebases + o.time_rebases,
+            resync_bytes: self.resync_bytes + o.resync_bytes,
+            reconnects: self.reconnects + o.reconnects,
+        }
+    }
 }
 
 pub struct Monitor {
@@ -194,12 +235,7 @@ impl Monitor {
         if kind != ServiceKind::Acquisition {
             return;
         }
-        let counters = DeviceCounters {
-            crc_errors: h.crc_errors,
-            lost_frames: h.lost,
-            resync_bytes: h.resync_bytes,
-            reconnects: h.reconnects,
-        };
+        let counters = DeviceCounters::from_heartbeat(h);
         match self.acquisition.iter_mut().find(|(pid, _)| *pid == h.pid) {
             Some(entry) => entry.1 = counters,
             None => self.acquisition.push((h.pid, counters)),
@@ -210,12 +246,7 @@ impl Monitor {
     pub fn device_counters(&self) -> DeviceCounters {
         self.acquisition
             .iter()
-            .fold(DeviceCounters::default(), |acc, (_, c)| DeviceCounters {
-                crc_errors: acc.crc_errors + c.crc_errors,
-                lost_frames: acc.lost_frames + c.lost_frames,
-                resync_bytes: acc.resync_bytes + c.resync_bytes,
-                reconnects: acc.reconnects + c.reconnects,
-            })
+            .fold(DeviceCounters::default(), |acc, (_, c)| acc.plus(c))
     }
 }
 

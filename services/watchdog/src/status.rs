@@ -28,6 +28,19 @@ pub fn status_line(
         " | dropped {dropped} crc {} lost {}",
         device.crc_errors, device.lost_frames
     ));
+    // The rarer device counters only when there is something to say, so the usual line keeps
+    // its width.
+    for (what, n) in [
+        ("malformed", device.malformed_frames),
+        ("duplicates", device.duplicate_frames),
+        ("late", device.late_frames),
+        ("seq jumps", device.seq_jumps),
+        ("time rebases", device.time_rebases),
+    ] {
+        if n > 0 {
+            line.push_str(&format!(" {what} {n}"));
+        }
+    }
     match nav {
         Some(nav) => {
             let [r, p, y] = euler_deg(nav.quaternion);
@@ -127,5 +140,34 @@ mod tests {
             "{line}"
         );
         assert!(!line.contains("navigating"), "{line}");
+    }
+
+    #[test]
+    fn rare_device_counters_appear_only_when_non_zero() {
+        let rates = [1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0];
+        let quiet = status_line(4.0, &rates, 0, &DeviceCounters::default(), None);
+        assert!(
+            quiet.ends_with("| dropped 0 crc 0 lost 0 | no navigation output yet"),
+            "{quiet}"
+        );
+        let device = DeviceCounters {
+            crc_errors: 1,
+            lost_frames: 2,
+            malformed_frames: 12_000,
+            late_frames: 3,
+            time_rebases: 2,
+            ..DeviceCounters::default()
+        };
+        let line = status_line(4.0, &rates, 3, &device, None);
+        assert!(
+            line.contains(
+                "| dropped 3 crc 1 lost 2 malformed 12000 late 3 time rebases 2 | no navigation"
+            ),
+            "{line}"
+        );
+        assert!(
+            !line.contains("duplicates") && !line.contains("seq jumps"),
+            "{line}"
+        );
     }
 }

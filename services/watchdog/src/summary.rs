@@ -33,8 +33,20 @@ pub struct Summary {
     /// pipeline losses together), between the first and the last navigation output.
     pub dropped: u64,
     pub crc_errors: u64,
-    /// Frames missing from the device's sequence numbers, as counted by acquisition.
+    /// Frames with a valid CRC but malformed content (unknown type, bad length, counts beyond 12
+    /// bits), as counted by acquisition.
+    pub malformed_frames: u64,
+    /// Frames missing from the device's sequence numbers, as counted by acquisition (a late frame
+    /// is taken back out).
     pub lost_frames: u64,
+    /// Frames whose sequence number had been received before: not published.
+    pub duplicate_frames: u64,
+    /// Frames that arrived after a later one of their type (reordered): not published, not lost.
+    pub late_frames: u64,
+    /// Sequence-counter discontinuities of the device, re-based without counting losses.
+    pub seq_jumps: u64,
+    /// Device-clock discontinuities, re-based on the receive clock.
+    pub time_rebases: u64,
     pub nav_samples: u64,
     pub restarts: u64,
     /// Longest time from a child's exit to the first sample of its output topic from its

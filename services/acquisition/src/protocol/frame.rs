@@ -16,6 +16,14 @@ pub enum FrameType {
 impl FrameType {
     pub const COUNT: usize = 4;
 
+    /// Every type, in [`FrameType::index`] order.
+    pub const ALL: [FrameType; Self::COUNT] = [
+        FrameType::Imu,
+        FrameType::Baro,
+        FrameType::Mag,
+        FrameType::Aux,
+    ];
+
     pub fn from_u8(v: u8) -> Option<Self> {
         match v {
             1 => Some(FrameType::Imu),
@@ -29,6 +37,16 @@ impl FrameType {
     /// Index 0..COUNT, for per-type counters.
     pub fn index(self) -> usize {
         self as usize - 1
+    }
+
+    /// Lower-case name, for messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            FrameType::Imu => "imu",
+            FrameType::Baro => "baro",
+            FrameType::Mag => "mag",
+            FrameType::Aux => "aux",
+        }
     }
 }
 

@@ -125,7 +125,8 @@ pub fn encode_one(frame: &Frame) -> Vec<u8> {
     buf[..n].to_vec()
 }
 
-/// Pushes `bytes` in chunks of the given sizes (cycled) and returns the frames handed out.
+/// Pushes `bytes` in chunks of the given sizes (cycled), all received at the same instant, and
+/// returns the frames handed out.
 pub fn push_chunked(decoder: &mut Decoder, bytes: &[u8], chunks: &[usize]) -> Vec<DecodedFrame> {
     let mut out = Vec::new();
     let mut rest = bytes;
@@ -133,11 +134,11 @@ pub fn push_chunked(decoder: &mut Decoder, bytes: &[u8], chunks: &[usize]) -> Ve
     while !rest.is_empty() {
         let n = sizes.next().copied().unwrap_or(rest.len()).min(rest.len());
         let (head, tail) = rest.split_at(n);
-        decoder.push(head, |f| out.push(f));
+        decoder.push(head, 0, |f| out.push(f));
         // An empty push must be harmless; then move on by one byte.
         rest = if n == 0 {
             let (one, tail) = rest.split_at(1);
-            decoder.push(one, |f| out.push(f));
+            decoder.push(one, 0, |f| out.push(f));
             tail
         } else {
             tail
