@@ -148,6 +148,18 @@ fn reordered_repeated_jumped_and_malformed_frames_are_counted_exactly() {
         since.len()
     );
     assert!(since.iter().all(|v| v["mode"] == 1), "not navigating");
+    // Nothing to doubt after a re-based clock: integrity ok throughout, and the magnetometer still
+    // updating (its aiding bit earned by accepted updates, not left over).
+    if let Some(v) = since.iter().find(|v| v["integrity"] != 0) {
+        panic!("integrity not ok after the clock jumps: {v}");
+    }
+    let mag_accepted = |v: &serde_json::Value| v["aiding_accepted"][1].as_u64().unwrap_or(0);
+    let (first, last) = (&since[0], &since[since.len() - 1]);
+    assert!(mag_accepted(last) > mag_accepted(first), "{first}\n{last}");
+    assert!(
+        last["aiding"].as_u64().unwrap_or(0) & u64::from(ipc_types::aiding::MAG) != 0,
+        "{last}"
+    );
     let times: Vec<u64> = all.iter().map(device_time_us).collect();
     if let Some(k) = times.windows(2).position(|w| w[1] <= w[0]) {
         panic!(

@@ -292,7 +292,12 @@ impl AidedNavigator {
                             self.attitude_recovery.lose(ekf, &self.config.integrity);
                         }
                     }
-                    StepOutcome::InvalidDt => self.integrity.on_time_stall(t_us),
+                    // Forward beyond `max_dt_s`: nothing arrived for that long, an outage like
+                    // any other; not forward: the device time did not advance.
+                    StepOutcome::InvalidDt => match previous_time_us {
+                        Some(last) if t_us > last => self.integrity.on_gap(last, t_us),
+                        _ => self.integrity.on_time_stall(t_us),
+                    },
                     StepOutcome::NonFiniteInput => {
                         // The epoch stays: the next good sample integrates across this one.
                         self.last_time_us = previous_time_us;

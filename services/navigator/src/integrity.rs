@@ -264,6 +264,13 @@ impl IntegrityMonitor {
         self.time_stalls = self.time_stalls.saturating_add(1);
     }
 
+    /// No IMU sample at all from `last_us` until `t_us` (longer than the strapdown's largest
+    /// step): an outage from `last_us` on, judged like one of unusable samples.
+    pub fn on_gap(&mut self, last_us: u64, t_us: u64) {
+        self.see_time(t_us);
+        self.outage_since_us.get_or_insert(last_us);
+    }
+
     /// A fused IMU sample arrived without a usable solution.
     pub fn on_unusable_imu(&mut self, t_us: u64) {
         self.see_time(t_us);

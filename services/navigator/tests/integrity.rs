@@ -313,3 +313,29 @@ fn a_vehicle_that_turned_during_an_outage_is_re_levelled_from_gravity_and_the_ma
     assert!(last.counts[AidingSource::Gravity as usize].accepted >= 1);
     assert_eq!(last.integrity, Integrity::Ok, "{last:?}");
 }
+
+#[test]
+fn a_gap_in_the_imu_stream_is_an_outage_and_loses_the_attitude() {
+    let mut nav = Navigator::new(config()).unwrap();
+    let (mut v, _) = Vehicle::aligned(&mut nav, 2000);
+    // Nothing at all for 300 ms (a serial outage), then samples again.
+    let first = v.step(&mut nav, 2300).expect("navigating");
+    assert_eq!(first.integrity, Integrity::Invalid, "{first:?}");
+    assert!(first.integrity_reasons & why::IMU_UNUSABLE != 0);
+    let next = v.step(&mut nav, 2301).expect("navigating");
+    let lost = IntegrityConfig::default()
+        .lost_attitude_sigma_deg
+        .to_radians();
+    assert!(
+        (next.covariance_diag[0].sqrt() - lost).abs() < 1e-9,
+        "{next:?}"
+    );
+    let mut last = next;
+    for k in 2302..=5000 {
+        last = v.step(&mut nav, k).expect("navigating");
+    }
+    assert_eq!(last.integrity, Integrity::Ok, "{last:?}");
+    // A short gap, within the strapdown's largest step, is integrated across: nothing to report.
+    let out = v.step(&mut nav, 5050).expect("navigating");
+    assert_eq!(out.integrity, Integrity::Ok, "{out:?}");
+}
