@@ -4,9 +4,9 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use common::Scratch;
 use serde_json::Value;
 
 fn rins(args: &[&str]) -> Output {
@@ -14,29 +14,6 @@ fn rins(args: &[&str]) -> Output {
         .args(args)
         .output()
         .unwrap()
-}
-
-/// A fresh directory under the system's temporary directory, removed on drop.
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(name: &str) -> Self {
-        let dir =
-            std::env::temp_dir().join(format!("rins-eval-quadrotor-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Self(dir)
-    }
-
-    fn path(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
 }
 
 fn assert_fails_naming(args: &[&str], needle: &str) {
@@ -131,14 +108,14 @@ fn eval_quadrotor_names_a_missing_directory() {
 
 #[test]
 fn eval_quadrotor_names_a_directory_without_trials() {
-    let empty = Scratch::new("empty");
+    let empty = Scratch::new("eval-quadrotor", "empty");
     let dir = empty.path().to_str().unwrap();
     assert_fails_naming(&["eval", "quadrotor", dir], dir);
 }
 
 #[test]
 fn eval_quadrotor_names_a_bad_file() {
-    let data = Scratch::new("bad");
+    let data = Scratch::new("eval-quadrotor", "bad");
     let trial = data.path().join("Horizontal/path_1");
     std::fs::create_dir_all(&trial).unwrap();
     std::fs::write(trial.join("IMU_1.csv"), "time,what\n1,2\n").unwrap();
@@ -155,7 +132,7 @@ fn eval_quadrotor_names_a_missing_truth_file() {
     let Some(dir) = common::quadrotor_data_dir() else {
         return;
     };
-    let data = Scratch::new("no-truth");
+    let data = Scratch::new("eval-quadrotor", "no-truth");
     let trial = data.path().join("Horizontal/path_1");
     std::fs::create_dir_all(&trial).unwrap();
     std::fs::copy(

@@ -105,6 +105,16 @@ fn episode(
     }
     drop(nav);
     let summary = stop_up(&ipc, up);
+    // For the record (`cargo test --test integrity -- --nocapture`).
+    eprintln!(
+        "{name}: not ok {:.3} s after the fault, worst {}, reasons {}; ok again {:.3} s after it ended; \
+         integrity samples {}",
+        device_s(&first_bad) - FAULT_AT_S,
+        worst.name(),
+        why::describe(all_reasons),
+        device_s(&back_ok) - end,
+        summary["nav_integrity_samples"]
+    );
     Episode {
         first_bad,
         worst,

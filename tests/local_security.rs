@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Output, Stdio};
 use std::time::{Duration, Instant};
 
-use common::{Isolated, PipelineSlot, stderr, stop_up};
+use common::{Isolated, PipelineSlot, Scratch, stderr, stop_up};
 
 /// The unprivileged attacker.
 const NOBODY: u32 = 65534;
@@ -35,29 +35,6 @@ fn c_path(path: &Path) -> CString {
 fn give_to(path: &Path, uid: u32) {
     // SAFETY: a valid NUL-terminated path; lchown never follows a link.
     assert_eq!(unsafe { libc::lchown(c_path(path).as_ptr(), uid, uid) }, 0);
-}
-
-/// A private scratch directory of this test process (mode 0700), removed when dropped.
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(name: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!("rins-sec-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir(&dir).expect("scratch directory");
-        std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700)).unwrap();
-        Self(dir)
-    }
-
-    fn path(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
 }
 
 /// A directory with files in it, standing for whatever a planted link points at.
@@ -172,7 +149,7 @@ fn assert_stopped_clean(ipc: &Isolated, out: &Output, what: &str) {
 #[test]
 fn a_symlinked_root_is_refused_and_the_target_directory_kept() {
     let ipc = Isolated::new("symroot");
-    let scratch = Scratch::new("symroot");
+    let scratch = Scratch::new("sec", "symroot");
     let victim = victim_dir(&scratch);
     std::os::unix::fs::symlink(&victim, &ipc.root).unwrap();
     if is_root() {
@@ -256,7 +233,7 @@ const EXTREME_POINT: &str = "18446744073709551000 - - - 18446744073709551000";
 
 #[test]
 fn a_planted_resume_point_and_symlinked_temporary_file_are_neither_followed_nor_trusted() {
-    let scratch = Scratch::new("resume");
+    let scratch = Scratch::new("sec", "resume");
     let secret = scratch.path().join("root-only");
     std::fs::write(&secret, "root-only").unwrap();
     std::fs::set_permissions(&secret, std::fs::Permissions::from_mode(0o600)).unwrap();
@@ -398,7 +375,7 @@ fn a_config_that_is_a_device_fifo_or_huge_is_refused_at_once() {
         &["up", "--config", "/dev/zero"],
         &["/dev/zero is a character device, not a regular file"],
     );
-    let scratch = Scratch::new("cfgfile");
+    let scratch = Scratch::new("sec", "cfgfile");
     let fifo = scratch.path().join("rins.toml");
     // SAFETY: a valid NUL-terminated path.
     assert_eq!(unsafe { libc::mkfifo(c_path(&fifo).as_ptr(), 0o600) }, 0);
