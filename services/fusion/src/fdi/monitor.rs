@@ -539,6 +539,7 @@ impl SensorMonitor {
             &self.geometry,
             &self.variances,
             &self.settings.thresholds,
+            (self.settings.persistence_k, self.settings.persistence_n),
             &retest,
             self.settings.readmit_after_samples,
         ) else {

@@ -7,8 +7,9 @@
 //! connector that came back). So, and only then, the excluded channels are re-tested: the
 //! candidates — channels in service plus excluded channels that are valid and off the converter
 //! rails — must number at least three, every one of them must vary (a frozen converter does not
-//! come back this way), and, when there are four or more, their parity must stay below the
-//! detection threshold, on every sample of `readmit_after_samples` in a row. Then the excluded
+//! come back this way), and, when there are four or more, their parity test must raise no
+//! alarm — the detector's own rule, the threshold exceeded k times in n — over
+//! `readmit_after_samples` in a row. Then the excluded
 //! candidates return together. With exactly three there is no parity to check them against each
 //! other; they return on health alone, which is still better than no solution, and the parity test
 //! resumes as soon as a fourth channel is back.
@@ -18,6 +19,7 @@
 
 use super::MAX_PARITY;
 use super::parity::ParitySpace;
+use super::persistence::Persistence;
 use crate::geometry::{Geometry, MAX_CHANNELS};
 
 /// The running re-test of one sensor type.
@@ -33,6 +35,8 @@ pub struct ExclusionRetest {
     first_counts: [i16; MAX_CHANNELS],
     /// Candidates whose count differed from the first sample's during the run.
     varied: u32,
+    /// The detector's k-of-n rule over the candidates' parity (`None` until the first sample).
+    alarm: Option<Persistence>,
 }
 
 /// One sample of the re-test.
@@ -53,6 +57,9 @@ impl ExclusionRetest {
         self.space = None;
         self.run = 0;
         self.varied = 0;
+        if let Some(alarm) = self.alarm.as_mut() {
+            alarm.reset();
+        }
     }
 
     /// Consistent samples in a row so far.
@@ -62,12 +69,13 @@ impl ExclusionRetest {
 
     /// Pushes one sample; returns the candidates once they have been consistent for `needed`
     /// samples in a row (the run then restarts). `thresholds[m]`: the detection threshold for
-    /// parity dimension m.
+    /// parity dimension m; `persistence`: the detector's (k, n) rule.
     pub fn push(
         &mut self,
         geometry: &Geometry,
         variances: &[f64; MAX_CHANNELS],
         thresholds: &[f64; MAX_PARITY + 1],
+        persistence: (u32, u32),
         input: &RetestInput,
         needed: u32,
     ) -> Option<u32> {
@@ -79,7 +87,11 @@ impl ExclusionRetest {
                 self.space = ParitySpace::new(geometry, input.candidates, &variances[..n]).ok();
             }
         }
-        if self.candidates.count_ones() < 3 || !self.consistent(thresholds, input.z) {
+        let exceeded = !self.space_agrees(thresholds, input.z);
+        let alarm = self
+            .alarm
+            .get_or_insert_with(|| Persistence::new(persistence.0, persistence.1));
+        if self.candidates.count_ones() < 3 || alarm.push(exceeded) {
             self.run = 0;
             return None;
         }
@@ -107,9 +119,9 @@ impl ExclusionRetest {
         None
     }
 
-    /// The candidates' parity is below the threshold of its dimension (always true below four
-    /// candidates, where there is none; false when their space could not be built).
-    fn consistent(&self, thresholds: &[f64; MAX_PARITY + 1], z: &[f64; MAX_CHANNELS]) -> bool {
+    /// The candidates' parity is below the threshold of its dimension on this sample (always true
+    /// below four candidates, where there is none; false when their space could not be built).
+    fn space_agrees(&self, thresholds: &[f64; MAX_PARITY + 1], z: &[f64; MAX_CHANNELS]) -> bool {
         if self.candidates.count_ones() < 4 {
             return true;
         }
@@ -165,7 +177,7 @@ mod tests {
                 counts: &counts,
                 z: &z,
             };
-            back = retest.push(&g, &variances, &thresholds(), &input, 20);
+            back = retest.push(&g, &variances, &thresholds(), (3, 5), &input, 20);
             if back.is_some() {
                 assert_eq!(k, 19, "returned on the 20th consistent sample");
                 break;
@@ -188,8 +200,12 @@ mod tests {
                 counts: &counts,
                 z: &z,
             };
-            assert_eq!(retest.push(&g, &variances, &thresholds(), &input, 20), None);
-            assert_eq!(retest.run(), 0);
+            assert_eq!(
+                retest.push(&g, &variances, &thresholds(), (3, 5), &input, 20),
+                None
+            );
+            // The detector's rule: declared from the third exceedance on.
+            assert!(retest.run() < 3, "run {} at sample {k}", retest.run());
         }
     }
 
@@ -207,7 +223,10 @@ mod tests {
                 counts: &counts,
                 z: &z,
             };
-            assert_eq!(retest.push(&g, &variances, &thresholds(), &input, 20), None);
+            assert_eq!(
+                retest.push(&g, &variances, &thresholds(), (3, 5), &input, 20),
+                None
+            );
         }
         assert!(
             retest.run() >= 20,
@@ -222,7 +241,10 @@ mod tests {
                 counts: &counts,
                 z: &z,
             };
-            assert_eq!(retest.push(&g, &variances, &thresholds(), &input, 20), None);
+            assert_eq!(
+                retest.push(&g, &variances, &thresholds(), (3, 5), &input, 20),
+                None
+            );
         }
     }
 }
