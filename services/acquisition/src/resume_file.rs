@@ -33,32 +33,59 @@ pub fn path_for(settings: &rins_runtime::ipc::IpcSettings) -> PathBuf {
     settings.run_dir().join("acquisition.resume")
 }
 
-/// `imu baro mag aux time_us`, `-` for a value not known yet.
+/// `imu baro mag aux time_us`, each `EXTENDED/WIRE` (the wire value it was given to; `EXTENDED`
+/// alone when that is not known), `-` for a value not known yet.
 pub fn format(point: &ResumePoint) -> String {
-    let field = |v: Option<u64>| v.map_or_else(|| "-".to_string(), |v| v.to_string());
-    let mut fields: Vec<String> = point.seq.iter().map(|&s| field(s)).collect();
-    fields.push(field(point.time_us));
+    let field = |v: Option<u64>, wire: Option<u64>| match (v, wire) {
+        (Some(v), Some(w)) => format!("{v}/{w}"),
+        (Some(v), None) => v.to_string(),
+        (None, _) => "-".to_string(),
+    };
+    let mut fields: Vec<String> = point
+        .seq
+        .iter()
+        .zip(point.seq_wire)
+        .map(|(&s, w)| field(s, w.map(u64::from)))
+        .collect();
+    fields.push(field(point.time_us, point.time_wire.map(u64::from)));
     fields.join(" ")
+}
+
+/// One field of the file: `-`, `EXTENDED` or `EXTENDED/WIRE`; `None` when it is none of these.
+fn parse_field(text: &str) -> Option<(Option<u64>, Option<u64>)> {
+    if text == "-" {
+        return Some((None, None));
+    }
+    match text.split_once('/') {
+        Some((v, w)) => Some((Some(v.parse().ok()?), Some(w.parse().ok()?))),
+        None => Some((Some(text.parse().ok()?), None)),
+    }
 }
 
 /// The point in `text`, or `None` when it is not one (a corrupt file is ignored: the numbering
 /// then starts from the wire values, as on a first start).
 pub fn parse(text: &str) -> Option<ResumePoint> {
-    let values: Vec<Option<u64>> = text
+    let values: Vec<(Option<u64>, Option<u64>)> = text
         .split_whitespace()
-        .map(|f| match f {
-            "-" => Some(None),
-            v => v.parse().ok().map(Some),
-        })
+        .map(parse_field)
         .collect::<Option<_>>()?;
     if values.len() != FIELDS {
         return None;
     }
     let mut point = ResumePoint::default();
-    for (slot, value) in point.seq.iter_mut().zip(&values) {
-        *slot = *value;
+    for (k, (value, wire)) in values[..FrameType::COUNT].iter().enumerate() {
+        point.seq[k] = *value;
+        point.seq_wire[k] = match wire {
+            Some(w) => Some(u16::try_from(*w).ok()?),
+            None => None,
+        };
     }
-    point.time_us = values[FrameType::COUNT];
+    let (time, time_wire) = values[FrameType::COUNT];
+    point.time_us = time;
+    point.time_wire = match time_wire {
+        Some(w) => Some(u32::try_from(w).ok()?),
+        None => None,
+    };
     Some(point)
 }
 
@@ -148,18 +175,30 @@ mod tests {
     fn round_trip_and_rejects() {
         let point = ResumePoint {
             seq: [Some(65_547), None, Some(3), Some(u64::MAX)],
+            seq_wire: [Some(11), None, None, Some(65_535)],
             time_us: Some(1 << 40),
+            time_wire: Some(7),
         };
         assert_eq!(
             format(&point),
-            "65547 - 3 18446744073709551615 1099511627776"
+            "65547/11 - 3 18446744073709551615/65535 1099511627776/7"
         );
         assert_eq!(parse(&format(&point)), Some(point));
         assert_eq!(
             parse(&format(&ResumePoint::default())),
             Some(ResumePoint::default())
         );
-        for bad in ["", "1 2 3 4", "1 2 3 4 5 6", "1 2 x 4 5", "-1 2 3 4 5"] {
+        for bad in [
+            "",
+            "1 2 3 4",
+            "1 2 3 4 5 6",
+            "1 2 x 4 5",
+            "-1 2 3 4 5",
+            "1/65536 2 3 4 5",
+            "1 2 3 4 5/4294967296",
+            "1/ 2 3 4 5",
+            "1/2/3 2 3 4 5",
+        ] {
             assert_eq!(parse(bad), None, "{bad:?}");
         }
     }
@@ -175,6 +214,7 @@ mod tests {
         ResumePoint {
             seq: [Some(7), Some(8), Some(9), None],
             time_us: Some(10),
+            ..ResumePoint::default()
         }
     }
 

@@ -165,6 +165,46 @@ fn a_resumed_decoder_continues_a_previous_run() {
     assert_eq!(second.stats().lost_frames, 0);
 }
 
+/// After a sequence jump and a re-based clock the extended values' low bits are no longer the wire
+/// values: the point carries the wire values too, through its file, so a restart still continues
+/// the numbering forward instead of ignoring the point (and running backwards downstream).
+#[test]
+fn a_decoder_resumed_after_a_jump_and_a_re_based_clock_continues_forward() {
+    let mut first = Decoder::new();
+    // A device counter restarted (1104 → 0: a jump) and a clock that stepped back 10 s (a re-base).
+    decode_all(
+        &mut first,
+        &[
+            frame(imu(), 1103, 20_000_000),
+            frame(imu(), 1104, 20_001_000),
+        ],
+    );
+    decode_all(&mut first, &[frame(imu(), 0, 10_002_000)]);
+    let stats = first.stats();
+    assert_eq!((stats.seq_jumps, stats.time_rebases), (1, 1));
+    let point = first.resume_point();
+    let (seq, time) = (
+        point.seq[FrameType::Imu.index()].unwrap(),
+        point.time_us.unwrap(),
+    );
+    assert_eq!(point.seq_wire[FrameType::Imu.index()], Some(0));
+    assert_eq!(point.time_wire, Some(10_002_000));
+    assert_ne!(
+        seq as u16, 0,
+        "the low bits are not the wire number any more"
+    );
+    // Through the file, as a restarted acquisition reads it.
+    let saved =
+        rins_acquisition::resume_file::parse(&rins_acquisition::resume_file::format(&point));
+    assert_eq!(saved, Some(point));
+    let mut second = Decoder::new();
+    second.resume_from(&point).unwrap();
+    // Five frames and 5 ms later.
+    let out = decode_all(&mut second, &[frame(imu(), 5, 10_007_000)]);
+    assert_eq!((out[0].seq, out[0].device_time_us), (seq + 5, time + 5_000));
+    assert_eq!(second.stats().resume_rejected, 0);
+}
+
 #[test]
 fn a_repeated_sequence_number_is_a_duplicate_and_loses_nothing() {
     let aux = Payload::Aux(AuxFrame { foot_pressure: 1 });
@@ -259,6 +299,7 @@ fn a_resume_point_out_of_bounds_is_rejected_whole() {
     let point = ResumePoint {
         seq: [Some(1 << 48), Some(5), None, None],
         time_us: Some(10),
+        ..ResumePoint::default()
     };
     assert_eq!(
         decoder.resume_from(&point),
@@ -270,6 +311,7 @@ fn a_resume_point_out_of_bounds_is_rejected_whole() {
     let point = ResumePoint {
         seq: [Some(7), None, None, None],
         time_us: Some(u64::MAX),
+        ..ResumePoint::default()
     };
     assert!(decoder.resume_from(&point).is_err());
     assert_eq!(decoder.stats().resume_rejected, 2);
@@ -288,6 +330,7 @@ fn a_resume_point_far_from_the_first_frame_is_ignored_part_by_part() {
         seq: [Some(65_546), Some(1_000), None, None],
         // A planted time 2^40 µs; the device's first frame is 11 min past it on the wire.
         time_us: Some(1 << 40),
+        ..ResumePoint::default()
     };
     decoder.resume_from(&point).unwrap();
     let eleven_min = 11 * 60 * 1_000_000;

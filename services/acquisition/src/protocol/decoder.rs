@@ -128,7 +128,9 @@ impl Decoder {
     pub fn resume_point(&self) -> ResumePoint {
         ResumePoint {
             seq: self.seq.map(|s| s.last()),
+            seq_wire: self.seq.map(|s| s.last_wire()),
             time_us: self.time.last(),
+            time_wire: self.time.last_wire(),
         }
     }
 
@@ -141,13 +143,13 @@ impl Decoder {
             self.stats.resume_rejected += 1;
             return Err(e);
         }
-        for (extender, last) in self.seq.iter_mut().zip(point.seq) {
+        for ((extender, last), wire) in self.seq.iter_mut().zip(point.seq).zip(point.seq_wire) {
             if let Some(last) = last {
-                extender.resume_from(last);
+                extender.resume_from(last, wire);
             }
         }
         if let Some(t) = point.time_us {
-            self.time.resume_from(t);
+            self.time.resume_from(t, point.time_wire);
         }
         Ok(())
     }

@@ -6,12 +6,17 @@ use core::fmt;
 use super::frame::FrameType;
 
 /// The last extended sequence number of each frame type (indexed by [`FrameType::index`]) and
-/// the last extended device time. A restarted acquisition continues from the point its previous
-/// run saved, so the sequence numbers consumers see never run backwards.
+/// the last extended device time, each with the wire value it was given to. A restarted
+/// acquisition continues from the point its previous run saved, so the sequence numbers consumers
+/// see never run backwards. The wire values matter after a sequence jump or a re-based clock,
+/// when the extended value's low bits no longer are the wire's; without them (`None`) the low bits
+/// stand in.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct ResumePoint {
     pub seq: [Option<u64>; FrameType::COUNT],
+    pub seq_wire: [Option<u16>; FrameType::COUNT],
     pub time_us: Option<u64>,
+    pub time_wire: Option<u32>,
 }
 
 /// A sequence number this large (2^48: 8 900 years of frames at 1 kHz) is not one a run reached.
@@ -70,6 +75,7 @@ mod tests {
         let good = ResumePoint {
             seq: [Some(MAX_RESUME_SEQ - 1), None, Some(0), None],
             time_us: Some(MAX_RESUME_TIME_US - 1),
+            ..ResumePoint::default()
         };
         assert_eq!(good.check(), Ok(()));
         let seq = ResumePoint {

@@ -68,8 +68,9 @@ pub struct SeqExtender {
     /// Numbers from here up to the newest that are not received were counted lost; those below
     /// came before the first frame or a re-base, and were never counted.
     counted_from: u64,
-    /// Extended number of the last frame a previous run published, until the first frame.
-    resume: Option<u64>,
+    /// Extended number of the last frame a previous run published and its wire number (when
+    /// known), until the first frame.
+    resume: Option<(u64, Option<u16>)>,
     period: FramePeriod,
     /// In frames of the learnt period (set once the period is known).
     anchor: ArrivalAnchor,
@@ -117,16 +118,24 @@ impl SeqExtender {
     /// continues it when its wire number lies 0..2^15 steps ahead of `last`'s (the step is not
     /// counted lost: `last` may be up to a second old, and the frames in between were published by
     /// that run); otherwise the point is ignored ([`Continuity::ResumeIgnored`]).
-    pub fn resume_from(&mut self, last: u64) {
+    /// `last_wire`: the wire number `last` was given to (after a jump its low bits are not it).
+    pub fn resume_from(&mut self, last: u64, last_wire: Option<u16>) {
         *self = Self {
-            resume: Some(last),
+            resume: Some((last, last_wire)),
             ..Self::default()
         };
     }
 
     /// The extended number of the newest frame (before the first, the resume point's).
     pub fn last(&self) -> Option<u64> {
-        self.newest.map(|n| n.seq).or(self.resume)
+        self.newest.map(|n| n.seq).or(self.resume.map(|r| r.0))
+    }
+
+    /// The wire number of the newest frame (before the first, the resume point's).
+    pub fn last_wire(&self) -> Option<u16> {
+        self.newest
+            .map(|n| n.wire)
+            .or(self.resume.and_then(|r| r.1))
     }
 
     /// The learnt frame period, ns.
@@ -136,8 +145,8 @@ impl SeqExtender {
 
     fn first(&mut self, wire: u16, rx_ns: u64) -> SeqVerdict {
         let (seq, continuity) = match self.resume.take() {
-            // Truncation intended: the point's wire number.
-            Some(last) => match wire.wrapping_sub(last as u16) {
+            // Truncation intended: the point's wire number when not saved.
+            Some((last, last_wire)) => match wire.wrapping_sub(last_wire.unwrap_or(last as u16)) {
                 step if step < RESUME_MAX_STEP => {
                     (last.saturating_add(step.into()), Continuity::Continued)
                 }
@@ -347,12 +356,12 @@ mod tests {
     fn a_resume_continues_forward_without_counting_the_step_or_is_ignored() {
         // A previous run published up to 200_005 (wire 200_005 mod 2^16 = 3_397).
         let mut r = SeqExtender::default();
-        r.resume_from(200_005);
+        r.resume_from(200_005, None);
         assert_eq!(r.extend(3_400, 0), new(200_008, 0));
         assert_eq!(r.extend(3_402, 0), new(200_010, 1));
         // A first frame behind the point (step ≥ 2^15): the point is ignored.
         let mut r = SeqExtender::default();
-        r.resume_from(200_005);
+        r.resume_from(200_005, None);
         assert_eq!(
             r.extend(3_000, 0),
             SeqVerdict::New {

@@ -52,8 +52,9 @@ struct LastTime {
 pub struct TimeExtender {
     last: Option<LastTime>,
     first_rx_ns: Option<u64>,
-    /// Extended time of the last frame a previous run published, until the first frame.
-    resume: Option<u64>,
+    /// Extended time of the last frame a previous run published and its wire time (when known),
+    /// until the first frame.
+    resume: Option<(u64, Option<u32>)>,
     /// In µs of extended time.
     anchor: ArrivalAnchor,
 }
@@ -91,22 +92,30 @@ impl TimeExtender {
     /// Continues from `last_us`, the extended time of a frame published by a previous run. The
     /// first frame continues it when its wire time lies −[`TOLERANCE_US`]..=[`RESUME_MAX_STEP_US`]
     /// from `last_us`'s; otherwise the point is ignored ([`Continuity::ResumeIgnored`]).
-    pub fn resume_from(&mut self, last_us: u64) {
+    /// `last_wire`: the wire time `last_us` was given to (after a re-base its low bits are not
+    /// it).
+    pub fn resume_from(&mut self, last_us: u64, last_wire: Option<u32>) {
         *self = Self {
-            resume: Some(last_us),
+            resume: Some((last_us, last_wire)),
             ..Self::default()
         };
     }
 
     /// The extended time of the last frame, µs (before the first, the resume point's).
     pub fn last(&self) -> Option<u64> {
-        self.last.map(|l| l.time_us).or(self.resume)
+        self.last.map(|l| l.time_us).or(self.resume.map(|r| r.0))
+    }
+
+    /// The wire time of the last frame (before the first, the resume point's).
+    pub fn last_wire(&self) -> Option<u32> {
+        self.last.map(|l| l.wire).or(self.resume.and_then(|r| r.1))
     }
 
     fn first(&mut self, wire: u32, rx_ns: u64) -> ExtendedTime {
-        let resumed = self.resume.take().map(|point| {
-            // Truncation intended: the signed 32-bit difference to the point's wire time.
-            let step = i64::from(wire.wrapping_sub(point as u32) as i32);
+        let resumed = self.resume.take().map(|(point, point_wire)| {
+            // Truncation intended: the signed 32-bit difference to the point's wire time (its
+            // low bits when the wire time was not saved).
+            let step = i64::from(wire.wrapping_sub(point_wire.unwrap_or(point as u32)) as i32);
             let t = i128::from(point) + i128::from(step);
             u64::try_from(t)
                 .ok()
@@ -248,17 +257,17 @@ mod tests {
     #[test]
     fn a_resume_point_near_the_first_frame_continues_and_a_far_one_is_ignored() {
         let mut t = TimeExtender::default();
-        t.resume_from((5 << 32) + 100);
+        t.resume_from((5 << 32) + 100, None);
         assert_eq!(t.extend(10, 0), continued((5 << 32) + 10));
         assert_eq!(t.last(), Some((5 << 32) + 10));
         let mut t = TimeExtender::default();
-        t.resume_from((5 << 32) + 100);
+        t.resume_from((5 << 32) + 100, None);
         assert_eq!(
             t.extend(100 + 10 * 60 * 1_000_000 + 1, 0).continuity,
             Continuity::ResumeIgnored
         );
         let mut t = TimeExtender::default();
-        t.resume_from(100);
+        t.resume_from(100, None);
         // Behind the point by more than the tolerance.
         let e = t.extend(u32::MAX - 600_000, 0);
         assert_eq!(
