@@ -307,7 +307,7 @@ pub struct SimArgs {
     pub faults: FaultArgs,
 }
 
-#[derive(Debug, clap::Args)]
+#[derive(Debug, Clone, clap::Args)]
 pub struct SoakArgs {
     /// How long to run, minutes.
     #[arg(long)]
@@ -326,6 +326,18 @@ pub struct SoakArgs {
     /// readmit it), disconnect (unplug the serial device for 0.2-1 s).
     #[arg(long, default_value = "kill,sensor")]
     pub faults: String,
+}
+
+impl From<SoakArgs> for rins_soak::SoakArgs {
+    fn from(a: SoakArgs) -> Self {
+        Self {
+            minutes: a.minutes,
+            seed: a.seed,
+            min_interval_s: a.min_interval_s,
+            max_interval_s: a.max_interval_s,
+            faults: a.faults,
+        }
+    }
 }
 
 #[cfg(test)]

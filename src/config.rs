@@ -42,8 +42,8 @@ impl Default for DeviceConfig {
     }
 }
 
-use rins_acquisition::protocol::layout::COUNTS_PER_FULL_SCALE;
-use rins_sim::GRAVITY_MPS2;
+use rins_earth::STANDARD_GRAVITY;
+use rins_protocol::layout::COUNTS_PER_FULL_SCALE;
 
 impl DeviceConfig {
     pub fn validate(&self) -> Result<(), String> {
@@ -71,7 +71,7 @@ impl DeviceConfig {
     }
 
     pub fn accel_lsb_mps2(&self) -> f64 {
-        self.accel_full_scale_g * GRAVITY_MPS2 / COUNTS_PER_FULL_SCALE
+        self.accel_full_scale_g * STANDARD_GRAVITY / COUNTS_PER_FULL_SCALE
     }
 }
 

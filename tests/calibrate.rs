@@ -6,9 +6,9 @@ mod common;
 use std::process::Output;
 
 use common::Isolated;
-use rins_acquisition::protocol::MagFrame;
 use rins_navigator::attitude::quaternion_from_euler;
 use rins_navigator::mag_calibration::MagCalibration;
+use rins_protocol::MagFrame;
 use rins_sim::sensor_model::SensorModel;
 use rins_sim::{SensorModelConfig, SimConfig};
 

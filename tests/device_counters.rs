@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use common::device::{DeviceTick, FakeDevice, Malformed, malformed_frame};
 use common::topic_stream::TopicStream;
 use common::{Isolated, PipelineSlot, spawn_up, stop_up};
-use rins_acquisition::protocol::Payload;
+use rins_protocol::Payload;
 use rins_sim::Scenario;
 
 /// Device seconds after the first frame written at which each disturbance starts.

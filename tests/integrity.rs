@@ -19,7 +19,7 @@ use common::device::{DeviceTick, FakeDevice};
 use common::topic_stream::TopicStream;
 use common::{Isolated, PipelineSlot, spawn_up, stop_up};
 use ipc_types::{Integrity, NavMode, integrity_reason as why};
-use rins_acquisition::protocol::Payload;
+use rins_protocol::Payload;
 use rins_sim::Scenario;
 use serde_json::Value;
 
@@ -124,7 +124,7 @@ fn episode(
     }
 }
 
-fn imu<'t>(tick: &'t mut DeviceTick<'_>) -> &'t mut rins_acquisition::protocol::ImuFrame {
+fn imu<'t>(tick: &'t mut DeviceTick<'_>) -> &'t mut rins_protocol::ImuFrame {
     match &mut tick.frames[0].payload {
         Payload::Imu(f) => f,
         _ => panic!("the first frame of a tick is the IMU's"),

@@ -14,8 +14,8 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use rins_acquisition::protocol::layout::{CRC_LEN, SEQ_OFFSET, TIME_OFFSET};
-use rins_acquisition::protocol::{DecodedFrame, Decoder, Frame, MAX_FRAME_LEN, encode};
+use rins_protocol::layout::{CRC_LEN, SEQ_OFFSET, TIME_OFFSET};
+use rins_protocol::{DecodedFrame, Decoder, Frame, MAX_FRAME_LEN, encode};
 
 fuzz_target!(|data: &[u8]| {
     let Some((&k, rest)) = data.split_first() else {

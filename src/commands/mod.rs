@@ -13,7 +13,6 @@ mod progress;
 mod readmit;
 mod service;
 mod sim;
-mod soak;
 mod status;
 mod up;
 
@@ -42,7 +41,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             csv,
             timeout,
         } => echo::run(&topic, count, csv, timeout).map(|()| ExitCode::SUCCESS),
-        Command::Soak(args) => soak::run(&args).map(|()| ExitCode::SUCCESS),
+        Command::Soak(args) => rins_soak::run(&args.into()).map(|()| ExitCode::SUCCESS),
         Command::Status { json, timeout } => status::run(json, timeout).map(|()| ExitCode::SUCCESS),
         Command::Inject(args) => inject::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Readmit { channel } => readmit::run(&channel).map(|()| ExitCode::SUCCESS),

@@ -11,8 +11,8 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use rins_acquisition::protocol::layout::{HEADER_LEN, SYNC, TYPE_OFFSET};
-use rins_acquisition::protocol::{Frame, MAX_FRAME_LEN, encode};
+use rins_protocol::layout::{HEADER_LEN, SYNC, TYPE_OFFSET};
+use rins_protocol::{Frame, MAX_FRAME_LEN, encode};
 use rins_sim::{Scenario, Simulator, TickOutput};
 use serialport::{SerialPort, TTYPort};
 

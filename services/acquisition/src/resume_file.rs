@@ -16,7 +16,7 @@ use std::io::{self, Read, Write};
 use std::os::unix::fs::{MetadataExt, OpenOptionsExt};
 use std::path::{Path, PathBuf};
 
-use crate::protocol::{FrameType, ResumePoint};
+use rins_protocol::{FrameType, ResumePoint};
 
 const FIELDS: usize = FrameType::COUNT + 1;
 

@@ -15,9 +15,9 @@ use rins_runtime::shutdown::Shutdown;
 use crate::backoff::Backoff;
 use crate::config::AcquisitionConfig;
 use crate::presence::{Opened, Presence};
-use crate::protocol::{DecodedFrame, Decoder, DecoderStats, FrameType, Payload};
 use crate::resume_file;
 use crate::to_ipc;
+use rins_protocol::{DecodedFrame, Decoder, DecoderStats, FrameType, Payload};
 
 struct Publishers {
     imu: TopicPublisher<RawImu>,

@@ -2,7 +2,7 @@
 
 use ipc_types::{Header, PAYLOAD_VERSION, RawAux, RawBaro, RawImu, RawMag};
 
-use crate::protocol::{AuxFrame, BaroFrame, DecodedFrame, ImuFrame, MagFrame};
+use rins_protocol::{AuxFrame, BaroFrame, DecodedFrame, ImuFrame, MagFrame};
 
 pub fn origin_header(frame: &DecodedFrame, rx_ns: u64) -> Header {
     Header {
@@ -65,7 +65,7 @@ pub fn raw_aux(f: &AuxFrame, header: Header) -> RawAux {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::protocol::Payload;
+    use rins_protocol::Payload;
 
     #[test]
     fn units_are_converted_and_header_kept() {

@@ -7,7 +7,7 @@
 //! backwards) restarts the filter from the next sample, since the state is then meaningless.
 
 use crate::error::ConfigError;
-use crate::isa::{altitude_per_pascal, pressure_to_altitude};
+use rins_earth::isa::{altitude_per_pascal, pressure_to_altitude};
 use serde::Deserialize;
 
 /// Altimeter configuration.

@@ -4,8 +4,8 @@
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal, StandardNormal};
-use rins_altimeter::isa::{altitude_per_pascal, altitude_to_pressure};
 use rins_altimeter::{AltimeterConfig, AltitudeEstimator, AltitudeOutput};
+use rins_earth::isa::{altitude_per_pascal, altitude_to_pressure};
 
 const QNH: f64 = 101_325.0;
 const DT_US: u64 = 20_000; // 50 Hz

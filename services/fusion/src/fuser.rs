@@ -39,7 +39,7 @@ pub fn default_gyro_sigma_rps() -> f64 {
 
 /// Default accelerometer channel noise σ: 150 µg/√Hz over a 1 kHz bandwidth, in m/s².
 pub fn default_accel_sigma_mps2() -> f64 {
-    150e-6 * 9.80665 * 1000_f64.sqrt()
+    150e-6 * rins_earth::STANDARD_GRAVITY * 1000_f64.sqrt()
 }
 
 /// One value per sensor type.

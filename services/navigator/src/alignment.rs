@@ -20,7 +20,7 @@
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::attitude::{quaternion_from_euler, wrap_pi};
-use crate::earth::STANDARD_GRAVITY;
+use rins_earth::STANDARD_GRAVITY;
 
 /// Heading is declared unaided when the levelled horizontal field is below this fraction of the total field
 /// (near a magnetic pole or with a dead magnetometer).

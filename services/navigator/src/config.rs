@@ -5,13 +5,13 @@ use serde::{Deserialize, Serialize};
 use crate::aided::{AidedConfig, ZuptConfig};
 use crate::aiding::BaroAidingConfig;
 use crate::alignment::AlignConfig;
-use crate::earth::normal_gravity;
 use crate::ekf::EkfNoise;
 use crate::integrity::IntegrityConfig;
 use crate::mag_calibration::MagCalibration;
 use crate::mag_heading::MagAidingConfig;
 use crate::mechanisation::StrapdownConfig;
 use crate::stance::StanceConfig;
+use rins_earth::normal_gravity;
 
 pub use rins_runtime::config_error::ConfigError;
 

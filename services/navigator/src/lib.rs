@@ -11,7 +11,6 @@ pub mod attitude;
 pub mod attitude_recovery;
 mod checks;
 pub mod config;
-pub mod earth;
 pub mod ekf;
 pub mod integrity;
 pub mod mag_calibration;

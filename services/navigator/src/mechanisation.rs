@@ -18,7 +18,7 @@
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::attitude::{rotation_vector_to_quaternion, wrap_pi};
-use crate::earth::{meridian_radius, normal_gravity, prime_vertical_radius};
+use rins_earth::{meridian_radius, normal_gravity, prime_vertical_radius};
 
 pub use crate::attitude::{euler_from_quaternion, quaternion_from_euler};
 

@@ -6,8 +6,8 @@ use std::f64::consts::PI;
 
 use nalgebra::{UnitQuaternion, Vector3};
 use proptest::prelude::*;
+use rins_earth::{meridian_radius, prime_vertical_radius};
 use rins_navigator::attitude::{rotation_vector_to_quaternion, wrap_pi};
-use rins_navigator::earth::{meridian_radius, prime_vertical_radius};
 use rins_navigator::mechanisation::{
     ImuBias, NominalState, StepOutcome, Strapdown, StrapdownConfig, euler_from_quaternion,
     quaternion_from_euler,

@@ -6,7 +6,7 @@ mod common;
 use common::{Noise, earth_field_ned, specific_force_at_rest};
 use ipc_types::{Integrity, NavMode, NavState, aiding, integrity_reason};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use rins_navigator::earth::normal_gravity;
+use rins_earth::normal_gravity;
 use rins_navigator::ekf::{AidingCounts, AidingSource};
 use rins_navigator::mechanisation::quaternion_from_euler;
 use rins_navigator::{AlignError, NavOutput, Navigator, NavigatorConfig};

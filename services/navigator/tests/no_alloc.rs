@@ -3,7 +3,7 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use rins_navigator::earth::normal_gravity;
+use rins_earth::normal_gravity;
 use rins_navigator::{Navigator, NavigatorConfig};
 
 /// Counts heap allocations made by the current thread while armed.

@@ -6,9 +6,9 @@ use std::fmt;
 
 use ipc_types::{MAX_CHANNELS, PAYLOAD_VERSION, SensorType, SimControl, SimFault};
 
-use crate::GRAVITY_MPS2;
 use crate::config::SimConfig;
 use crate::sensor_model::fault::{ChannelFault, InertialSensor};
+use rins_earth::STANDARD_GRAVITY;
 
 /// Period of an intermittent fault when none is given, s (dead for the first half of it).
 pub const DEFAULT_INTERMITTENT_PERIOD_S: f64 = 0.2;
@@ -394,7 +394,7 @@ impl WhiteNoise {
         let s = &config.sensors;
         Self {
             gyro_rps: s.gyro_noise_density_dps_rthz.to_radians() * sqrt_rate,
-            accel_mps2: s.accel_noise_density_ug_rthz * 1e-6 * GRAVITY_MPS2 * sqrt_rate,
+            accel_mps2: s.accel_noise_density_ug_rthz * 1e-6 * STANDARD_GRAVITY * sqrt_rate,
         }
     }
 
@@ -604,7 +604,7 @@ mod tests {
         let gyro = (0.01f64 * 1000f64.sqrt()).to_radians();
         assert!((w.gyro_rps - gyro).abs() < 1e-15);
         // 150 µg/√Hz at 1 kHz.
-        let accel = 150e-6 * GRAVITY_MPS2 * 1000f64.sqrt();
+        let accel = 150e-6 * STANDARD_GRAVITY * 1000f64.sqrt();
         assert!((w.accel_mps2 - accel).abs() < 1e-15);
     }
 }

@@ -1,7 +1,10 @@
-//! Device simulator core: a deterministic truth trajectory, per-channel sensor error models and the
-//! frame generator that emulates the redundant sensor block. Pure: no I/O, no clocks, no globals.
+//! Device simulator: a deterministic truth trajectory, per-channel sensor error models and the frame
+//! generator that emulates the redundant sensor block — pure, no I/O, no clocks, no globals — and,
+//! around them, the process: the simulated serial line on a pseudo-terminal ([`serial_line`]), the
+//! fault commands it takes and the truth it publishes ([`service`]).
 //!
-//! The Earth is modelled as non-rotating with constant gravity [`GRAVITY_MPS2`]; see [`trajectory`].
+//! The Earth is modelled as non-rotating with constant standard gravity
+//! ([`rins_earth::STANDARD_GRAVITY`]); see [`trajectory`].
 
 pub mod config;
 pub mod device_fault;
@@ -22,6 +25,3 @@ pub use sensor_model::SensorModelConfig;
 pub use sensor_model::fault::{ChannelFault, InertialSensor};
 pub use simulator::{Simulator, TickOutput, TruthSample};
 pub use trajectory::{Scenario, Trajectory, TrajectoryStart, TruthState};
-
-/// Standard gravity, m/s² (g_n = [0, 0, +g] in NED).
-pub const GRAVITY_MPS2: f64 = 9.80665;

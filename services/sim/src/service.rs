@@ -10,7 +10,7 @@ use ipc_types::{
     FaultApplied, FaultOutcome, Header, Health, PAYLOAD_VERSION, ServiceKind, SimControl, Truth,
     names,
 };
-use rins_acquisition::protocol::{Frame, MAX_FRAME_LEN, encode};
+use rins_protocol::{Frame, MAX_FRAME_LEN, encode};
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::heartbeat::Heartbeat;
 use rins_runtime::ipc::{IpcSettings, TopicPublisher, TopicSubscriber, create_node};

@@ -4,7 +4,7 @@
 //! ticks where `⌊k·rate/imu_rate⌋` advances (and on tick 0), so any rate up to the IMU rate works
 //! without drift and without requiring an integer ratio.
 
-use rins_acquisition::protocol::{AuxFrame, BaroFrame, Frame, ImuFrame, MagFrame, Payload};
+use rins_protocol::{AuxFrame, BaroFrame, Frame, ImuFrame, MagFrame, Payload};
 
 use crate::config::SimConfig;
 use crate::error::SimError;
@@ -76,7 +76,7 @@ impl Default for TickOutput {
     }
 }
 
-/// Per-frame-type sequence counters, in [`rins_acquisition::protocol::FrameType`] index order.
+/// Per-frame-type sequence counters, in [`rins_protocol::FrameType`] index order.
 #[derive(Debug, Clone, Copy, Default)]
 struct Sequences {
     imu: u16,

@@ -2,7 +2,8 @@
 
 mod common;
 
-use rins_sim::{GRAVITY_MPS2, Scenario, SensorModelConfig, SimConfig, SimError, Simulator};
+use rins_earth::STANDARD_GRAVITY;
+use rins_sim::{Scenario, SensorModelConfig, SimConfig, SimError, Simulator};
 
 #[test]
 fn defaults_are_the_documented_mems_block() {
@@ -15,7 +16,7 @@ fn defaults_are_the_documented_mems_block() {
     );
     assert_eq!(c.qnh_pa, 101_325.0);
     assert!((c.gyro_lsb_rps() - 300f64.to_radians() / 2048.0).abs() < 1e-18);
-    assert!((c.accel_lsb_mps2() - 8.0 * GRAVITY_MPS2 / 2048.0).abs() < 1e-15);
+    assert!((c.accel_lsb_mps2() - 8.0 * STANDARD_GRAVITY / 2048.0).abs() < 1e-15);
     assert_eq!(
         (c.earth_field.intensity_ut, c.earth_field.inclination_deg),
         (50.0, 60.0)

@@ -4,12 +4,11 @@ mod common;
 
 use nalgebra::{UnitQuaternion, Vector3};
 use proptest::prelude::*;
-use rins_acquisition::protocol::{BaroFrame, ImuFrame, MagFrame, Payload};
+use rins_earth::STANDARD_GRAVITY;
+use rins_protocol::{BaroFrame, ImuFrame, MagFrame, Payload};
 use rins_sim::sensor_model::baro::{isa_altitude_m, isa_pressure_pa};
 use rins_sim::sensor_model::{Environment, SensorModel};
-use rins_sim::{
-    GRAVITY_MPS2, Scenario, SensorModelConfig, SimConfig, Simulator, TickOutput, TruthState,
-};
+use rins_sim::{Scenario, SensorModelConfig, SimConfig, Simulator, TickOutput, TruthState};
 
 fn truth(rate: Vector3<f64>, force: Vector3<f64>) -> TruthState {
     TruthState {
@@ -52,7 +51,7 @@ fn large_rate_saturates_and_clamps_with_status_bit() {
     // 20 rad/s about x: projections ±20·cos(35.26°)·cos(45°) ≈ ±11.5 rad/s, beyond ±5.24 rad/s full scale.
     let rate = Vector3::new(20.0, 0.0, 0.0);
     m.imu(
-        &truth(rate, Vector3::new(0.0, 0.0, -GRAVITY_MPS2)),
+        &truth(rate, Vector3::new(0.0, 0.0, -STANDARD_GRAVITY)),
         &mut frame,
     );
     assert_eq!(frame.status & SATURATION, SATURATION);
@@ -66,7 +65,7 @@ fn large_rate_saturates_and_clamps_with_status_bit() {
     // 1 rad/s is inside the range: no status bit, counts ≈ projection/lsb.
     let rate = Vector3::new(1.0, 0.0, 0.0);
     m.imu(
-        &truth(rate, Vector3::new(0.0, 0.0, -GRAVITY_MPS2)),
+        &truth(rate, Vector3::new(0.0, 0.0, -STANDARD_GRAVITY)),
         &mut frame,
     );
     assert_eq!(frame.status & SATURATION, 0);
@@ -82,7 +81,7 @@ fn large_rate_saturates_and_clamps_with_status_bit() {
     m.imu(
         &truth(
             Vector3::zeros(),
-            Vector3::new(0.0, 0.0, -10.0 * GRAVITY_MPS2 / 0.57),
+            Vector3::new(0.0, 0.0, -10.0 * STANDARD_GRAVITY / 0.57),
         ),
         &mut frame,
     );
@@ -105,7 +104,7 @@ fn frame_layout_reports_channel_counts_and_clears_unused_slots() {
         ..ImuFrame::default()
     };
     m.imu(
-        &truth(Vector3::zeros(), Vector3::new(0.0, 0.0, -GRAVITY_MPS2)),
+        &truth(Vector3::zeros(), Vector3::new(0.0, 0.0, -STANDARD_GRAVITY)),
         &mut frame,
     );
     assert_eq!(
@@ -136,7 +135,7 @@ proptest! {
         let mut m = model(&config, &axes);
         let mut frame = ImuFrame::default();
         let w = Vector3::new(wx, wy, wz);
-        m.imu(&truth(w, Vector3::new(0.0, 0.0, -GRAVITY_MPS2)), &mut frame);
+        m.imu(&truth(w, Vector3::new(0.0, 0.0, -STANDARD_GRAVITY)), &mut frame);
         let mut any_clipped = false;
         for (i, axis) in axes.iter().enumerate() {
             let raw = (Vector3::from(*axis).normalize().dot(&w) / lsb).round();

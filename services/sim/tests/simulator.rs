@@ -3,7 +3,7 @@
 mod common;
 
 use proptest::prelude::*;
-use rins_acquisition::protocol::{Frame, ImuFrame, Payload};
+use rins_protocol::{Frame, ImuFrame, Payload};
 use rins_sim::sensor_model::baro::isa_pressure_pa;
 use rins_sim::{
     ChannelFault, InertialSensor, Scenario, SimConfig, SimError, Simulator, TickOutput,

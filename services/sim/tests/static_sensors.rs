@@ -4,8 +4,9 @@
 mod common;
 
 use nalgebra::Vector3;
-use rins_acquisition::protocol::Payload;
-use rins_sim::{GRAVITY_MPS2, InertialSensor, Scenario, SimConfig, Simulator, TickOutput};
+use rins_earth::STANDARD_GRAVITY;
+use rins_protocol::Payload;
+use rins_sim::{InertialSensor, Scenario, SimConfig, Simulator, TickOutput};
 
 const SECONDS: usize = 10;
 
@@ -61,11 +62,11 @@ fn averaged_counts_match_projection_plus_true_errors_within_noise_bounds() {
         / (n as f64).sqrt();
     let accel_tol =
         5.0 * sample_sigma(
-            s.accel_noise_density_ug_rthz * 1e-6 * GRAVITY_MPS2,
+            s.accel_noise_density_ug_rthz * 1e-6 * STANDARD_GRAVITY,
             1000.0,
             a_lsb,
         ) / (n as f64).sqrt();
-    let f_b = Vector3::new(0.0, 0.0, -GRAVITY_MPS2);
+    let f_b = Vector3::new(0.0, 0.0, -STANDARD_GRAVITY);
 
     let mut sum_abs_gyro_bias = 0.0;
     for i in 0..4 {
@@ -117,7 +118,7 @@ fn averaged_counts_match_ideal_projection_within_model_tolerance() {
     let config = SimConfig::default();
     let axes = common::pyramid(28.7);
     let s = &config.sensors;
-    let mg = 1e-3 * GRAVITY_MPS2;
+    let mg = 1e-3 * STANDARD_GRAVITY;
     let n = 2000;
     let root_n = f64::from(n).sqrt();
     let gyro_noise = sample_sigma(
@@ -126,7 +127,7 @@ fn averaged_counts_match_ideal_projection_within_model_tolerance() {
         config.gyro_lsb_rps(),
     ) / root_n;
     let accel_noise = sample_sigma(
-        s.accel_noise_density_ug_rthz * 1e-6 * GRAVITY_MPS2,
+        s.accel_noise_density_ug_rthz * 1e-6 * STANDARD_GRAVITY,
         1000.0,
         config.accel_lsb_mps2(),
     ) / root_n;
@@ -142,7 +143,7 @@ fn averaged_counts_match_ideal_projection_within_model_tolerance() {
         * ((s.accel_turn_on_bias_sigma_mg * mg).powi(2)
             + (s.accel_bias_instability_sigma_mg * mg).powi(2)
             + (s.accel_bias_temp_coeff_sigma_mg_per_c * mg).powi(2)
-            + (s.accel_scale_error_sigma * GRAVITY_MPS2).powi(2))
+            + (s.accel_scale_error_sigma * STANDARD_GRAVITY).powi(2))
         .sqrt()
         + 5.0 * accel_noise;
     for seed in 0..5 {
@@ -155,7 +156,7 @@ fn averaged_counts_match_ideal_projection_within_model_tolerance() {
                 measured_gyro.abs() < gyro_tol,
                 "seed {seed} gyro {i}: {measured_gyro}"
             );
-            let ideal = h.dot(&Vector3::new(0.0, 0.0, -GRAVITY_MPS2));
+            let ideal = h.dot(&Vector3::new(0.0, 0.0, -STANDARD_GRAVITY));
             let measured = avg.accel[i] * config.accel_lsb_mps2();
             assert!(
                 (measured - ideal).abs() < accel_tol,

@@ -2,11 +2,12 @@
 //! shape of the UAV profile.
 
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use rins_earth::STANDARD_GRAVITY;
 use rins_sim::trajectory::geodesy::geodetic_rates;
 use rins_sim::trajectory::uav_profile::{
     CRUISE_ALTITUDE_AGL_M, CRUISE_SPEED_MPS, MAX_BANK_DEG, MIN_BANK_DEG,
 };
-use rins_sim::{GRAVITY_MPS2, Scenario, SimConfig, Trajectory, TruthState};
+use rins_sim::{Scenario, SimConfig, Trajectory, TruthState};
 
 fn uav() -> (Trajectory, SimConfig) {
     let config = SimConfig {
@@ -25,7 +26,7 @@ fn q_dot(q: &Quaternion<f64>, w: &Vector3<f64>) -> Quaternion<f64> {
 }
 
 fn nav_accel(s: &TruthState) -> Vector3<f64> {
-    s.attitude.transform_vector(&s.specific_force_b) + Vector3::new(0.0, 0.0, GRAVITY_MPS2)
+    s.attitude.transform_vector(&s.specific_force_b) + Vector3::new(0.0, 0.0, STANDARD_GRAVITY)
 }
 
 fn geo_rates(s: &TruthState, lat: f64) -> [f64; 2] {
@@ -132,7 +133,7 @@ fn turns_are_coordinated() {
         max_lateral = max_lateral.max(s.specific_force_b.y.abs());
         let [roll, pitch, _] = s.euler_rad;
         if roll.abs() > 15f64.to_radians() && pitch == 0.0 && s.velocity_n.z == 0.0 {
-            let expected = -GRAVITY_MPS2 / roll.cos();
+            let expected = -STANDARD_GRAVITY / roll.cos();
             assert!(
                 (s.specific_force_b.z - expected).abs() < 1e-9,
                 "load factor at t={}",
@@ -166,7 +167,9 @@ fn uav_profile_climbs_to_cruise_banks_within_limits_and_lands() {
         if t < config.static_s {
             assert_eq!(s.velocity_n, Vector3::zeros());
             assert_eq!(s.angular_rate_b, Vector3::zeros());
-            assert!((s.specific_force_b - Vector3::new(0.0, 0.0, -GRAVITY_MPS2)).norm() < 1e-12);
+            assert!(
+                (s.specific_force_b - Vector3::new(0.0, 0.0, -STANDARD_GRAVITY)).norm() < 1e-12
+            );
         }
     }
     assert!(
@@ -200,7 +203,7 @@ fn uav_profile_climbs_to_cruise_banks_within_limits_and_lands() {
             s.euler_rad[0].abs() < 1e-12 && s.euler_rad[1].abs() < 1e-12,
             "level when parked"
         );
-        assert!((s.specific_force_b - Vector3::new(0.0, 0.0, -GRAVITY_MPS2)).norm() < 1e-9);
+        assert!((s.specific_force_b - Vector3::new(0.0, 0.0, -STANDARD_GRAVITY)).norm() < 1e-9);
     }
     let parked = traj.sample(traj.end_s());
     let later = traj.sample(traj.end_s() + 1e5);
@@ -222,7 +225,10 @@ fn static_scenario_is_level_at_origin_with_configured_heading() {
         assert_eq!((s.euler_rad[0], s.euler_rad[1]), (0.0, 0.0));
         let (r, p, y) = s.attitude.euler_angles();
         assert!(r.abs() < 1e-12 && p.abs() < 1e-12 && (y - 123f64.to_radians()).abs() < 1e-12);
-        assert_eq!(s.specific_force_b, Vector3::new(0.0, 0.0, -GRAVITY_MPS2));
+        assert_eq!(
+            s.specific_force_b,
+            Vector3::new(0.0, 0.0, -STANDARD_GRAVITY)
+        );
         assert_eq!(s.latitude_rad, config.origin_latitude_deg.to_radians());
         assert_eq!(s.longitude_rad, config.origin_longitude_deg.to_radians());
         assert_eq!(s.altitude_m, config.origin_altitude_m);

@@ -8,13 +8,15 @@ mod counting_alloc;
 
 use counting_alloc::allocations_during;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use rins_acquisition::protocol::Payload;
-use rins_sim::trajectory::geodesy::{geodetic_rates, meridian_radius_m, prime_vertical_radius_m};
+use rins_earth::STANDARD_GRAVITY;
+use rins_earth::{meridian_radius, prime_vertical_radius};
+use rins_protocol::Payload;
+use rins_sim::trajectory::geodesy::geodetic_rates;
 use rins_sim::trajectory::walk::{
     self, COURSE_LENGTH_M, COURSE_WIDTH_M, FINAL_STAND_S, LIFT_M, LOAD_RAMP_S, PATH_LENGTH_M,
     STANCE_LOAD, STANCE_S, STRIDE_PERIOD_S, SWING_S, WalkPath,
 };
-use rins_sim::{GRAVITY_MPS2, Scenario, SimConfig, Simulator, TickOutput, Trajectory, TruthState};
+use rins_sim::{Scenario, SimConfig, Simulator, TickOutput, Trajectory, TruthState};
 
 /// Truth is sampled on the simulator's 1 kHz grid.
 const H: f64 = 1e-3;
@@ -53,8 +55,8 @@ fn local_from_geodetic(s: &TruthState, config: &SimConfig) -> Vector3<f64> {
         config.origin_altitude_m,
     );
     Vector3::new(
-        (s.latitude_rad - lat0) * (meridian_radius_m(lat0) + h0),
-        (s.longitude_rad - lon0) * (prime_vertical_radius_m(lat0) + h0) * lat0.cos(),
+        (s.latitude_rad - lat0) * (meridian_radius(lat0) + h0),
+        (s.longitude_rad - lon0) * (prime_vertical_radius(lat0) + h0) * lat0.cos(),
         h0 - s.altitude_m,
     )
 }
@@ -154,8 +156,8 @@ fn flat_geodetic_map_matches_the_curvilinear_mechanisation() {
         let r4 = rates(&end, lat + H * r3[0]);
         lat += H / 6.0 * (r1[0] + 2.0 * r2[0] + 2.0 * r3[0] + r4[0]);
         lon += H / 6.0 * (r1[1] + 2.0 * r2[1] + 2.0 * r3[1] + r4[1]);
-        let north = (lat - end.latitude_rad) * meridian_radius_m(lat);
-        let east = (lon - end.longitude_rad) * prime_vertical_radius_m(lat) * lat.cos();
+        let north = (lat - end.latitude_rad) * meridian_radius(lat);
+        let east = (lon - end.longitude_rad) * prime_vertical_radius(lat) * lat.cos();
         max_err = max_err.max(north.hypot(east));
         prev = end;
     }
@@ -170,7 +172,7 @@ fn q_dot(q: &Quaternion<f64>, w: &Vector3<f64>) -> Quaternion<f64> {
 /// Navigation-frame acceleration rebuilt from the truth specific force and attitude `q`.
 fn nav_accel(q: &Quaternion<f64>, s: &TruthState) -> Vector3<f64> {
     UnitQuaternion::from_quaternion(*q).transform_vector(&s.specific_force_b)
-        + Vector3::new(0.0, 0.0, GRAVITY_MPS2)
+        + Vector3::new(0.0, 0.0, STANDARD_GRAVITY)
 }
 
 /// Largest errors of a strapdown integration of the truth body rate and specific force.
@@ -321,7 +323,7 @@ fn foot_rests_exactly_in_stance_and_swings_plausibly() {
             assert_eq!(s.acceleration_n, Vector3::zeros(), "t={}", s.time_s);
             assert_eq!((s.euler_rad[0], s.euler_rad[1]), (0.0, 0.0));
             assert_eq!(s.altitude_m, config.origin_altitude_m);
-            let level = Vector3::new(0.0, 0.0, -GRAVITY_MPS2);
+            let level = Vector3::new(0.0, 0.0, -STANDARD_GRAVITY);
             assert!((s.specific_force_b - level).norm() < 1e-12);
         } else {
             peak_speed = peak_speed.max(s.velocity_n.norm());

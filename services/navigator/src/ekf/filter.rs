@@ -5,8 +5,8 @@ use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use super::noise::EkfNoise;
 use super::{ATT, BA, BG, Covariance, POS, STATES, VEL};
 use crate::attitude::{rotation_vector_to_quaternion, wrap_pi};
-use crate::earth::{meridian_radius, prime_vertical_radius};
 use crate::mechanisation::{ImuBias, NominalState, StepOutcome, Strapdown, StrapdownConfig};
+use rins_earth::{meridian_radius, prime_vertical_radius};
 
 /// Smallest `cos φ` used when turning an east error into longitude.
 const MIN_COS_LATITUDE: f64 = 1e-6;

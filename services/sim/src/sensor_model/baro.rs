@@ -3,12 +3,12 @@
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
-use rins_acquisition::protocol::BaroFrame;
+use rins_protocol::BaroFrame;
 
 use super::temperature::to_centi_c;
 
 // One ISA for the whole product: the simulated barometer follows the same law the altimeter inverts.
-pub use rins_altimeter::isa::{
+pub use rins_earth::isa::{
     altitude_to_pressure as isa_pressure_pa, pressure_to_altitude as isa_altitude_m,
     temperature_k as isa_temperature_k,
 };

@@ -2,11 +2,11 @@
 
 use serde::Deserialize;
 
-use crate::GRAVITY_MPS2;
 use crate::error::{SimError, check_positive, check_range};
+use rins_earth::STANDARD_GRAVITY;
 
 /// The converter is the protocol's: signed 12-bit counts.
-pub use rins_acquisition::protocol::layout::{
+pub use rins_protocol::layout::{
     COUNT_MAX as ADC_MAX, COUNT_MIN as ADC_MIN, COUNTS_PER_FULL_SCALE as ADC_HALF_RANGE,
 };
 /// Module temperature sensors the frame can carry.
@@ -119,7 +119,7 @@ impl SensorModelConfig {
 
     /// Accelerometer ADC resolution: m/s² per count.
     pub fn accel_lsb_mps2(&self) -> f64 {
-        self.accel_full_scale_g * GRAVITY_MPS2 / ADC_HALF_RANGE
+        self.accel_full_scale_g * STANDARD_GRAVITY / ADC_HALF_RANGE
     }
 
     /// Checks every field; the error names the field (prefixed `sim.sensors.`) and its value.

@@ -5,7 +5,7 @@
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
-use rins_acquisition::protocol::AuxFrame;
+use rins_protocol::AuxFrame;
 
 /// Counts of a fully loaded sensor.
 const FULL_SCALE_COUNTS: f64 = u16::MAX as f64;

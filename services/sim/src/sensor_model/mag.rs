@@ -5,7 +5,7 @@ use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
-use rins_acquisition::protocol::MagFrame;
+use rins_protocol::MagFrame;
 
 /// The local Earth magnetic field.
 #[derive(Debug, Clone, Copy, PartialEq)]

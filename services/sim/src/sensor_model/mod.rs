@@ -18,9 +18,8 @@ use ipc_types::MAX_CHANNELS;
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rins_acquisition::protocol::{AuxFrame, BaroFrame, ImuFrame, MagFrame};
+use rins_protocol::{AuxFrame, BaroFrame, ImuFrame, MagFrame};
 
-use crate::GRAVITY_MPS2;
 use crate::error::SimError;
 use crate::trajectory::TruthState;
 use baro::BaroModel;
@@ -29,6 +28,7 @@ use fault::{ChannelFault, InertialSensor};
 use foot_pressure::FootPressureModel;
 use inertial::{BankParams, ChannelErrors, InertialBank};
 use mag::{EarthField, MagModel};
+use rins_earth::STANDARD_GRAVITY;
 pub use temperature::TEMPERATURE_SLOTS;
 use temperature::TemperatureModel;
 
@@ -147,12 +147,15 @@ impl SensorModel {
             },
             &mut construction,
         );
-        let mg = 1e-3 * GRAVITY_MPS2;
+        let mg = 1e-3 * STANDARD_GRAVITY;
         let accel = InertialBank::new(
             &accel_axes,
             &BankParams {
                 lsb: config.accel_lsb_mps2(),
-                white_sigma: config.accel_noise_density_ug_rthz * 1e-6 * GRAVITY_MPS2 * sqrt_rate,
+                white_sigma: config.accel_noise_density_ug_rthz
+                    * 1e-6
+                    * STANDARD_GRAVITY
+                    * sqrt_rate,
                 turn_on_sigma: config.accel_turn_on_bias_sigma_mg * mg,
                 gm_sigma: config.accel_bias_instability_sigma_mg * mg,
                 gm_tau_s: config.accel_bias_instability_tau_s,

@@ -15,7 +15,7 @@ use super::geodesy::{GeodeticTable, Kinematics};
 use super::schedule::Schedule;
 use super::uav_profile::UavProfile;
 use super::{Landmarks, TrajectoryStart, TruthState, attitude_and_body_rate, specific_force_b};
-use crate::GRAVITY_MPS2;
+use rins_earth::STANDARD_GRAVITY;
 
 /// Grid spacing of the precomputed latitude/longitude table, seconds.
 const GEODETIC_TABLE_SPACING_S: f64 = 0.01;
@@ -112,9 +112,9 @@ impl FlightPath {
         let psi = self.start.heading_rad + hr.integral;
         let (h_dot, h_ddot) = (cr.value, cr.rate);
 
-        let k = v * psi_dot / GRAVITY_MPS2;
+        let k = v * psi_dot / STANDARD_GRAVITY;
         let roll = k.atan();
-        let roll_dot = (v_dot * psi_dot + v * psi_ddot) / GRAVITY_MPS2 / (1.0 + k * k);
+        let roll_dot = (v_dot * psi_dot + v * psi_ddot) / STANDARD_GRAVITY / (1.0 + k * k);
         let d = v * v + h_dot * h_dot;
         let (pitch, pitch_dot) = if d > 1e-12 {
             (h_dot.atan2(v), (v * h_ddot - h_dot * v_dot) / d)

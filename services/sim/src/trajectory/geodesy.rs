@@ -1,4 +1,4 @@
-//! WGS84 curvature radii and the tabulated latitude/longitude path.
+//! The tabulated latitude/longitude path over the WGS84 ellipsoid (radii from `rins_earth`).
 //!
 //! Latitude and longitude are the integral of the curvilinear kinematics over a non-rotating
 //! ellipsoid, `φ̇ = v_N/(R_M(φ)+h)`, `λ̇ = v_E/((R_N(φ)+h) cos φ)`, so a navigator mechanised with
@@ -6,27 +6,13 @@
 //! fixed grid and sampled by cubic Hermite interpolation (value and rate at both knots), which keeps
 //! the sampled position's derivative consistent with the velocity to far below a millimetre.
 
-/// WGS84 semi-major axis, metres.
-pub const WGS84_A: f64 = 6_378_137.0;
-/// WGS84 first eccentricity squared.
-pub const WGS84_E2: f64 = 6.694_379_990_14e-3;
-
-/// Meridian radius of curvature R_M(φ), metres.
-pub fn meridian_radius_m(latitude_rad: f64) -> f64 {
-    let w2 = 1.0 - WGS84_E2 * latitude_rad.sin().powi(2);
-    WGS84_A * (1.0 - WGS84_E2) / (w2 * w2.sqrt())
-}
-
-/// Prime-vertical radius of curvature R_N(φ), metres.
-pub fn prime_vertical_radius_m(latitude_rad: f64) -> f64 {
-    WGS84_A / (1.0 - WGS84_E2 * latitude_rad.sin().powi(2)).sqrt()
-}
+use rins_earth::{meridian_radius, prime_vertical_radius};
 
 /// (φ̇, λ̇) in rad/s for a north/east velocity at latitude φ and altitude h.
 pub fn geodetic_rates(latitude_rad: f64, altitude_m: f64, v_north: f64, v_east: f64) -> [f64; 2] {
     [
-        v_north / (meridian_radius_m(latitude_rad) + altitude_m),
-        v_east / ((prime_vertical_radius_m(latitude_rad) + altitude_m) * latitude_rad.cos()),
+        v_north / (meridian_radius(latitude_rad) + altitude_m),
+        v_east / ((prime_vertical_radius(latitude_rad) + altitude_m) * latitude_rad.cos()),
     ]
 }
 
@@ -129,17 +115,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn radii_match_known_values() {
-        // Equator: R_M = a(1−e²), R_N = a; pole: both a/√(1−e²).
-        assert!((meridian_radius_m(0.0) - 6_335_439.327).abs() < 1e-2);
-        assert!((prime_vertical_radius_m(0.0) - WGS84_A).abs() < 1e-9);
-        let polar = WGS84_A / (1.0 - WGS84_E2).sqrt();
-        let p = std::f64::consts::FRAC_PI_2;
-        assert!((meridian_radius_m(p) - polar).abs() < 1e-3);
-        assert!((prime_vertical_radius_m(p) - polar).abs() < 1e-3);
-    }
-
-    #[test]
     fn constant_north_velocity_advances_latitude_by_distance_over_radius() {
         let lat0 = 0.8;
         let table = GeodeticTable::integrate(lat0, 0.1, 0.0, 100.0, 0.01, |_| Kinematics {
@@ -149,13 +124,11 @@ mod tests {
         });
         let [lat, lon] = table.sample(100.0);
         // Over 1 km R_M changes by ~1e-4 relative: the first-order estimate holds to ~1e-11 rad.
-        let approx =
-            lat0 + 1000.0 / meridian_radius_m(lat0 + 0.5 * 1000.0 / meridian_radius_m(lat0));
+        let approx = lat0 + 1000.0 / meridian_radius(lat0 + 0.5 * 1000.0 / meridian_radius(lat0));
         assert!((lat - approx).abs() < 1e-11, "{lat} vs {approx}");
         assert_eq!(lon, 0.1);
         let mid = table.sample(50.005)[0];
-        let expected_mid =
-            lat0 + 500.05 / meridian_radius_m(lat0 + 250.0 / meridian_radius_m(lat0));
+        let expected_mid = lat0 + 500.05 / meridian_radius(lat0 + 250.0 / meridian_radius(lat0));
         assert!((mid - expected_mid).abs() < 1e-11);
     }
 }

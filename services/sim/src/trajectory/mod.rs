@@ -8,7 +8,7 @@
 //! - specific force f_b = C_nbᵀ (a − g_n), g_n = [0, 0, +g].
 //!
 //! The Earth is **non-rotating**: the truth body rate has no Earth-rate component and the specific
-//! force has no Coriolis or centripetal terms. Gravity is the constant [`GRAVITY_MPS2`]. Altitude is
+//! force has no Coriolis or centripetal terms. Gravity is the constant [`STANDARD_GRAVITY`]. Altitude is
 //! above mean sea level, the origin altitude being ground level.
 
 pub mod flight;
@@ -21,8 +21,8 @@ pub mod walk;
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::Deserialize;
 
-use crate::GRAVITY_MPS2;
 use flight::FlightPath;
+use rins_earth::STANDARD_GRAVITY;
 use walk::WalkPath;
 
 /// Which motion the simulator produces.
@@ -193,5 +193,5 @@ fn attitude_and_body_rate(
 
 /// Specific force in the body frame, f_b = C_nbᵀ (a − g_n), for acceleration `a` NED.
 fn specific_force_b(attitude: &UnitQuaternion<f64>, acceleration_n: &Vector3<f64>) -> Vector3<f64> {
-    attitude.inverse_transform_vector(&(acceleration_n - Vector3::new(0.0, 0.0, GRAVITY_MPS2)))
+    attitude.inverse_transform_vector(&(acceleration_n - Vector3::new(0.0, 0.0, STANDARD_GRAVITY)))
 }

@@ -6,7 +6,7 @@
 //! a landing roll to a stop, then parked for as long as the simulation runs.
 
 use super::schedule::Schedule;
-use crate::GRAVITY_MPS2;
+use rins_earth::STANDARD_GRAVITY;
 
 /// Horizontal ground speed in cruise, m/s.
 pub const CRUISE_SPEED_MPS: f64 = 15.0;
@@ -131,7 +131,7 @@ fn coordinated_turn(
     turn_deg: f64,
     bank_deg: f64,
 ) -> f64 {
-    let rate = GRAVITY_MPS2 * bank_deg.to_radians().tan() / CRUISE_SPEED_MPS;
+    let rate = STANDARD_GRAVITY * bank_deg.to_radians().tan() / CRUISE_SPEED_MPS;
     let hold_s = (turn_deg.to_radians().abs() / rate - ROLL_TRANSITION_S).max(0.0);
     heading_rate.step_to(start_s, ROLL_TRANSITION_S, rate * turn_deg.signum());
     heading_rate.step_to(start_s + ROLL_TRANSITION_S + hold_s, ROLL_TRANSITION_S, 0.0);

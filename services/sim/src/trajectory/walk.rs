@@ -25,10 +25,10 @@ use std::f64::consts::FRAC_PI_4;
 
 use nalgebra::Vector3;
 
-use super::geodesy::{meridian_radius_m, prime_vertical_radius_m};
 use super::{
     Landmarks, TrajectoryStart, TruthState, attitude_and_body_rate, gait, specific_force_b,
 };
+use rins_earth::{meridian_radius, prime_vertical_radius};
 
 /// Long side of the rectangle, m.
 pub const COURSE_LENGTH_M: f64 = 50.0;
@@ -142,8 +142,8 @@ impl WalkPath {
         }
         let lat = start.latitude_rad;
         let rad_per_m = [
-            1.0 / (meridian_radius_m(lat) + start.altitude_m),
-            1.0 / ((prime_vertical_radius_m(lat) + start.altitude_m) * lat.cos()),
+            1.0 / (meridian_radius(lat) + start.altitude_m),
+            1.0 / ((prime_vertical_radius(lat) + start.altitude_m) * lat.cos()),
         ];
         Self {
             start,

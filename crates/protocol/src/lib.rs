@@ -1,0 +1,26 @@
+//! The sensor block's serial protocol (see `docs/protocol.md`): frame types, the wire codec and
+//! the streaming decoder with its sequence and clock extension — the contract between the device
+//! (or the simulator that plays it) and acquisition. Pure: no I/O.
+
+pub mod arrival;
+pub mod codec;
+pub mod continuity;
+pub mod decoder;
+pub mod error;
+pub mod frame;
+pub mod frame_period;
+pub mod layout;
+pub mod resume_point;
+pub mod seq_extend;
+pub mod seq_window;
+pub mod time_extend;
+
+pub use codec::{decode_frame, encode, peek_frame_len};
+pub use continuity::Continuity;
+pub use decoder::{Decoder, DecoderStats};
+pub use error::{DecodeError, EncodeError};
+pub use frame::*;
+pub use layout::{MAX_FRAME_LEN, MAX_PAYLOAD_LEN};
+pub use resume_point::{ResumeError, ResumePoint};
+pub use seq_extend::{SeqExtender, SeqVerdict};
+pub use time_extend::{ExtendedTime, TimeExtender};
