@@ -1,6 +1,6 @@
 //! `rins eval fdi` on the real quadrotor recordings and `rins mc`, end to end through the binary.
-//! The recordings live outside the repository (`<repo>/../shared/data/quadrotor-4imu`); the FDI
-//! tests print a note and return when they are absent.
+//! The recordings are not in the repository (`quadrotor-4imu` in `$RINS_DATA_DIR`, else
+//! `<repo>/data`); the FDI tests print a note and return when they are absent.
 
 mod common;
 

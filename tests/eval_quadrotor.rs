@@ -1,5 +1,5 @@
-//! `rins eval quadrotor` end to end through the binary. The recordings live outside the repository
-//! (`<repo>/../shared/data/quadrotor-4imu`); the tests on them print a note and return when they
+//! `rins eval quadrotor` end to end through the binary. The recordings are not in the repository
+//! (`quadrotor-4imu` in `$RINS_DATA_DIR`, else `<repo>/data`); the tests on them print a note and return when they
 //! are absent. The error cases need no data.
 
 mod common;

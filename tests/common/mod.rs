@@ -199,15 +199,9 @@ impl Drop for Scratch {
     }
 }
 
-/// The quadrotor recordings beside the repository, or `None` (with a note) when they are absent.
+/// The quadrotor recordings in the recordings directory, or `None` (with a note) when they are absent.
 pub fn quadrotor_data_dir() -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/quadrotor-4imu");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("note: {} not found; test skipped", dir.display());
-        None
-    }
+    rins_eval::datasets::recording_set("quadrotor-4imu")
 }
 
 /// `rins up ARGS` started in the background on `ipc`'s namespace, stdout piped for its summary.

@@ -1,5 +1,5 @@
-//! The quadrotor loader on the real recordings. The data live outside the repository, at
-//! `<repo>/../shared/data/quadrotor-4imu`; every test here prints a note and returns when they are
+//! The quadrotor loader on the real recordings. The data are not in the repository: they
+//! are read from `quadrotor-4imu` in the recordings directory (`$RINS_DATA_DIR`, else `<repo>/data`); every test here prints a note and returns when they are
 //! absent ("..._when_present"). `-- --nocapture` shows the figures each test measures.
 
 use std::path::PathBuf;
@@ -14,13 +14,7 @@ use rins_eval::installation::{angle_between, estimate_relative_rotation, residua
 use rins_fusion::{Geometry, GeometryConfig};
 
 fn data_dir() -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/quadrotor-4imu");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("note: {} not found; test skipped", dir.display());
-        None
-    }
+    rins_eval::datasets::recording_set("quadrotor-4imu")
 }
 
 fn trials() -> Option<Vec<Trial>> {

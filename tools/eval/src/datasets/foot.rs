@@ -267,10 +267,10 @@ mod tests {
         assert_eq!(e.to_string(), "/nonexistent/rins/w.csv: missing (walk)");
     }
 
-    /// Every recording at hand, when the shared data directory is there.
+    /// Every recording at hand, when the recordings directory is there.
     #[test]
     fn real_recordings_load_with_their_rates_and_a_z_down_rest() {
-        let data = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data"));
+        let data = super::super::recordings_dir();
         if !data.is_dir() {
             return;
         }
