@@ -108,7 +108,7 @@ pub struct LaneSelector {
 
 /// A solution the selector may choose for quality.
 pub fn trusted(s: &NavState, settle: u64) -> bool {
-    NavMode::from_u8(s.mode).is_usable()
+    NavMode::from_u8(s.mode).is_some_and(NavMode::is_usable)
         && s.solution_start_seq != 0
         && s.header.origin_seq.saturating_sub(s.solution_start_seq) >= settle
         && s.quaternion.iter().all(|q| q.is_finite())

@@ -24,7 +24,8 @@ pub struct FaultRecord {
     pub detected_at_s: Option<f64>,
     /// First fused output at or after injection with the channel Excluded.
     pub isolated_at_s: Option<f64>,
-    /// [`FaultReason`] name given for the exclusion.
+    /// [`FaultReason`] name given for the exclusion (`unknown` for a number this build cannot
+    /// read).
     pub reason: Option<&'static str>,
     /// When the fault was cleared or replaced by another fault on the same channel.
     pub cleared_at_s: Option<f64>,
@@ -44,7 +45,8 @@ impl FaultRecord {
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct ChannelTrack {
     state: ChannelState,
-    reason: FaultReason,
+    /// Name of the [`FaultReason`] fusion gave.
+    reason: &'static str,
     /// Start of the current stretch away from Ok (Suspect or Excluded).
     not_ok_since_s: Option<f64>,
     /// Start of the current exclusion.
@@ -55,7 +57,7 @@ impl Default for ChannelTrack {
     fn default() -> Self {
         Self {
             state: ChannelState::Ok,
-            reason: FaultReason::None,
+            reason: FaultReason::None.name(),
             not_ok_since_s: None,
             excluded_since_s: None,
         }
@@ -175,7 +177,7 @@ impl FaultTracker {
         record.detected_at_s = detected.into_iter().flatten().reduce(f64::min);
         if let Some(s) = since_injection(track.excluded_since_s) {
             record.isolated_at_s = Some(s);
-            record.reason = Some(track.reason.name());
+            record.reason = Some(track.reason);
         }
         self.false_alarms
             .retain(|a| !(a.sensor == sensor && a.t_s >= t_s));
@@ -207,8 +209,10 @@ impl FaultTracker {
             }
 
             for i in 0..n {
-                let state = ChannelState::from_u8(states[i]);
-                let reason = FaultReason::from_u8(reasons[i]);
+                // A state this build cannot read is not Ok: it counts as a channel in doubt
+                // (Suspect), so that an unreadable output is never taken for a healthy channel.
+                let state = ChannelState::from_u8(states[i]).unwrap_or(ChannelState::Suspect);
+                let reason = FaultReason::from_u8(reasons[i]).map_or("unknown", FaultReason::name);
                 let track = &mut self.channels[ti][i];
                 if state == ChannelState::Absent {
                     *track = ChannelTrack::default();
@@ -245,7 +249,7 @@ impl FaultTracker {
                 }
                 if r.isolated_at_s.is_none() && state == ChannelState::Excluded {
                     r.isolated_at_s = Some(t_s);
-                    r.reason = Some(self.channels[ti][r.index].reason.name());
+                    r.reason = Some(self.channels[ti][r.index].reason);
                 }
             }
         }
