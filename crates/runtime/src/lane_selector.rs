@@ -318,6 +318,25 @@ mod tests {
     }
 
     #[test]
+    fn only_a_settled_usable_mode_is_trusted() {
+        let settled = nav(0, 1 + SETTLE, 1);
+        assert!(trusted(&settled, SETTLE));
+        let coasting = NavState {
+            mode: NavMode::Coasting as u8,
+            ..settled
+        };
+        assert!(trusted(&coasting, SETTLE));
+        // Aligning, invalid, or a mode this build cannot read: no usable solution.
+        for mode in [NavMode::Aligning as u8, NavMode::Invalid as u8, 4, u8::MAX] {
+            assert!(
+                !trusted(&NavState { mode, ..settled }, SETTLE),
+                "mode {mode}"
+            );
+        }
+        assert!(!trusted(&nav(0, SETTLE, 1), SETTLE));
+    }
+
+    #[test]
     fn healthy_lanes_deliver_the_selected_lane_once_in_order() {
         let mut sel = LaneSelector::new(cfg());
         let mut out = Vec::new();

@@ -415,6 +415,32 @@ mod tests {
     }
 
     #[test]
+    fn a_state_or_reason_that_cannot_be_read_is_not_taken_for_ok() {
+        let mut tr = FaultTracker::new();
+        // An unknown state byte with no fault active: a channel in doubt, so a false alarm.
+        run(&mut tr, 0, 100_000, |t, mut f| {
+            if t >= 50_000 {
+                f.gyro_state[0] = u8::MAX;
+            }
+            f
+        });
+        assert_eq!(tr.false_alarms(), 1);
+        // An exclusion with an unknown reason is an isolation, named as unknown.
+        tr.on_fault_applied(&event(SensorType::Accel, 1, SimFault::Stuck, 1_000_000));
+        run(&mut tr, 1_000_000, 1_100_000, |t, mut f| {
+            if t >= 1_030_000 {
+                f.accel_state[1] = ChannelState::Excluded as u8;
+                f.accel_reason[1] = u8::MAX;
+            }
+            f
+        });
+        let r = &tr.records()[0];
+        assert_eq!(r.detected_at_s, Some(1.03));
+        assert_eq!(r.isolated_at_s, Some(1.03));
+        assert_eq!(r.reason, Some("unknown"));
+    }
+
+    #[test]
     fn clearing_ends_the_fault_and_later_alarms_count() {
         let mut tr = FaultTracker::new();
         tr.on_fault_applied(&event(SensorType::Gyro, 1, SimFault::Dead, 1_000_000));

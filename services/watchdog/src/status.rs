@@ -146,6 +146,27 @@ mod tests {
     }
 
     #[test]
+    fn a_mode_or_integrity_that_cannot_be_read_is_shown_as_such() {
+        let unknown = NavState {
+            mode: 200,
+            integrity: 200,
+            ..NavState::default()
+        };
+        let line = status_line(
+            3.0,
+            &[1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0],
+            0,
+            &DeviceCounters::default(),
+            Some(&unknown),
+        );
+        assert!(
+            line.contains("| mode 200 roll") && line.contains("integrity INVALID: "),
+            "{line}"
+        );
+        assert!(!line.contains("aligning"), "{line}");
+    }
+
+    #[test]
     fn rare_device_counters_appear_only_when_non_zero() {
         let rates = [1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0];
         let quiet = status_line(4.0, &rates, 0, &DeviceCounters::default(), None);
