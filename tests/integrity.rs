@@ -37,12 +37,18 @@ fn device_s(v: &Value) -> f64 {
         * 1e-6
 }
 
+/// The sample's integrity; one that cannot be read counts as invalid.
 fn integrity(v: &Value) -> Integrity {
-    Integrity::from_u8(v["integrity"].as_u64().unwrap_or(255) as u8)
+    let value = v["integrity"].as_u64().and_then(|i| u8::try_from(i).ok());
+    value
+        .and_then(Integrity::from_u8)
+        .unwrap_or(Integrity::Invalid)
 }
 
-fn mode(v: &Value) -> NavMode {
-    NavMode::from_u8(v["mode"].as_u64().unwrap_or(255) as u8)
+/// The sample's mode, `None` when it cannot be read.
+fn mode(v: &Value) -> Option<NavMode> {
+    let value = v["mode"].as_u64().and_then(|m| u8::try_from(m).ok());
+    value.and_then(NavMode::from_u8)
 }
 
 fn reasons(v: &Value) -> u32 {
@@ -79,7 +85,7 @@ fn episode(
     let up = spawn_up(&ipc, &["--port", device.tty(), "--json"]);
     let nav = TopicStream::start(&ipc, "nav");
     let (before, _) = nav.wait_for("ok before the fault", 0, WAIT, |v| {
-        integrity(v) == Integrity::Ok && mode(v) == NavMode::Navigating
+        integrity(v) == Integrity::Ok && mode(v) == Some(NavMode::Navigating)
     });
     let (i, _) = nav.wait_for("at the fault", before, WAIT, |v| device_s(v) >= FAULT_AT_S);
     let (_, first_bad) = nav.wait_for("not ok after the fault", i, WAIT, |v| {
@@ -99,7 +105,7 @@ fn episode(
         all_reasons |= reasons(v);
         // Never navigating while invalid, in any sample.
         if integrity(v) == Integrity::Invalid {
-            assert_eq!(mode(v), NavMode::Invalid, "{v}");
+            assert_eq!(mode(v), Some(NavMode::Invalid), "{v}");
             assert_eq!(v["aiding"].as_u64().unwrap_or(0) & 0xff, 0, "{v}");
         }
     }
@@ -158,7 +164,7 @@ fn assert_back_within(e: &Episode, fault_s: f64, within_s: f64) {
         "ok again only at {t} s (fault ended at {} s)",
         FAULT_AT_S + fault_s
     );
-    assert_eq!(mode(&e.back_ok), NavMode::Navigating, "{}", e.back_ok);
+    assert_eq!(mode(&e.back_ok), Some(NavMode::Navigating), "{}", e.back_ok);
 }
 
 #[test]

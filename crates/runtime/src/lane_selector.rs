@@ -108,7 +108,7 @@ pub struct LaneSelector {
 
 /// A solution the selector may choose for quality.
 pub fn trusted(s: &NavState, settle: u64) -> bool {
-    NavMode::from_u8(s.mode).is_usable()
+    NavMode::from_u8(s.mode).is_some_and(NavMode::is_usable)
         && s.solution_start_seq != 0
         && s.header.origin_seq.saturating_sub(s.solution_start_seq) >= settle
         && s.quaternion.iter().all(|q| q.is_finite())
@@ -315,6 +315,25 @@ mod tests {
         while let Some(s) = sel.pop() {
             out.push((s.header.origin_seq, s.lane));
         }
+    }
+
+    #[test]
+    fn only_a_settled_usable_mode_is_trusted() {
+        let settled = nav(0, 1 + SETTLE, 1);
+        assert!(trusted(&settled, SETTLE));
+        let coasting = NavState {
+            mode: NavMode::Coasting as u8,
+            ..settled
+        };
+        assert!(trusted(&coasting, SETTLE));
+        // Aligning, invalid, or a mode this build cannot read: no usable solution.
+        for mode in [NavMode::Aligning as u8, NavMode::Invalid as u8, 4, u8::MAX] {
+            assert!(
+                !trusted(&NavState { mode, ..settled }, SETTLE),
+                "mode {mode}"
+            );
+        }
+        assert!(!trusted(&nav(0, SETTLE, 1), SETTLE));
     }
 
     #[test]

@@ -44,9 +44,10 @@ pub fn step(nav: &mut Navigator, imu: &FusedImu, last: &NavState) -> NavState {
             out.integrity_reasons = reasons;
         }
     }
-    // The first sample of a solution marks its start; aligning has none.
+    // The first sample of a solution marks its start; aligning has none, nor has a mode that
+    // is not one of ours.
     out.solution_start_seq = match NavMode::from_u8(out.mode) {
-        NavMode::Aligning => 0,
+        Some(NavMode::Aligning) | None => 0,
         _ if last.solution_start_seq == 0 => imu.header.origin_seq,
         _ => last.solution_start_seq,
     };
@@ -90,7 +91,8 @@ fn take_over_if_ready(
 
 /// A change of the integrity level, with its reasons (rare: logged off the per-sample path).
 fn log_integrity(state: &NavState) {
-    let integrity = Integrity::from_u8(state.integrity);
+    // An integrity that cannot be read is not to be trusted.
+    let integrity = Integrity::from_u8(state.integrity).unwrap_or(Integrity::Invalid);
     let reasons = integrity_reason::describe(state.integrity_reasons);
     let t = state.header.origin_device_time_us;
     match integrity {
@@ -211,7 +213,7 @@ pub fn run(
             state.version = PAYLOAD_VERSION;
             state.header.stamp(Stage::Navigator, monotonic_ns());
             output.publish(state)?;
-            let aligned = NavMode::from_u8(state.mode) != NavMode::Aligning;
+            let aligned = NavMode::from_u8(state.mode).is_some_and(|m| m != NavMode::Aligning);
             if aligned && state.integrity != last.integrity {
                 log_integrity(&state);
             }

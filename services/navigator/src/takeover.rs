@@ -44,8 +44,9 @@ pub struct PeerSolution {
 
 /// Checks a peer's sample and reads its filter state.
 pub fn peer_solution(peer: &NavState) -> Result<PeerSolution, TakeOverError> {
-    // An invalid solution is not worth taking over: a lane that aligns on its own is better.
-    if !NavMode::from_u8(peer.mode).is_usable() {
+    // An invalid solution is not worth taking over: a lane that aligns on its own is better. A
+    // mode this build cannot read is no usable solution either.
+    if !NavMode::from_u8(peer.mode).is_some_and(NavMode::is_usable) {
         return Err(TakeOverError::NotNavigating(peer.mode));
     }
     if !trusted(peer, SelectorConfig::default().settle) {

@@ -24,7 +24,8 @@ pub struct FaultRecord {
     pub detected_at_s: Option<f64>,
     /// First fused output at or after injection with the channel Excluded.
     pub isolated_at_s: Option<f64>,
-    /// [`FaultReason`] name given for the exclusion.
+    /// [`FaultReason`] name given for the exclusion (`unknown` for a number this build cannot
+    /// read).
     pub reason: Option<&'static str>,
     /// When the fault was cleared or replaced by another fault on the same channel.
     pub cleared_at_s: Option<f64>,
@@ -44,7 +45,8 @@ impl FaultRecord {
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct ChannelTrack {
     state: ChannelState,
-    reason: FaultReason,
+    /// Name of the [`FaultReason`] fusion gave.
+    reason: &'static str,
     /// Start of the current stretch away from Ok (Suspect or Excluded).
     not_ok_since_s: Option<f64>,
     /// Start of the current exclusion.
@@ -55,7 +57,7 @@ impl Default for ChannelTrack {
     fn default() -> Self {
         Self {
             state: ChannelState::Ok,
-            reason: FaultReason::None,
+            reason: FaultReason::None.name(),
             not_ok_since_s: None,
             excluded_since_s: None,
         }
@@ -175,7 +177,7 @@ impl FaultTracker {
         record.detected_at_s = detected.into_iter().flatten().reduce(f64::min);
         if let Some(s) = since_injection(track.excluded_since_s) {
             record.isolated_at_s = Some(s);
-            record.reason = Some(track.reason.name());
+            record.reason = Some(track.reason);
         }
         self.false_alarms
             .retain(|a| !(a.sensor == sensor && a.t_s >= t_s));
@@ -207,8 +209,10 @@ impl FaultTracker {
             }
 
             for i in 0..n {
-                let state = ChannelState::from_u8(states[i]);
-                let reason = FaultReason::from_u8(reasons[i]);
+                // A state this build cannot read is not Ok: it counts as a channel in doubt
+                // (Suspect), so that an unreadable output is never taken for a healthy channel.
+                let state = ChannelState::from_u8(states[i]).unwrap_or(ChannelState::Suspect);
+                let reason = FaultReason::from_u8(reasons[i]).map_or("unknown", FaultReason::name);
                 let track = &mut self.channels[ti][i];
                 if state == ChannelState::Absent {
                     *track = ChannelTrack::default();
@@ -245,7 +249,7 @@ impl FaultTracker {
                 }
                 if r.isolated_at_s.is_none() && state == ChannelState::Excluded {
                     r.isolated_at_s = Some(t_s);
-                    r.reason = Some(self.channels[ti][r.index].reason.name());
+                    r.reason = Some(self.channels[ti][r.index].reason);
                 }
             }
         }
@@ -408,6 +412,32 @@ mod tests {
         f.n_gyro = 6;
         tr.on_fused(&f);
         assert_eq!(tr.false_alarms(), 4);
+    }
+
+    #[test]
+    fn a_state_or_reason_that_cannot_be_read_is_not_taken_for_ok() {
+        let mut tr = FaultTracker::new();
+        // An unknown state byte with no fault active: a channel in doubt, so a false alarm.
+        run(&mut tr, 0, 100_000, |t, mut f| {
+            if t >= 50_000 {
+                f.gyro_state[0] = u8::MAX;
+            }
+            f
+        });
+        assert_eq!(tr.false_alarms(), 1);
+        // An exclusion with an unknown reason is an isolation, named as unknown.
+        tr.on_fault_applied(&event(SensorType::Accel, 1, SimFault::Stuck, 1_000_000));
+        run(&mut tr, 1_000_000, 1_100_000, |t, mut f| {
+            if t >= 1_030_000 {
+                f.accel_state[1] = ChannelState::Excluded as u8;
+                f.accel_reason[1] = u8::MAX;
+            }
+            f
+        });
+        let r = &tr.records()[0];
+        assert_eq!(r.detected_at_s, Some(1.03));
+        assert_eq!(r.isolated_at_s, Some(1.03));
+        assert_eq!(r.reason, Some("unknown"));
     }
 
     #[test]

@@ -208,8 +208,11 @@ impl Monitor {
     fn on_nav(&mut self, nav: NavState) {
         let seq = nav.header.origin_seq;
         self.nav_gaps.observe(seq);
-        if NavMode::from_u8(nav.mode) != NavMode::Aligning {
-            self.integrity_samples[Integrity::from_u8(nav.integrity) as usize] += 1;
+        // Scored once aligned; a mode that cannot be read is no solution to score, and an
+        // integrity that cannot be read counts as invalid.
+        if NavMode::from_u8(nav.mode).is_some_and(|m| m != NavMode::Aligning) {
+            let integrity = Integrity::from_u8(nav.integrity).unwrap_or(Integrity::Invalid);
+            self.integrity_samples[integrity as usize] += 1;
             let truth = &self.truth_ring[(seq as usize) % TRUTH_RING];
             if truth.header.origin_seq == seq && truth.version != 0 {
                 self.accuracy.push(

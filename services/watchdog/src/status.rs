@@ -44,9 +44,11 @@ pub fn status_line(
     match nav {
         Some(nav) => {
             let [r, p, y] = euler_deg(nav.quaternion);
+            let mode = NavMode::from_u8(nav.mode);
+            // A mode this build does not know is named by its number.
+            let mode_name = mode.map_or_else(|| format!("mode {}", nav.mode), |m| m.name().into());
             line.push_str(&format!(
-                " | {} roll {r:6.2} pitch {p:6.2} yaw {y:7.2} alt {:7.1} m",
-                NavMode::from_u8(nav.mode).name(),
+                " | {mode_name} roll {r:6.2} pitch {p:6.2} yaw {y:7.2} alt {:7.1} m",
                 nav.altitude_m
             ));
             // Say so when the filter coasts: a configured aiding source has gone quiet.
@@ -58,8 +60,9 @@ pub fn status_line(
                     line.push_str(&format!(" | {what}, coasting"));
                 }
             }
-            let integrity = Integrity::from_u8(nav.integrity);
-            if integrity != Integrity::Ok && NavMode::from_u8(nav.mode) != NavMode::Aligning {
+            // An integrity that cannot be read is not to be trusted: shown as invalid.
+            let integrity = Integrity::from_u8(nav.integrity).unwrap_or(Integrity::Invalid);
+            if integrity != Integrity::Ok && mode != Some(NavMode::Aligning) {
                 line.push_str(&format!(
                     " | integrity {}: {}",
                     integrity.name().to_uppercase(),
@@ -140,6 +143,27 @@ mod tests {
             "{line}"
         );
         assert!(!line.contains("navigating"), "{line}");
+    }
+
+    #[test]
+    fn a_mode_or_integrity_that_cannot_be_read_is_shown_as_such() {
+        let unknown = NavState {
+            mode: 200,
+            integrity: 200,
+            ..NavState::default()
+        };
+        let line = status_line(
+            3.0,
+            &[1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0],
+            0,
+            &DeviceCounters::default(),
+            Some(&unknown),
+        );
+        assert!(
+            line.contains("| mode 200 roll") && line.contains("integrity INVALID: "),
+            "{line}"
+        );
+        assert!(!line.contains("aligning"), "{line}");
     }
 
     #[test]

@@ -109,7 +109,7 @@ fn all_channels_in(fused: &FusedImu) -> bool {
         states
             .iter()
             .take(usize::from(n))
-            .all(|&s| ChannelState::from_u8(s) == ChannelState::Ok)
+            .all(|&s| ChannelState::from_u8(s) == Some(ChannelState::Ok))
     };
     let pending = fused_flags::GYRO_FAULT_DETECTED_NOT_ISOLATED
         | fused_flags::ACCEL_FAULT_DETECTED_NOT_ISOLATED;

@@ -28,7 +28,8 @@ impl NavWatch {
     pub fn drain(&mut self, nav: &mut NavSubscriber) -> Result<()> {
         while let Some(n) = nav.receive()? {
             self.observe(n.header.origin_seq, Instant::now());
-            self.observe_mode(NavMode::from_u8(n.mode));
+            // A mode this build cannot read is no solution: counted as not navigating.
+            self.observe_mode(NavMode::from_u8(n.mode).unwrap_or(NavMode::Aligning));
         }
         Ok(())
     }

@@ -1,0 +1,148 @@
+//! Supervision: each process's heartbeat with its counters ([`Health`]) and the watchdog's view of
+//! every process ([`HealthReport`]).
+
+use iceoryx2::prelude::ZeroCopySend;
+use serde::Serialize;
+
+wire_enum! {
+    /// Which process a [`Health`] message speaks for; the name is the process's service name.
+    pub enum ServiceKind: u8 {
+        /// The device simulator, `rins sim`.
+        Simulator = 0 => "sim",
+        /// Serial acquisition.
+        Acquisition = 1 => "acquisition",
+        /// Redundancy fusion and fault detection.
+        Fusion = 2 => "fusion",
+        /// Barometric altimeter.
+        Altimeter = 3 => "altimeter",
+        /// The primary navigator lane (lane 0).
+        Navigator = 4 => "navigator",
+        /// The watchdog, `rins up`.
+        Watchdog = 5 => "watchdog",
+        /// The hot-standby navigator lane (lane 1).
+        NavigatorStandby = 6 => "navigator-standby",
+    }
+}
+
+impl ServiceKind {
+    /// The navigator process of each lane, [`crate::NavState::lane`].
+    pub const NAVIGATOR_LANES: [ServiceKind; 2] =
+        [ServiceKind::Navigator, ServiceKind::NavigatorStandby];
+}
+
+/// Periodic heartbeat and counters of one process, published once a second by every process on
+/// [`crate::names::HEARTBEAT`]. Counters count since the process started.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::Health")]
+pub struct Health {
+    /// Layout version, [`crate::PAYLOAD_VERSION`].
+    pub version: u16,
+    /// [`ServiceKind`] as u8.
+    pub service: u8,
+    /// Zero; makes the padding explicit so that the layout has no hidden bytes.
+    pub _pad: [u8; 1],
+    /// Process id of the sender.
+    pub pid: u32,
+    /// CLOCK_MONOTONIC ns when this heartbeat was published.
+    pub now_ns: u64,
+    /// Messages taken in since start.
+    pub received: u64,
+    /// Messages published since start.
+    pub published: u64,
+    /// Serial frames with a bad CRC (acquisition).
+    pub crc_errors: u64,
+    /// Frames missing from the device's sequence (acquisition), or input samples lost (others).
+    pub lost: u64,
+    /// Serial frames with a valid CRC but malformed content: unknown type, bad length, channel
+    /// counts or samples out of range (acquisition).
+    pub malformed: u64,
+    /// Serial frames whose sequence number was received before, not published (acquisition).
+    pub duplicates: u64,
+    /// Serial frames that arrived after a later one of their type (reordered), not published and
+    /// not counted in `lost` (acquisition).
+    pub late: u64,
+    /// Device sequence-counter discontinuities, re-based without counting losses (acquisition).
+    pub seq_jumps: u64,
+    /// Device-clock discontinuities, re-based on the receive clock (acquisition).
+    pub time_rebases: u64,
+    /// Bytes skipped while resynchronising (acquisition).
+    pub resync_bytes: u64,
+    /// Times the input device was reopened (acquisition).
+    pub reconnects: u64,
+    /// Payloads rejected for a wrong version or malformed content.
+    pub rejected: u64,
+    /// Periods in which the process's input went quiet for longer than its deadline.
+    pub stale_input_episodes: u64,
+    /// 1 while the input is quiet (stale) now.
+    pub input_stale: u8,
+    /// Zero; makes the padding explicit so that the layout has no hidden bytes.
+    pub _pad2: [u8; 7],
+}
+
+/// Up to this many processes in a [`HealthReport`].
+pub const MAX_SUPERVISED: usize = 8;
+
+wire_enum! {
+    /// What the watchdog knows of one supervised process, [`ServiceHealth::state`].
+    #[derive(Default)]
+    pub enum ServiceState: u8 {
+        /// Started, no heartbeat from this process yet.
+        #[default]
+        Starting = 0 => "starting",
+        /// Running and heartbeating.
+        Running = 1 => "running",
+        /// Exited; waiting out its restart backoff.
+        Restarting = 2 => "restarting",
+        /// Its heartbeat is overdue although the process is still there (hung or starved).
+        Silent = 3 => "silent",
+        /// It died more often than its restart limit allows; the watchdog no longer restarts it.
+        GivenUp = 4 => "given-up",
+    }
+}
+
+/// One process in a [`HealthReport`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::ServiceHealth")]
+pub struct ServiceHealth {
+    /// [`ServiceKind`] as u8.
+    pub service: u8,
+    /// [`ServiceState`] as u8.
+    pub state: u8,
+    /// 1 when the process's last heartbeat said its input is quiet (stale).
+    pub input_stale: u8,
+    /// Zero; makes the padding explicit so that the layout has no hidden bytes.
+    pub _pad: [u8; 1],
+    /// Process id (0 while restarting).
+    pub pid: u32,
+    /// Restarts since the watchdog started.
+    pub restarts: u32,
+    /// Age of the last heartbeat, ms; `u32::MAX` when none has arrived.
+    pub heartbeat_age_ms: u32,
+    /// Samples per second on the process's output topic over the last report period (NaN for a
+    /// process without one).
+    pub output_rate_hz: f32,
+    /// Zero; makes the padding explicit so that the layout has no hidden bytes.
+    pub _pad2: [u8; 4],
+}
+
+/// The watchdog's view of every process, published a few times a second on
+/// [`crate::names::HEALTH`]; `rins status` prints it.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::HealthReport")]
+pub struct HealthReport {
+    /// Layout version, [`crate::PAYLOAD_VERSION`].
+    pub version: u16,
+    /// Entries of [`HealthReport::services`] in use.
+    pub count: u8,
+    /// Zero; makes the padding explicit so that the layout has no hidden bytes.
+    pub _pad: [u8; 5],
+    /// CLOCK_MONOTONIC ns when the report was made.
+    pub now_ns: u64,
+    /// Time since the watchdog started, ms.
+    pub uptime_ms: u64,
+    /// One entry per supervised process; the first [`HealthReport::count`] are in use.
+    pub services: [ServiceHealth; MAX_SUPERVISED],
+}

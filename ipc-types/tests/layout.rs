@@ -1,0 +1,72 @@
+//! The payload layouts are the contract between processes built at different times: their size
+//! and alignment must not change without a new [`PAYLOAD_VERSION`]. The figures are the layouts of
+//! version 5.
+
+use std::mem::{align_of, offset_of, size_of};
+
+use rins_ipc_types::{
+    Altitude, FaultApplied, FusedImu, FusionControl, Header, Health, HealthReport, NavState,
+    PAYLOAD_VERSION, RawAux, RawBaro, RawImu, RawMag, ServiceHealth, SimControl, Truth,
+};
+
+/// Size and alignment in bytes of `T`.
+fn layout<T>() -> (usize, usize) {
+    (size_of::<T>(), align_of::<T>())
+}
+
+#[test]
+fn the_layouts_are_those_of_version_5() {
+    assert_eq!(PAYLOAD_VERSION, 5);
+}
+
+#[test]
+fn every_payload_keeps_its_size_and_alignment() {
+    assert_eq!(layout::<Header>(), (56, 8));
+    assert_eq!(layout::<RawImu>(), (152, 8));
+    assert_eq!(layout::<RawBaro>(), (80, 8));
+    assert_eq!(layout::<RawMag>(), (80, 8));
+    assert_eq!(layout::<RawAux>(), (72, 8));
+    assert_eq!(layout::<FusedImu>(), (232, 8));
+    assert_eq!(layout::<Altitude>(), (88, 8));
+    assert_eq!(layout::<NavState>(), (368, 8));
+    assert_eq!(layout::<Truth>(), (144, 8));
+    assert_eq!(layout::<SimControl>(), (16, 8));
+    assert_eq!(layout::<FaultApplied>(), (24, 8));
+    assert_eq!(layout::<FusionControl>(), (8, 2));
+    assert_eq!(layout::<Health>(), (128, 8));
+    assert_eq!(layout::<ServiceHealth>(), (24, 4));
+    assert_eq!(layout::<HealthReport>(), (216, 8));
+}
+
+/// A reader checks the version before anything else, so it must sit at the same place in every
+/// payload; the header of the pipeline payloads stays where it is.
+#[test]
+fn the_version_leads_every_payload_and_the_header_stays_in_place() {
+    let version = [
+        offset_of!(RawImu, version),
+        offset_of!(RawBaro, version),
+        offset_of!(RawMag, version),
+        offset_of!(RawAux, version),
+        offset_of!(FusedImu, version),
+        offset_of!(Altitude, version),
+        offset_of!(NavState, version),
+        offset_of!(Truth, version),
+        offset_of!(SimControl, version),
+        offset_of!(FaultApplied, version),
+        offset_of!(FusionControl, version),
+        offset_of!(Health, version),
+        offset_of!(HealthReport, version),
+    ];
+    assert_eq!(version, [0; 13]);
+    let header = [
+        offset_of!(RawBaro, header),
+        offset_of!(RawMag, header),
+        offset_of!(RawAux, header),
+        offset_of!(FusedImu, header),
+        offset_of!(Altitude, header),
+        offset_of!(NavState, header),
+        offset_of!(Truth, header),
+    ];
+    assert_eq!(header, [8; 7]);
+    assert_eq!(offset_of!(RawImu, header), 16);
+}

@@ -1,0 +1,187 @@
+//! Every wire enum: the numbers and names that travel or are typed are those of today, each
+//! variant decodes back to itself, and a number or name no variant has decodes to `None`.
+
+use rins_ipc_types::{
+    ChannelState, FaultOutcome, FaultReason, Integrity, NavMode, SensorType, ServiceKind,
+    ServiceState, SimFault, Stage,
+};
+
+/// Checks `$enum` against its expected `(variant, wire value, name)` list, in order.
+macro_rules! check_wire_enum {
+    ($enum:ident, $decode:ident, [$(($variant:ident, $value:expr, $name:expr)),+ $(,)?]) => {{
+        let expected = [$(($enum::$variant, $value, $name)),+];
+        assert_eq!($enum::COUNT, expected.len(), stringify!($enum));
+        assert_eq!($enum::ALL.map(|v| v as usize), expected.map(|(_, value, _)| value));
+        for (variant, value, name) in expected {
+            assert_eq!(variant as usize, value, "{variant:?}");
+            assert_eq!(variant.name(), name, "{variant:?}");
+            assert_eq!($enum::$decode(value as _), Some(variant), "{variant:?}");
+            assert_eq!($enum::from_name(name), Some(variant), "{variant:?}");
+        }
+        assert_eq!($enum::$decode(expected.len() as _), None, stringify!($enum));
+        assert_eq!($enum::$decode(u8::MAX as _), None, stringify!($enum));
+        assert_eq!($enum::from_name(""), None, stringify!($enum));
+        assert_eq!($enum::from_name(&expected[0].2.to_uppercase()), None, stringify!($enum));
+    }};
+}
+
+#[test]
+fn channel_state() {
+    check_wire_enum!(
+        ChannelState,
+        from_u8,
+        [
+            (Ok, 0, "ok"),
+            (Suspect, 1, "suspect"),
+            (Excluded, 2, "excluded"),
+            (Absent, 3, "absent"),
+        ]
+    );
+    assert_eq!(ChannelState::default(), ChannelState::Ok);
+}
+
+#[test]
+fn fault_reason() {
+    check_wire_enum!(
+        FaultReason,
+        from_u8,
+        [
+            (None, 0, "none"),
+            (Missing, 1, "missing"),
+            (DeviceError, 2, "device-error"),
+            (Saturated, 3, "saturated"),
+            (Stuck, 4, "stuck"),
+            (Noisy, 5, "noisy"),
+            (Parity, 6, "parity"),
+            (StationaryReference, 7, "stationary-reference"),
+            (Temperature, 8, "temperature"),
+        ]
+    );
+    assert_eq!(FaultReason::default(), FaultReason::None);
+}
+
+#[test]
+fn nav_mode() {
+    check_wire_enum!(
+        NavMode,
+        from_u8,
+        [
+            (Aligning, 0, "aligning"),
+            (Navigating, 1, "navigating"),
+            (Coasting, 2, "coasting"),
+            (Invalid, 3, "invalid"),
+        ]
+    );
+    assert_eq!(NavMode::default(), NavMode::Aligning);
+    let usable = NavMode::ALL.map(NavMode::is_usable);
+    assert_eq!(usable, [false, true, true, false]);
+}
+
+#[test]
+fn integrity() {
+    check_wire_enum!(
+        Integrity,
+        from_u8,
+        [
+            (Ok, 0, "ok"),
+            (Degraded, 1, "degraded"),
+            (Invalid, 2, "invalid")
+        ]
+    );
+    assert_eq!(Integrity::default(), Integrity::Ok);
+    // Ordered from best to worst: the worst of several is their maximum.
+    assert!(Integrity::Ok < Integrity::Degraded && Integrity::Degraded < Integrity::Invalid);
+}
+
+#[test]
+fn sensor_type() {
+    check_wire_enum!(
+        SensorType,
+        from_u8,
+        [(Gyro, 0, "gyro"), (Accel, 1, "accel")]
+    );
+}
+
+#[test]
+fn sim_fault() {
+    check_wire_enum!(
+        SimFault,
+        from_u8,
+        [
+            (Clear, 0, "clear"),
+            (Dead, 1, "dead"),
+            (Stuck, 2, "stuck"),
+            (BiasStep, 3, "bias"),
+            (Ramp, 4, "ramp"),
+            (Noise, 5, "noise"),
+            (Saturate, 6, "saturate"),
+            (Intermittent, 7, "intermittent"),
+            (Disconnect, 8, "disconnect"),
+        ]
+    );
+}
+
+#[test]
+fn fault_outcome() {
+    check_wire_enum!(
+        FaultOutcome,
+        from_u8,
+        [
+            (Applied, 0, "applied"),
+            (UnknownCommand, 1, "unknown-command"),
+            (NoSuchChannel, 2, "no-such-channel"),
+            (InvalidParameter, 3, "invalid-parameter"),
+        ]
+    );
+}
+
+#[test]
+fn service_kind() {
+    check_wire_enum!(
+        ServiceKind,
+        from_u8,
+        [
+            (Simulator, 0, "sim"),
+            (Acquisition, 1, "acquisition"),
+            (Fusion, 2, "fusion"),
+            (Altimeter, 3, "altimeter"),
+            (Navigator, 4, "navigator"),
+            (Watchdog, 5, "watchdog"),
+            (NavigatorStandby, 6, "navigator-standby"),
+        ]
+    );
+    assert_eq!(
+        ServiceKind::NAVIGATOR_LANES,
+        [ServiceKind::Navigator, ServiceKind::NavigatorStandby]
+    );
+}
+
+#[test]
+fn service_state() {
+    check_wire_enum!(
+        ServiceState,
+        from_u8,
+        [
+            (Starting, 0, "starting"),
+            (Running, 1, "running"),
+            (Restarting, 2, "restarting"),
+            (Silent, 3, "silent"),
+            (GivenUp, 4, "given-up"),
+        ]
+    );
+    assert_eq!(ServiceState::default(), ServiceState::Starting);
+}
+
+#[test]
+fn stage() {
+    check_wire_enum!(
+        Stage,
+        from_index,
+        [
+            (Acquisition, 0, "acquisition"),
+            (Fusion, 1, "fusion"),
+            (Altimeter, 2, "altimeter"),
+            (Navigator, 3, "navigator"),
+        ]
+    );
+}
