@@ -86,7 +86,7 @@ fn geometry_reports_the_seed_pyramid_and_its_z_axis_penalty() {
     let gyro = &reports[0];
     assert_eq!(gyro["sensor"], "gyro");
     let c = &gyro["capability"];
-    // DESIGN §4.1: at α = 28.7° the x/y variance is 1/(2cos²α) = 0.65σ², z is 1/(4sin²α) = 1.084σ².
+    // docs/design.md §4: at α = 28.7° the x/y variance is 1/(2cos²α) = 0.65σ², z is 1/(4sin²α) = 1.084σ².
     let v = |i: usize| c["variance_factors"][i].as_f64().unwrap();
     assert!(
         (v(0) - 0.650).abs() < 1e-3 && (v(2) - 1.084).abs() < 1e-3,

@@ -1,4 +1,4 @@
-//! ADC counts to SI units per channel, with temperature compensation (DESIGN §4.3):
+//! ADC counts to SI units per channel, with temperature compensation (docs/design.md §6.1):
 //!
 //! ```text
 //! bias_i(T)  = bias_i + bias_per_c_i · (T − T_ref)

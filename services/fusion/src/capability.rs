@@ -1,4 +1,4 @@
-//! What a sensor geometry can do for fault detection and isolation (DESIGN §4.1–4.2), decided
+//! What a sensor geometry can do for fault detection and isolation (docs/design.md §4–5), decided
 //! from the structure of H alone, without an SVD.
 //!
 //! The parity space (left null space of H) is the column space of the projector

@@ -1,4 +1,4 @@
-//! Weighted least squares for one active channel set (DESIGN §4.1):
+//! Weighted least squares for one active channel set (docs/design.md §4):
 //! `x̂ = (HᵀWH)⁻¹ HᵀW z`, `cov(x̂) = (HᵀWH)⁻¹`, `W = diag(1/σ_i²)`.
 //!
 //! The gain G = (HᵀWH)⁻¹HᵀW is computed once per channel set so that a sample costs 3·N

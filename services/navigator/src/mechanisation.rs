@@ -1,6 +1,6 @@
 //! Quaternion strapdown mechanisation: the nominal attitude, velocity and position.
 //!
-//! Model (DESIGN §4.4), non-rotating Earth in this version: no Earth rate in the attitude update, no
+//! Model (docs/design.md §6.3), non-rotating Earth in this version: no Earth rate in the attitude update, no
 //! Coriolis or transport-rate terms in the velocity update. Over a short flight the Earth rate
 //! (7.3e-5 rad/s) is absorbed into the gyro bias measured at alignment.
 //!

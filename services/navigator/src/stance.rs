@@ -1,9 +1,9 @@
-//! Stance (zero-velocity) detection for a foot-mounted unit (DESIGN §4.4, seeds 000 and 004).
+//! Stance (zero-velocity) detection for a foot-mounted unit (docs/design.md §6.5; [R2], [R3], [R4]).
 //!
 //! Three detectors over a trailing window of the last `window` samples:
 //! * `thresholds` — every sample of the window has `| |f| − g | < accel_tolerance` and
-//!   `|ω| < gyro_max` (the seeds' magnitude tests);
-//! * `fsr` — the foot-pressure reading of the latest sample exceeds `threshold` (seed 004);
+//!   `|ω| < gyro_max` (the magnitude tests of [R2] and [R3]);
+//! * `fsr` — the foot-pressure reading of the latest sample exceeds `threshold` ([R3]);
 //! * `shoe` — the stance hypothesis likelihood test (Skog et al.):
 //!   `T = (1/W) Σ ( |y_a − g ȳ_a/|ȳ_a||²/σ_a² + |y_ω|²/σ_ω² ) < γ`, with `ȳ_a` the window's mean
 //!   specific force.

@@ -1,4 +1,4 @@
-//! Parity space of one active channel set (DESIGN §4.2).
+//! Parity space of one active channel set (docs/design.md §5).
 //!
 //! V is an orthonormal basis of the left null space of the active rows of H: (m×n_a) with
 //! m = n_a − 3, `V H = 0`, `V Vᵀ = I`, taken from the last m left singular vectors of H (faer SVD).
@@ -13,7 +13,7 @@
 //! **GLT weighting.** A bias f on channel i moves p' by `f·w_i`, w_i the i-th column of V_w. The
 //! generalised likelihood ratio of "bias on channel i" against "no fault", maximised over f, is
 //! `(w_iᵀ p')² / (w_iᵀ w_i)` — the squared projection of the whitened parity on the fault
-//! direction. This is DESIGN's `(v_iᵀ p)²/(v_iᵀ v_i)` made correct for unequal channel noise; with
+//! direction. This is the textbook `(v_iᵀ p)²/(v_iᵀ v_i)` ([R12]) made correct for unequal channel noise; with
 //! equal σ it is that expression divided by σ², so the argmax is the same.
 //!
 //! Two channels whose columns are parallel ("twins") produce the same parity signature and cannot

@@ -8,7 +8,7 @@
 //! last completed block was and the current partial block has not (yet) contradicted it.
 //!
 //! **Reference.** While stationary, each channel's mean over a block is `h_i·x_ref` plus the
-//! channel's own residual bias — the per-channel form of DESIGN's `h_i·x_ref` that also removes
+//! channel's own residual bias — the per-channel form of the design's `h_i·x_ref` that also removes
 //! calibration residuals. A block becomes the reference when it was stationary, no fault was
 //! declared during it, the active set did not change, and its mean test statistic was consistent
 //! with noise (`mean T ≤ m + 5·√(2m/W)`, which also keeps a slowly growing, still undetected

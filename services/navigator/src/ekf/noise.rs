@@ -31,7 +31,7 @@ pub struct EkfNoise {
 }
 
 impl Default for EkfNoise {
-    /// A MEMS unit of the product's class (DESIGN §5: 0.01 °/s/√Hz, 150 µg/√Hz) with margins for
+    /// A MEMS unit of the product's class (0.01 °/s/√Hz, 150 µg/√Hz) with margins for
     /// the unmodelled scale-factor and vibration errors.
     fn default() -> Self {
         Self {

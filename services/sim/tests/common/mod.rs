@@ -3,7 +3,7 @@
 
 use rins_sim::{SensorModelConfig, SimConfig};
 
-/// The 4-face pyramid of DESIGN §4.1: β_i = 45° + i·90°, elevation α.
+/// The 4-face pyramid of docs/design.md §4: β_i = 45° + i·90°, elevation α.
 pub fn pyramid(alpha_deg: f64) -> Vec<[f64; 3]> {
     let a = alpha_deg.to_radians();
     (0..4)
