@@ -2,8 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::aided::{AidedConfig, ZuptConfig};
-use crate::aiding::BaroAidingConfig;
+use crate::baro_height::BaroAidingConfig;
+use crate::inertial_core::{AidedConfig, ZuptConfig};
 use crate::alignment::AlignConfig;
 use crate::ekf::EkfNoise;
 use crate::integrity::IntegrityConfig;

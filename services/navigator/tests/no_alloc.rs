@@ -110,7 +110,7 @@ fn navigating_samples_do_not_allocate() {
 
 #[test]
 fn the_error_state_filter_and_stance_detector_do_not_allocate_per_sample() {
-    use rins_navigator::aided::{AidedNavigator, ZuptConfig};
+    use rins_navigator::inertial_core::{AidedNavigator, ZuptConfig};
     use rins_navigator::ekf::AidingSource;
 
     let config = NavigatorConfig {
