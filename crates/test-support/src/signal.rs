@@ -14,6 +14,10 @@ pub enum Signal {
     Stop,
     /// SIGCONT: resume after [`Signal::Stop`].
     Continue,
+    /// SIGHUP: the controlling terminal went away.
+    Hangup,
+    /// SIGUSR1: a user-defined signal nobody asked for.
+    User1,
 }
 
 impl Signal {
@@ -24,6 +28,8 @@ impl Signal {
             Signal::Kill => libc::SIGKILL,
             Signal::Stop => libc::SIGSTOP,
             Signal::Continue => libc::SIGCONT,
+            Signal::Hangup => libc::SIGHUP,
+            Signal::User1 => libc::SIGUSR1,
         }
     }
 }

@@ -24,9 +24,9 @@ pub mod service;
 pub mod wls;
 
 pub use calibration::{Calibration, ChannelCalibration};
+pub use config::{ChannelNoise, FusionConfig, NoiseConfig, PerSensor};
 pub use error::ConfigError;
 pub use fdi::{ChannelEvent, ChannelEvents, FdiConfig, ParityNoise, ParitySpace, SensorStatus};
-pub use config::{ChannelNoise, FusionConfig, NoiseConfig, PerSensor};
 pub use fuser::{Fused, ImuFuser, ImuSample};
 pub use geometry::{Geometry, GeometryConfig};
 pub use kalman::{FusionMethod, KalmanConfig};

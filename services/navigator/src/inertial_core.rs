@@ -10,9 +10,9 @@
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use crate::baro_height::BaroAidingConfig;
 use crate::alignment::{AlignConfig, AlignError, Alignment, StaticAligner};
 use crate::attitude_recovery::AttitudeRecovery;
+use crate::baro_height::BaroAidingConfig;
 use crate::ekf::{AidingSource, EkfNoise, ErrorStateEkf, UpdateOutcome};
 use crate::integrity::{IntegrityConfig, IntegrityMonitor};
 use crate::mag_calibration::MagCalibration;

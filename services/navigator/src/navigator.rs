@@ -20,12 +20,12 @@
 
 use ipc_types::{Integrity, NAV_STATES, NavMode, NavState, aiding};
 
-use crate::baro_mag_updates::AidingOutcome;
-use crate::inertial_core::AidedNavigator;
 use crate::alignment::{AlignError, Alignment};
 use crate::attitude::quaternion_to_array;
+use crate::baro_mag_updates::AidingOutcome;
 use crate::config::{ConfigError, NavigatorConfig};
 use crate::ekf::{AidingCounts, AidingSource, ErrorStateEkf};
+use crate::inertial_core::AidedNavigator;
 use crate::mechanisation::{NominalState, StepOutcome};
 use crate::takeover::{TakeOverError, peer_solution};
 

@@ -3,10 +3,7 @@
 //! swing dynamics, the foot-pressure load, and the configuration switch.
 
 mod common;
-#[path = "common/counting_alloc.rs"]
-mod counting_alloc;
 
-use counting_alloc::allocations_during;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use rins_earth::STANDARD_GRAVITY;
 use rins_earth::{meridian_radius, prime_vertical_radius};
@@ -17,6 +14,10 @@ use rins_sim::trajectory::walk::{
     STANCE_LOAD, STANCE_S, STRIDE_PERIOD_S, SWING_S, WalkPath,
 };
 use rins_sim::{Scenario, SimConfig, Simulator, TickOutput, Trajectory, TruthState};
+use rins_test_support::counting_alloc::{CountingAllocator, allocations_during};
+
+#[global_allocator]
+static ALLOCATOR: CountingAllocator = CountingAllocator;
 
 /// Truth is sampled on the simulator's 1 kHz grid.
 const H: f64 = 1e-3;

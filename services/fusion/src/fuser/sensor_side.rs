@@ -6,7 +6,9 @@ use crate::calibration::{Calibration, MAX_TEMPERATURE_C, MIN_TEMPERATURE_C};
 use crate::config::FusionConfig;
 use crate::error::ConfigError;
 use crate::fdi::channel_health::{COUNT_MAX, COUNT_MIN};
-use crate::fdi::{ChannelEvents, FdiSettings, MonitorInput, SensorEstimate, SensorMonitor, SensorStatus};
+use crate::fdi::{
+    ChannelEvents, FdiSettings, MonitorInput, SensorEstimate, SensorMonitor, SensorStatus,
+};
 use crate::geometry::{Geometry, MAX_CHANNELS, channel_mask};
 use crate::kalman::{FusionMethod, KalmanConfig, KalmanFuser};
 use crate::rest_bias::RestBias;

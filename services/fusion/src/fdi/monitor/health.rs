@@ -41,7 +41,12 @@ impl SensorMonitor {
     /// Of the `saturated` channels, those that the active channels not at a rail place well
     /// inside the converter range (inner 90 %): a channel at a rail there is faulty, not
     /// over-ranged. Needs three channels off the rails; without them nothing can be said.
-    pub(super) fn should_be_in_range(&self, saturated: u32, at_rail: u32, z: &[f64; MAX_CHANNELS]) -> u32 {
+    pub(super) fn should_be_in_range(
+        &self,
+        saturated: u32,
+        at_rail: u32,
+        z: &[f64; MAX_CHANNELS],
+    ) -> u32 {
         let others = self.active_mask() & !at_rail;
         let n = self.geometry.n();
         if others.count_ones() < 3 {

@@ -13,7 +13,11 @@ impl SensorMonitor {
     /// Parity test, persistence, adaptive noise and isolation. Returns the test statistic, the
     /// Suspect candidates of a detected-but-unisolated fault (0 when none) and whether the
     /// adaptive estimate was still learning (declarations suspended).
-    pub(super) fn parity_test(&mut self, z: &[f64; MAX_CHANNELS], stationary: bool) -> (f64, u32, bool) {
+    pub(super) fn parity_test(
+        &mut self,
+        z: &[f64; MAX_CHANNELS],
+        stationary: bool,
+    ) -> (f64, u32, bool) {
         let active = self.active_mask();
         let Some(space) = self.parity.as_mut().filter(|p| p.dimension() > 0) else {
             self.reference.push(z, active, 0.0, true);
