@@ -15,6 +15,7 @@ use rins_sim::trajectory::walk::{
 };
 use rins_sim::{Scenario, SimConfig, Simulator, TickOutput, Trajectory, TruthState};
 use rins_test_support::counting_alloc::{CountingAllocator, allocations_during};
+use rins_test_support::pyramid::optimal_pyramid_axes;
 
 #[global_allocator]
 static ALLOCATOR: CountingAllocator = CountingAllocator;
@@ -415,7 +416,7 @@ fn foot_load_follows_the_stance_phases() {
 #[test]
 fn simulator_foot_pressure_frames_follow_the_load() {
     let config = walk_config(0.0, 3.0);
-    let axes = common::optimal_pyramid();
+    let axes = optimal_pyramid_axes();
     let mut sim = Simulator::new(&config, &axes, &axes, 5).unwrap();
     let sigma = config.sensors.foot_pressure_noise_counts;
     assert_eq!(sigma, 20.0);
@@ -455,7 +456,7 @@ fn walk_parses_from_toml_and_builds() {
     let c: SimConfig = toml::from_str("scenario = \"walk\"\nstatic_s = 2.0\n").unwrap();
     c.validate().unwrap();
     assert_eq!(c.scenario, Scenario::Walk);
-    let axes = common::optimal_pyramid();
+    let axes = optimal_pyramid_axes();
     let sim = Simulator::new(&c, &axes, &axes, 1).unwrap();
     assert_eq!(sim.trajectory().lift_off_s(), 2.0);
     assert!(sim.trajectory().end_s() > 100.0);
