@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{Fault, GYRO_LSB, GYRO_SIGMA, Rig, dodecahedron, pyramid4};
+use common::{Fault, GYRO_SIGMA, Rig, dodecahedron, pyramid4};
 use ipc_types::{FaultReason, SensorType};
 use rins_fusion::fdi::{FdiConfig, ParityNoise};
 

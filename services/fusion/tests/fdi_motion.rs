@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{Fault, GYRO_LSB, GYRO_SIGMA, Rig, pyramid4};
+use common::{Fault, GYRO_SIGMA, Rig};
 use ipc_types::SensorType;
 use rins_fusion::fdi::FdiConfig;
 

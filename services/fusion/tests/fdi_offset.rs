@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{ACCEL_LSB, ACCEL_SIGMA, Fault, Rig, dodecahedron, pyramid4};
+use common::{ACCEL_SIGMA, Fault, Rig, dodecahedron, pyramid4};
 use ipc_types::{FaultReason, SensorType};
 use proptest::prelude::*;
 use rand::SeedableRng;

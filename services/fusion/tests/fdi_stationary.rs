@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{ACCEL_LSB, ACCEL_SIGMA, Fault, GYRO_LSB, GYRO_SIGMA, Rig, pyramid4};
+use common::{ACCEL_LSB, ACCEL_SIGMA, Fault, GYRO_LSB, GYRO_SIGMA, Rig};
 use ipc_types::{ChannelState, FaultReason, SensorType};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
