@@ -11,6 +11,7 @@ use std::sync::mpsc::{Receiver, channel};
 use std::time::{Duration, Instant};
 
 use common::{Isolated, PipelineSlot, num, spawn_up, stop_up};
+use rins_test_support::signal::{Signal, send_signal};
 use serde_json::Value;
 
 /// One navigation sample as `rins echo nav` prints it.
@@ -48,7 +49,7 @@ fn echo_nav(ipc: &Isolated) -> (Child, Receiver<Sample>) {
     (child, rx)
 }
 
-fn pid_of(ipc: &Isolated, name: &str) -> libc::pid_t {
+fn pid_of(ipc: &Isolated, name: &str) -> u64 {
     let report = ipc.status();
     let service = report["services"]
         .as_array()
@@ -57,7 +58,7 @@ fn pid_of(ipc: &Isolated, name: &str) -> libc::pid_t {
         .find(|s| s["service"] == name && s["state"] == "running")
         .unwrap_or_else(|| panic!("{name} not running: {report}"))
         .clone();
-    libc::pid_t::try_from(service["pid"].as_u64().expect("pid")).expect("pid fits")
+    service["pid"].as_u64().expect("pid")
 }
 
 /// Takes samples for `span`, checking that each one follows the previous without a gap.
@@ -105,8 +106,8 @@ fn killing_either_navigator_lane_loses_no_sample_and_navigation_goes_on() {
     // Kill the delivering lane: the other delivers from the next sequence number on.
     let first_victim = LANES[delivering as usize];
     let killed = pid_of(&ipc, first_victim);
-    // SAFETY: a signal to a process of this test's own pipeline.
-    assert_eq!(unsafe { libc::kill(killed, libc::SIGKILL) }, 0);
+    // A process of this test's own pipeline.
+    send_signal(killed, Signal::Kill).expect("SIGKILL");
     let after_first = follow(&rx, &mut last, Duration::from_secs(6));
     assert!(
         after_first.iter().all(|s| s.mode == NAVIGATING),
@@ -119,8 +120,7 @@ fn killing_either_navigator_lane_loses_no_sample_and_navigation_goes_on() {
     let second_victim = LANES[1 - delivering as usize];
     let other = pid_of(&ipc, second_victim);
     assert_ne!(pid_of(&ipc, first_victim), killed);
-    // SAFETY: as above.
-    assert_eq!(unsafe { libc::kill(other, libc::SIGKILL) }, 0);
+    send_signal(other, Signal::Kill).expect("SIGKILL");
     let after_second = follow(&rx, &mut last, Duration::from_secs(4));
     assert!(
         after_second.iter().all(|s| s.mode == NAVIGATING),
@@ -128,8 +128,8 @@ fn killing_either_navigator_lane_loses_no_sample_and_navigation_goes_on() {
     );
     assert_eq!(after_second.last().map(|s| s.lane), Some(delivering));
 
-    // SAFETY: our own child.
-    unsafe { libc::kill(echo.id() as libc::pid_t, libc::SIGTERM) };
+    // Our own child; already gone is fine too.
+    let _ = send_signal(u64::from(echo.id()), Signal::Terminate);
     let _ = echo.wait();
     let summary = stop_up(&ipc, up);
     assert_eq!(num(&summary, "restarts"), 2.0, "{summary}");

@@ -9,6 +9,7 @@ mod common;
 use std::time::{Duration, Instant};
 
 use common::{Isolated, PipelineSlot, num, spawn_up_navigating, stop_up};
+use rins_test_support::signal::{Signal, send_signal};
 use serde_json::Value;
 
 const KILLS: usize = 50;
@@ -100,10 +101,9 @@ fn fifty_kills_leave_no_zombie_no_shared_memory_growth_and_a_live_watchdog() {
             .iter()
             .find(|(n, _)| n == victim)
             .unwrap_or_else(|| panic!("no {victim} in {pids:?}"));
-        let pid = libc::pid_t::try_from(*pid).expect("pid fits");
-        // SAFETY: a signal to a process of this test's own pipeline.
-        assert_eq!(unsafe { libc::kill(pid, libc::SIGKILL) }, 0, "{victim}");
-        killed.push(pid);
+        // A process of this test's own pipeline.
+        send_signal(*pid, Signal::Kill).unwrap_or_else(|e| panic!("{victim}: {e}"));
+        killed.push(*pid);
     }
     let after = wait_all_running(&ipc, Duration::from_secs(20));
     let watchdog_after = after.iter().find(|(n, _)| n == "watchdog").map(|p| p.1);

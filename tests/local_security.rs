@@ -16,6 +16,7 @@ use std::process::{Child, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use common::{Isolated, PipelineSlot, Scratch, stderr, stop_up};
+use rins_test_support::signal::{Signal, send_signal};
 
 /// The unprivileged attacker.
 const NOBODY: u32 = 65534;
@@ -88,10 +89,9 @@ fn processes_of(prefix: &str) -> Vec<u32> {
         .collect()
 }
 
-fn signal(child: &Child, sig: libc::c_int) {
-    let pid = libc::pid_t::try_from(child.id()).expect("pid fits pid_t");
-    // SAFETY: a signal to our own child, not reaped yet.
-    assert_eq!(unsafe { libc::kill(pid, sig) }, 0);
+/// Sends `sig` to our own child, not reaped yet.
+fn signal(child: &Child, sig: Signal) {
+    send_signal(u64::from(child.id()), sig).expect("signal to our own child");
 }
 
 /// A process of the test that is stopped with SIGTERM (and reaped) however the test ends, so a
@@ -102,7 +102,7 @@ impl Stopped {
     /// Stops it now and returns its output.
     fn stop(mut self, limit: Duration) -> Output {
         let child = self.0.take().expect("still running");
-        signal(&child, libc::SIGTERM);
+        signal(&child, Signal::Terminate);
         wait_within(child, limit)
     }
 }
@@ -110,7 +110,7 @@ impl Stopped {
 impl Drop for Stopped {
     fn drop(&mut self) {
         if let Some(mut child) = self.0.take() {
-            signal(&child, libc::SIGTERM);
+            signal(&child, Signal::Terminate);
             let _ = child.wait();
         }
     }
@@ -257,7 +257,7 @@ fn a_planted_resume_point_and_symlinked_temporary_file_are_neither_followed_nor_
     }
     // Two saves of the point, then a restarted acquisition that reads it.
     std::thread::sleep(Duration::from_millis(2500));
-    signal(&up, libc::SIGTERM);
+    signal(&up, Signal::Terminate);
     let out = wait_within(up, Duration::from_secs(30));
     assert!(out.status.success(), "{}", stderr(&out));
     assert_eq!(std::fs::read_to_string(&secret).unwrap(), "root-only");
@@ -415,7 +415,7 @@ fn an_axis_that_is_not_a_unit_vector_is_refused() {
 }
 
 /// A running pipeline stopped by `sig`: a clean stop, like SIGTERM.
-fn stops_cleanly_on(sig: libc::c_int, name: &str) {
+fn stops_cleanly_on(sig: Signal, name: &str) {
     let ipc = Isolated::new(name);
     let _slot = PipelineSlot::take();
     let up = common::spawn_up_navigating(&ipc, &["--duration", "120", "--json"]);
@@ -433,12 +433,12 @@ fn stops_cleanly_on(sig: libc::c_int, name: &str) {
 
 #[test]
 fn sighup_stops_the_pipeline_cleanly() {
-    stops_cleanly_on(libc::SIGHUP, "sighup");
+    stops_cleanly_on(Signal::Hangup, "sighup");
 }
 
 #[test]
 fn sigusr1_stops_the_pipeline_cleanly() {
-    stops_cleanly_on(libc::SIGUSR1, "sigusr1");
+    stops_cleanly_on(Signal::User1, "sigusr1");
 }
 
 #[test]
@@ -456,7 +456,7 @@ fn sigterm_during_start_up_is_a_clean_stop() {
             .spawn()
             .expect("rins up");
         std::thread::sleep(Duration::from_millis(ms));
-        signal(&up, libc::SIGTERM);
+        signal(&up, Signal::Terminate);
         let out = wait_within(up, Duration::from_secs(30));
         let what = format!("SIGTERM {ms} ms after launch");
         assert_stopped_clean(&ipc, &out, &what);

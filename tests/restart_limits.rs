@@ -6,6 +6,7 @@ mod common;
 use std::time::{Duration, Instant};
 
 use common::{Isolated, PipelineSlot, TempFile, fails_with, spawn_up_navigating, stderr, stop_up};
+use rins_test_support::signal::{Signal, send_signal};
 use serde_json::Value;
 
 fn service(report: &Value, name: &str) -> Value {
@@ -33,9 +34,8 @@ fn running_pid(ipc: &Isolated, name: &str, not: Option<u64>) -> u64 {
 }
 
 fn sigkill(pid: u64) {
-    let pid = libc::pid_t::try_from(pid).expect("pid fits");
-    // SAFETY: a signal to a process of this test's own pipeline.
-    assert_eq!(unsafe { libc::kill(pid, libc::SIGKILL) }, 0);
+    // A process of this test's own pipeline.
+    send_signal(pid, Signal::Kill).expect("SIGKILL");
 }
 
 #[test]

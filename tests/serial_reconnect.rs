@@ -14,6 +14,7 @@ use std::time::{Duration, Instant};
 use common::{Isolated, PipelineSlot, fails_with, last_json, num, spawn_up, stderr, stop_up};
 use ipc_types::{Health, NavMode, NavState, RawImu, ServiceKind, names};
 use rins_runtime::ipc::{IpcSettings, TopicSubscriber, create_node};
+use rins_test_support::signal::{Signal, send_signal};
 use serde_json::Value;
 
 /// The outage injected, s.
@@ -303,9 +304,8 @@ fn read_available(pipe: &mut std::process::ChildStderr, into: &mut String) {
 }
 
 fn terminate(child: &mut Child) {
-    let pid = libc::pid_t::try_from(child.id()).expect("pid fits pid_t");
-    // SAFETY: sends a signal to our own child process, which has not been reaped yet.
-    assert_eq!(unsafe { libc::kill(pid, libc::SIGTERM) }, 0);
+    // Our own child process, not reaped yet.
+    send_signal(u64::from(child.id()), Signal::Terminate).expect("SIGTERM to our own child");
 }
 
 #[test]

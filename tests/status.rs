@@ -6,6 +6,7 @@ mod common;
 use std::time::{Duration, Instant};
 
 use common::{Isolated, PipelineSlot, TempFile, spawn_up, spawn_up_navigating, stop_up};
+use rins_test_support::signal::{Signal, process_exists, send_signal};
 use serde_json::Value;
 
 fn service<'a>(report: &'a Value, name: &str) -> &'a Value {
@@ -68,9 +69,8 @@ fn status_shows_every_process_and_counts_a_restart_after_sigkill() {
     // A real SIGKILL to fusion: the watchdog restarts it, the report shows the new pid and the
     // restart, and navigation output resumes.
     let old_pid = service(&report, "fusion")["pid"].as_u64().unwrap();
-    let pid = libc::pid_t::try_from(old_pid).expect("pid fits pid_t");
-    // SAFETY: sends a signal to a process of this test's own pipeline.
-    assert_eq!(unsafe { libc::kill(pid, libc::SIGKILL) }, 0);
+    // A process of this test's own pipeline.
+    send_signal(old_pid, Signal::Kill).expect("SIGKILL");
     let after = wait_for(&ipc, Duration::from_secs(20), |r| {
         let f = service(r, "fusion");
         f["restarts"] == 1 && f["state"] == "running"
@@ -122,18 +122,15 @@ fn stopped_service_is_replaced(test: &str, watchdog: &str, name: &str, limit: Du
         service(r, name)["state"] == "running"
     });
     let old_pid = service(&report, name)["pid"].as_u64().unwrap();
-    let pid = libc::pid_t::try_from(old_pid).expect("pid fits pid_t");
     // SIGSTOP: the process is still there but does nothing, as if hung.
-    // SAFETY: sends a signal to a process of this test's own pipeline.
-    assert_eq!(unsafe { libc::kill(pid, libc::SIGSTOP) }, 0);
+    send_signal(old_pid, Signal::Stop).expect("SIGSTOP");
     let after = wait_for(&ipc, limit, |r| {
         let s = service(r, name);
         s["restarts"] == 1 && s["state"] == "running"
     });
     assert_ne!(service(&after, name)["pid"].as_u64().unwrap(), old_pid);
     // The stopped process is gone (killed and reaped: no zombie under the old pid).
-    // SAFETY: signal 0 only checks whether the pid exists.
-    assert_ne!(unsafe { libc::kill(pid, 0) }, 0, "pid {pid} still exists");
+    assert!(!process_exists(old_pid), "pid {old_pid} still exists");
     let others = [
         "acquisition",
         "fusion",
@@ -187,12 +184,10 @@ fn fusion_says_when_acquisition_goes_quiet_and_when_it_is_back() {
     });
     assert_eq!(service(&report, "fusion")["input_stale"], false);
     let pid = service(&report, "acquisition")["pid"].as_u64().unwrap();
-    let pid = libc::pid_t::try_from(pid).expect("pid fits pid_t");
     // Acquisition stopped: fusion's input deadline (50 ms) passes and its next heartbeat (within
     // a second) says so; after the 3 s heartbeat timeout the watchdog replaces acquisition and
     // fusion's input returns.
-    // SAFETY: sends a signal to a process of this test's own pipeline.
-    assert_eq!(unsafe { libc::kill(pid, libc::SIGSTOP) }, 0);
+    send_signal(pid, Signal::Stop).expect("SIGSTOP");
     wait_for(&ipc, Duration::from_secs(10), |r| {
         service(r, "fusion")["input_stale"] == true
     });

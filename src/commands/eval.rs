@@ -26,7 +26,7 @@ pub fn run_fdi(args: &EvalFdiArgs) -> Result<()> {
     Ok(())
 }
 
-fn pedestrian(args: &EvalProfileArgs) -> Result<rins_navigator::aided::AidedConfig> {
+fn pedestrian(args: &EvalProfileArgs) -> Result<rins_navigator::inertial_core::AidedConfig> {
     Ok(config::load_pedestrian(args.profile.as_deref())?
         .navigator
         .aided_config())

@@ -2,7 +2,7 @@
 //! configured sensor block.
 
 use anyhow::{Result, anyhow};
-use rins_sim::fault_command::FaultParseError;
+use rins_sim::FaultParseError;
 use rins_sim::fault_schedule::{FaultFile, ScheduledFault};
 
 use crate::cli::FaultArgs;

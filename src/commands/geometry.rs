@@ -58,7 +58,7 @@ fn report(sensor: &'static str, cfg: &GeometryConfig) -> Result<SensorReport> {
             .map_err(|e| anyhow!("{}", e.within(&field)))?;
             Some(OptimalPyramid {
                 alpha_deg,
-                capability: optimal.capability(),
+                capability: Capability::of(&optimal),
             })
         }
         _ => None,
@@ -66,7 +66,7 @@ fn report(sensor: &'static str, cfg: &GeometryConfig) -> Result<SensorReport> {
     Ok(SensorReport {
         sensor,
         geometry: describe(cfg),
-        capability: geometry.capability(),
+        capability: Capability::of(&geometry),
         optimal_pyramid,
     })
 }

@@ -6,6 +6,7 @@
 pub mod device;
 pub mod topic_stream;
 
+use rins_test_support::signal::{Signal, send_signal};
 use std::path::PathBuf;
 use std::process::{Command, Output};
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -227,9 +228,8 @@ pub fn spawn_up_navigating(ipc: &Isolated, args: &[&str]) -> std::process::Child
 /// Stops a pipeline from [`spawn_up`] with SIGTERM, as an operator does, checks that it ended
 /// cleanly with no shared memory left, and returns its JSON summary.
 pub fn stop_up(ipc: &Isolated, up: std::process::Child) -> serde_json::Value {
-    let pid = libc::pid_t::try_from(up.id()).expect("pid fits pid_t");
-    // SAFETY: sends a signal to our own child process, which has not been reaped yet.
-    assert_eq!(unsafe { libc::kill(pid, libc::SIGTERM) }, 0);
+    // Our own child process, not reaped yet.
+    send_signal(u64::from(up.id()), Signal::Terminate).expect("SIGTERM to our own child");
     let out = up.wait_with_output().expect("rins up did not finish");
     assert!(out.status.success(), "rins up: {:?}", out.status);
     assert_eq!(ipc.shm_entries(), Vec::<String>::new());

@@ -7,9 +7,8 @@
 //! Layouts (`kind` in the configuration): `pyramid` (n axes on a cone, the seed's layout), `axes`
 //! (any 3..=16 vectors), `triad` (orthogonal, no redundancy), `dodecahedron` (6 face normals,
 //! isotropic) and `stacked` (several triaxial IMUs, 3 rows each). What a layout allows for fault
-//! detection and isolation is reported by [`Geometry::capability`].
+//! detection and isolation is worked out from these rows by the `capability` module.
 
-use crate::capability::Capability;
 use crate::error::ConfigError;
 use crate::linalg::{normal_matrix, reciprocal_condition};
 use nalgebra::Rotation3;
@@ -301,11 +300,6 @@ impl Geometry {
     /// λ_min/λ_max of HᵀH (1 for an isotropic layout such as the orthogonal triad).
     pub fn reciprocal_condition(&self) -> f64 {
         self.reciprocal_condition
-    }
-
-    /// Noise figures and fault detection/isolation abilities of this layout.
-    pub fn capability(&self) -> Capability {
-        Capability::of(self)
     }
 
     /// Bitmask with one bit set per channel.

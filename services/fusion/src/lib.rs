@@ -7,10 +7,12 @@
 //! - [`fdi`]: fault detection (parity, χ², channel health), isolation and reconfiguration.
 //! - [`kalman`]: the optional Kalman fusion method over the same channel sets.
 //! - [`rest_bias`]: per-channel gyro biases from a start-up window at rest.
+//! - [`config`]: the `[fusion]` table and its checks.
 //! - [`fuser`]: the gyro and accelerometer sides together, with their fault monitors.
 
 pub mod calibration;
 pub mod capability;
+pub mod config;
 pub mod error;
 pub mod fdi;
 pub mod fuser;
@@ -22,9 +24,10 @@ pub mod service;
 pub mod wls;
 
 pub use calibration::{Calibration, ChannelCalibration};
+pub use config::{ChannelNoise, FusionConfig, NoiseConfig, PerSensor};
 pub use error::ConfigError;
 pub use fdi::{ChannelEvent, ChannelEvents, FdiConfig, ParityNoise, ParitySpace, SensorStatus};
-pub use fuser::{ChannelNoise, Fused, FusionConfig, ImuFuser, ImuSample, NoiseConfig, PerSensor};
+pub use fuser::{Fused, ImuFuser, ImuSample};
 pub use geometry::{Geometry, GeometryConfig};
 pub use kalman::{FusionMethod, KalmanConfig};
 pub use rest_bias::RestBiasState;

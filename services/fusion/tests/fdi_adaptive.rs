@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{Fault, GYRO_LSB, GYRO_SIGMA, Rig, dodecahedron, pyramid4};
+use common::{Fault, GYRO_SIGMA, Rig, dodecahedron, pyramid4};
 use ipc_types::{FaultReason, SensorType};
 use rins_fusion::fdi::{FdiConfig, ParityNoise};
 
@@ -12,15 +12,12 @@ fn vibrating_rig(mode: ParityNoise, geometry: rins_fusion::Geometry, seed: u64) 
         parity_noise: mode,
         ..FdiConfig::default()
     };
-    let mut rig = Rig::new(
-        SensorType::Gyro,
-        geometry,
-        GYRO_SIGMA,
-        GYRO_LSB,
-        false,
-        &cfg,
-        seed,
-    );
+    let mut rig = Rig::builder(SensorType::Gyro)
+        .geometry(geometry)
+        .exact()
+        .config(&cfg)
+        .seed(seed)
+        .build();
     let n = rig.n();
     rig.sigma[..n].iter_mut().for_each(|s| *s *= 3.0);
     rig

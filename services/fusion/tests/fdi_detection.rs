@@ -27,7 +27,12 @@ fn a_million_fault_free_samples_raise_no_alarm() {
         (SensorType::Gyro, GYRO_SIGMA, GYRO_LSB, 0.5, 11),
         (SensorType::Accel, ACCEL_SIGMA, ACCEL_LSB, 9.81, 12),
     ] {
-        let mut rig = Rig::new(sensor, pyramid4(), sigma, lsb, true, &cfg, seed);
+        let mut rig = Rig::builder(sensor)
+            .sigma(sigma)
+            .lsb(lsb)
+            .config(&cfg)
+            .seed(seed)
+            .build();
         for k in 0..1_000_000u32 {
             let t = f64::from(k) * 1e-3;
             let x = [
@@ -64,15 +69,11 @@ fn declared_false_alarm_rate_matches_the_arithmetic() {
                 .abs()
                 < 1e-9
         );
-        let mut rig = Rig::new(
-            SensorType::Gyro,
-            pyramid4(),
-            GYRO_SIGMA,
-            GYRO_LSB,
-            false,
-            &cfg,
-            21,
-        );
+        let mut rig = Rig::builder(SensorType::Gyro)
+            .exact()
+            .config(&cfg)
+            .seed(21)
+            .build();
         const SAMPLES: u32 = 300_000;
         let mut declarations = 0u32;
         let mut previous = false;
@@ -119,15 +120,12 @@ fn five_sigma_bias_step_is_declared_within_ten_samples() {
     for (geometry, name) in [(pyramid4(), "pyramid"), (dodecahedron(), "dodecahedron")] {
         let mut worst = 0;
         for trial in 0..500u64 {
-            let mut rig = Rig::new(
-                SensorType::Gyro,
-                geometry,
-                GYRO_SIGMA,
-                GYRO_LSB,
-                false,
-                &cfg,
-                100 + trial,
-            );
+            let mut rig = Rig::builder(SensorType::Gyro)
+                .geometry(geometry)
+                .exact()
+                .config(&cfg)
+                .seed(100 + trial)
+                .build();
             let x = random_vector(&mut rng, 1.0);
             rig.learn(x, false);
             for _ in 0..rng.random_range(5..30) {
@@ -163,15 +161,12 @@ fn random_single_faults_are_isolated_correctly_with_six_channels() {
         let mut delays = Vec::new();
         const TRIALS: u64 = 1000;
         for trial in 0..TRIALS {
-            let mut rig = Rig::new(
-                SensorType::Gyro,
-                geometry,
-                GYRO_SIGMA,
-                GYRO_LSB,
-                false,
-                &cfg,
-                1000 * seed + trial,
-            );
+            let mut rig = Rig::builder(SensorType::Gyro)
+                .geometry(geometry)
+                .exact()
+                .config(&cfg)
+                .seed(1000 * seed + trial)
+                .build();
             let x = random_vector(&mut rng, 2.0);
             rig.learn(x, false);
             for _ in 0..rng.random_range(5..30) {
@@ -217,15 +212,12 @@ fn reconfiguration_does_not_make_the_solution_jump() {
     let cfg = FdiConfig::default();
     for (geometry, faulty) in [(dodecahedron(), 2usize), (pyramid4(), 1)] {
         let n = geometry.n();
-        let mut rig = Rig::new(
-            SensorType::Gyro,
-            geometry,
-            GYRO_SIGMA,
-            GYRO_LSB,
-            false,
-            &cfg,
-            77,
-        );
+        let mut rig = Rig::builder(SensorType::Gyro)
+            .geometry(geometry)
+            .exact()
+            .config(&cfg)
+            .seed(77)
+            .build();
         let x = [0.4, -0.3, 0.8];
         const M: usize = 2000;
         let mut before = [0.0; 3];
@@ -289,15 +281,12 @@ fn reconfiguration_does_not_make_the_solution_jump() {
 fn six_channels_isolate_two_successive_faults_then_report_the_third() {
     let cfg = FdiConfig::default();
     let geometry: Geometry = dodecahedron();
-    let mut rig = Rig::new(
-        SensorType::Accel,
-        geometry,
-        ACCEL_SIGMA,
-        ACCEL_LSB,
-        false,
-        &cfg,
-        9,
-    );
+    let mut rig = Rig::builder(SensorType::Accel)
+        .geometry(geometry)
+        .exact()
+        .config(&cfg)
+        .seed(9)
+        .build();
     let x = [0.5, 1.0, -9.8];
     rig.learn(x, false);
     let step_until_excluded = |rig: &mut Rig, channel: usize| {

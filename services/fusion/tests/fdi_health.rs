@@ -32,15 +32,7 @@ fn until_excluded(
 #[test]
 fn missing_channel_is_excluded_on_the_same_sample_and_stays_out() {
     let cfg = FdiConfig::default();
-    let mut rig = Rig::new(
-        SensorType::Gyro,
-        pyramid4(),
-        GYRO_SIGMA,
-        GYRO_LSB,
-        true,
-        &cfg,
-        1,
-    );
+    let mut rig = Rig::builder(SensorType::Gyro).config(&cfg).seed(1).build();
     let x = [0.2, 0.1, -0.3];
     for _ in 0..10 {
         rig.step(x, false);
@@ -91,7 +83,12 @@ fn stuck_channel_is_excluded_within_twenty_samples() {
         (SensorType::Accel, ACCEL_SIGMA, ACCEL_LSB),
     ] {
         for trial in 0..200 {
-            let mut rig = Rig::new(sensor, pyramid4(), sigma, lsb, true, &cfg, 300 + trial);
+            let mut rig = Rig::builder(sensor)
+                .sigma(sigma)
+                .lsb(lsb)
+                .config(&cfg)
+                .seed(300 + trial)
+                .build();
             let x = random_vector(&mut rng, 20.0 * sigma);
             for _ in 0..rng.random_range(30..60) {
                 rig.step(x, false);
@@ -149,15 +146,11 @@ fn stuck_false_alarm_arithmetic() {
 fn saturated_channel_is_excluded_within_twenty_samples() {
     let cfg = FdiConfig::default();
     for (geometry, seed) in [(pyramid4(), 4), (dodecahedron(), 5)] {
-        let mut rig = Rig::new(
-            SensorType::Accel,
-            geometry,
-            ACCEL_SIGMA,
-            ACCEL_LSB,
-            true,
-            &cfg,
-            seed,
-        );
+        let mut rig = Rig::builder(SensorType::Accel)
+            .geometry(geometry)
+            .config(&cfg)
+            .seed(seed)
+            .build();
         let x = [0.3, -0.5, -9.8];
         for _ in 0..50 {
             rig.step(x, false);
@@ -182,7 +175,11 @@ fn saturated_channel_is_excluded_within_twenty_samples() {
 fn genuine_over_range_is_suspect_not_excluded() {
     let cfg = FdiConfig::default();
     let g = pyramid4();
-    let mut rig = Rig::new(SensorType::Gyro, g, GYRO_SIGMA, GYRO_LSB, true, &cfg, 6);
+    let mut rig = Rig::builder(SensorType::Gyro)
+        .geometry(g)
+        .config(&cfg)
+        .seed(6)
+        .build();
     let full_scale = f64::from(COUNT_MAX) * GYRO_LSB;
     let h0 = g.axes()[0];
     let over = h0.map(|c| c * 1.2 * full_scale);
@@ -210,15 +207,7 @@ fn genuine_over_range_is_suspect_not_excluded() {
 fn noisy_channel_is_excluded_within_two_windows() {
     let cfg = FdiConfig::default();
     let window = cfg.noise_window;
-    let mut rig = Rig::new(
-        SensorType::Gyro,
-        pyramid4(),
-        GYRO_SIGMA,
-        GYRO_LSB,
-        true,
-        &cfg,
-        7,
-    );
+    let mut rig = Rig::builder(SensorType::Gyro).config(&cfg).seed(7).build();
     let x = [0.1, 0.2, 0.3];
     for _ in 0..137 {
         rig.step(x, false);
@@ -228,15 +217,11 @@ fn noisy_channel_is_excluded_within_two_windows() {
     assert_eq!(reason, FaultReason::Noisy);
     assert!(t <= 2 * window, "{t}");
 
-    let mut rig = Rig::new(
-        SensorType::Gyro,
-        dodecahedron(),
-        GYRO_SIGMA,
-        GYRO_LSB,
-        true,
-        &cfg,
-        8,
-    );
+    let mut rig = Rig::builder(SensorType::Gyro)
+        .geometry(dodecahedron())
+        .config(&cfg)
+        .seed(8)
+        .build();
     rig.inject(3, Fault::Noise(3.0));
     for _ in 0..10 * window {
         rig.step(x, false);
@@ -249,15 +234,7 @@ fn noisy_channel_is_excluded_within_two_windows() {
 #[test]
 fn noisy_channel_among_three_is_suspect() {
     let cfg = FdiConfig::default();
-    let mut rig = Rig::new(
-        SensorType::Gyro,
-        pyramid4(),
-        GYRO_SIGMA,
-        GYRO_LSB,
-        true,
-        &cfg,
-        9,
-    );
+    let mut rig = Rig::builder(SensorType::Gyro).config(&cfg).seed(9).build();
     rig.inject(0, Fault::Dead);
     rig.inject(2, Fault::Noise(10.0));
     let x = [0.1, 0.2, 0.3];
@@ -279,15 +256,7 @@ fn noisy_channel_among_three_is_suspect() {
 #[test]
 fn readmit_is_explicit_and_the_channel_is_judged_again() {
     let cfg = FdiConfig::default();
-    let mut rig = Rig::new(
-        SensorType::Gyro,
-        pyramid4(),
-        GYRO_SIGMA,
-        GYRO_LSB,
-        true,
-        &cfg,
-        10,
-    );
+    let mut rig = Rig::builder(SensorType::Gyro).config(&cfg).seed(10).build();
     let x = [0.4, 0.1, 0.2];
     rig.inject(1, Fault::Dead);
     rig.step(x, false);

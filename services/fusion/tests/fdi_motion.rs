@@ -4,21 +4,17 @@
 
 mod common;
 
-use common::{Fault, GYRO_LSB, GYRO_SIGMA, Rig, pyramid4};
+use common::{Fault, GYRO_SIGMA, Rig};
 use ipc_types::SensorType;
 use rins_fusion::fdi::FdiConfig;
 
 /// The seed pyramid's gyros with exact (unquantised) values.
 fn pyramid_gyros(config: &FdiConfig, seed: u64) -> Rig {
-    Rig::new(
-        SensorType::Gyro,
-        pyramid4(),
-        GYRO_SIGMA,
-        GYRO_LSB,
-        false,
-        config,
-        seed,
-    )
+    Rig::builder(SensorType::Gyro)
+        .exact()
+        .config(config)
+        .seed(seed)
+        .build()
 }
 
 /// Alarmed samples over 2 s of a rate of magnitude `rate` rad/s whose direction sweeps (a

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{ACCEL_LSB, ACCEL_SIGMA, Fault, Rig, dodecahedron, pyramid4};
+use common::{ACCEL_SIGMA, Fault, Rig, dodecahedron, pyramid4};
 use ipc_types::{FaultReason, SensorType};
 use proptest::prelude::*;
 use rand::SeedableRng;
@@ -20,15 +20,11 @@ fn biased_rig(
     bias_sigmas: &[f64],
     seed: u64,
 ) -> Rig {
-    let mut rig = Rig::new(
-        SensorType::Accel,
-        geometry,
-        ACCEL_SIGMA,
-        ACCEL_LSB,
-        true,
-        cfg,
-        seed,
-    );
+    let mut rig = Rig::builder(SensorType::Accel)
+        .geometry(geometry)
+        .config(cfg)
+        .seed(seed)
+        .build();
     for (i, b) in bias_sigmas.iter().enumerate() {
         rig.inject(i, Fault::Bias(b * ACCEL_SIGMA));
     }

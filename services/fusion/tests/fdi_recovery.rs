@@ -4,22 +4,14 @@
 
 mod common;
 
-use common::{Fault, GYRO_LSB, GYRO_SIGMA, Rig, pyramid4};
+use common::{Fault, GYRO_SIGMA, Rig};
 use ipc_types::{ChannelState, FaultReason, SensorType};
 use rins_fusion::fdi::{FdiConfig, ReadmitPolicy};
 
 const X: [f64; 3] = [0.2, 0.1, -0.3];
 
 fn gyro_rig(cfg: &FdiConfig) -> Rig {
-    Rig::new(
-        SensorType::Gyro,
-        pyramid4(),
-        GYRO_SIGMA,
-        GYRO_LSB,
-        true,
-        cfg,
-        7,
-    )
+    Rig::builder(SensorType::Gyro).config(cfg).seed(7).build()
 }
 
 /// Every channel dead for `samples`, then back.

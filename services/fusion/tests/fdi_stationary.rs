@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{ACCEL_LSB, ACCEL_SIGMA, Fault, GYRO_LSB, GYRO_SIGMA, Rig, pyramid4};
+use common::{ACCEL_LSB, ACCEL_SIGMA, Fault, GYRO_LSB, GYRO_SIGMA, Rig};
 use ipc_types::{ChannelState, FaultReason, SensorType};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -37,7 +37,12 @@ fn stationary_reference_isolates_with_four_channels() {
         (SensorType::Gyro, GYRO_SIGMA, GYRO_LSB, [0.0, 0.0, 0.0]),
     ] {
         for trial in 0..200 {
-            let mut rig = Rig::new(sensor, pyramid4(), sigma, lsb, true, &cfg, 500 + trial);
+            let mut rig = Rig::builder(sensor)
+                .sigma(sigma)
+                .lsb(lsb)
+                .config(&cfg)
+                .seed(500 + trial)
+                .build();
             // The learning phase (1000 samples = 5 blocks), then stationary blocks of which the
             // last clean one is the reference.
             for _ in 0..1200 + rng.random_range(0..200) {
@@ -79,15 +84,7 @@ fn stationary_reference_isolates_with_four_channels() {
 #[test]
 fn moving_fault_is_detected_not_isolated_and_reported() {
     let cfg = FdiConfig::default();
-    let mut rig = Rig::new(
-        SensorType::Gyro,
-        pyramid4(),
-        GYRO_SIGMA,
-        GYRO_LSB,
-        true,
-        &cfg,
-        41,
-    );
+    let mut rig = Rig::builder(SensorType::Gyro).config(&cfg).seed(41).build();
     let x = |t: u32| [0.5 * (f64::from(t) * 0.01).sin(), 0.2, -0.1];
     for t in 0..1000 {
         rig.step(x(t), false);
@@ -149,7 +146,12 @@ fn gyro_reference_survives_motion_accel_reference_does_not() {
             false,
         ),
     ] {
-        let mut rig = Rig::new(sensor, pyramid4(), sigma, lsb, true, &cfg, 51);
+        let mut rig = Rig::builder(sensor)
+            .sigma(sigma)
+            .lsb(lsb)
+            .config(&cfg)
+            .seed(51)
+            .build();
         for _ in 0..1200 {
             rig.step(still, true);
         }

@@ -4,7 +4,7 @@ use ipc_types::{ChannelState, FaultReason, FusedImu, RawImu, SensorType, fused_f
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
-use rins_fusion::fuser::{default_accel_sigma_mps2, default_gyro_sigma_rps};
+use rins_fusion::config::{default_accel_sigma_mps2, default_gyro_sigma_rps};
 use rins_fusion::{
     ChannelCalibration, ChannelNoise, FusionConfig, FusionMethod, Geometry, GeometryConfig,
     ImuFuser, ImuSample, RestBiasState, WlsSolver,

@@ -4,7 +4,7 @@
 mod fuser_block;
 
 use fuser_block::{ALL_VALID, AT_REST_FORCE, Block, GYRO_LSB};
-use rins_fusion::fuser::default_gyro_sigma_rps;
+use rins_fusion::config::default_gyro_sigma_rps;
 use rins_fusion::{Fused, FusionConfig, FusionMethod, WlsSolver};
 
 const RATE: [f64; 3] = [0.3, -0.2, 0.5];

@@ -4,7 +4,7 @@
 mod fuser_block;
 
 use fuser_block::{ALL_VALID, AT_REST_FORCE, Block, GYRO_LSB};
-use rins_fusion::fuser::default_gyro_sigma_rps;
+use rins_fusion::config::default_gyro_sigma_rps;
 use rins_fusion::{Fused, FusionConfig, FusionMethod, RestBiasState, WlsSolver};
 
 /// Distinct turn-on biases, rad/s (about 1–2 channel σ): a part along the parity direction, which

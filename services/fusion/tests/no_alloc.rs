@@ -6,30 +6,10 @@ use rins_fusion::GeometryConfig;
 use rins_fusion::fdi::ParityNoise;
 use rins_fusion::kalman::KalmanFuser;
 use rins_fusion::{FusionConfig, FusionMethod, ImuFuser, ImuSample};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-
-struct CountingAlloc;
-
-thread_local! {
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-// SAFETY: delegates to the system allocator; only counts calls on the current thread.
-unsafe impl GlobalAlloc for CountingAlloc {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.with(|c| c.set(c.get() + 1));
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
+use rins_test_support::counting_alloc::{CountingAllocator, allocations_during};
 
 #[global_allocator]
-static GLOBAL: CountingAlloc = CountingAlloc;
+static ALLOCATOR: CountingAllocator = CountingAllocator;
 
 /// Deterministic pseudo-noise of a few counts (no RNG allocation concerns, varies every sample).
 fn wobble(k: u32, i: u32) -> i16 {
@@ -49,10 +29,7 @@ fn frame(k: u32, gyro_bias: i16) -> ([i16; 4], [i16; 4]) {
 #[test]
 fn fuse_does_not_allocate() {
     // The counter sees this thread's allocations.
-    let probe_before = ALLOCATIONS.with(Cell::get);
-    let probe = std::hint::black_box(vec![1u8; 8]);
-    assert!(ALLOCATIONS.with(Cell::get) > probe_before);
-    drop(probe);
+    assert!(allocations_during(|| drop(std::hint::black_box(vec![1u8; 8]))) > 0);
 
     let cases = [
         (ParityNoise::Configured, FusionMethod::Wls),
@@ -76,37 +53,36 @@ fn fuse_does_not_allocate() {
             0b0111
         );
 
-        let before = ALLOCATIONS.with(Cell::get);
         let mut sum = 0.0;
         let mut flagged = 0;
         let temperatures = [25.0f32, 200.0];
-        for k in 2000..12_000u32 {
-            // A gyro bias of 60 counts from k = 5000: detected, not isolated (N = 4, moving).
-            let (g, a) = frame(k, if k >= 5000 { 60 } else { 0 });
-            let mask = if k % 3 == 0 { 0x000F_000F } else { 0x0007_000F };
-            let f = fuser.fuse_sample(&ImuSample {
-                gyro_counts: &g,
-                accel_counts: &a,
-                valid_mask: mask,
-                status: if k % 100 == 0 {
-                    ipc_types::status::DEVICE_ERROR
-                } else {
-                    0
-                },
-                temperatures_c: &temperatures,
-            });
-            sum += f.rate[0] + f.specific_force[2] + f.events.len() as f64;
-            flagged += usize::from(f.gyro_status.detected_not_isolated);
-        }
-        let after = ALLOCATIONS.with(Cell::get);
+        let allocations = allocations_during(|| {
+            for k in 2000..12_000u32 {
+                // A gyro bias of 60 counts from k = 5000: detected, not isolated (N = 4, moving).
+                let (g, a) = frame(k, if k >= 5000 { 60 } else { 0 });
+                let mask = if k % 3 == 0 { 0x000F_000F } else { 0x0007_000F };
+                let f = fuser.fuse_sample(&ImuSample {
+                    gyro_counts: &g,
+                    accel_counts: &a,
+                    valid_mask: mask,
+                    status: if k % 100 == 0 {
+                        ipc_types::status::DEVICE_ERROR
+                    } else {
+                        0
+                    },
+                    temperatures_c: &temperatures,
+                });
+                sum += f.rate[0] + f.specific_force[2] + f.events.len() as f64;
+                flagged += usize::from(f.gyro_status.detected_not_isolated);
+            }
+        });
         assert!(sum.is_finite());
         assert!(
             flagged > 1000,
             "{mode:?}/{method:?}: the fault path was exercised ({flagged})"
         );
         assert_eq!(
-            after - before,
-            0,
+            allocations, 0,
             "{mode:?}/{method:?}: allocations in the per-sample path"
         );
     }
@@ -115,27 +91,25 @@ fn fuse_does_not_allocate() {
 /// The Kalman fuser alone: its update and channel changes must not touch the heap either.
 #[test]
 fn update_and_channel_changes_do_not_allocate() {
-    let probe_before = ALLOCATIONS.with(Cell::get);
-    let probe = std::hint::black_box(vec![1u8; 8]);
-    assert!(ALLOCATIONS.with(Cell::get) > probe_before);
-    drop(probe);
+    // The counter sees this thread's allocations.
+    assert!(allocations_during(|| drop(std::hint::black_box(vec![1u8; 8]))) > 0);
 
     let g = GeometryConfig::Dodecahedron {}.build().unwrap();
     let variances = [1e-4; 6];
     let mut kf = KalmanFuser::new(&g, g.full_mask(), &variances, 0.001, 10.0).unwrap();
     let z = [0.1, -0.2, 0.3, 0.05, f64::NAN, 0.2];
-    let before = ALLOCATIONS.with(Cell::get);
     let mut sum = 0.0;
-    for k in 0..1000u32 {
-        let mask = if k % 2 == 0 { 0b101111 } else { 0b101011 };
-        kf.set_channels(&g, mask, &variances).unwrap();
-        let (x, v) = kf.update(&z);
-        sum += x[0] + v[2];
-        if k % 100 == 99 {
-            kf.reset();
+    let allocations = allocations_during(|| {
+        for k in 0..1000u32 {
+            let mask = if k % 2 == 0 { 0b101111 } else { 0b101011 };
+            kf.set_channels(&g, mask, &variances).unwrap();
+            let (x, v) = kf.update(&z);
+            sum += x[0] + v[2];
+            if k % 100 == 99 {
+                kf.reset();
+            }
         }
-    }
-    let after = ALLOCATIONS.with(Cell::get);
+    });
     assert!(sum.is_finite());
-    assert_eq!(after - before, 0, "allocations in the per-sample path");
+    assert_eq!(allocations, 0, "allocations in the per-sample path");
 }

@@ -2,10 +2,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::aided::{AidedConfig, ZuptConfig};
-use crate::aiding::BaroAidingConfig;
 use crate::alignment::AlignConfig;
+use crate::baro_height::BaroAidingConfig;
 use crate::ekf::EkfNoise;
+use crate::inertial_core::{AidedConfig, ZuptConfig};
 use crate::integrity::IntegrityConfig;
 use crate::mag_calibration::MagCalibration;
 use crate::mag_heading::MagAidingConfig;

@@ -4,14 +4,15 @@
 //! Pure functions and small structs, no I/O. Frames: NED navigation, FRD body; quaternions rotate
 //! body → NED (Hamilton, scalar first); SI units inside, degrees only in [`NavigatorConfig`].
 
-pub mod aided;
-pub mod aiding;
 pub mod alignment;
 pub mod attitude;
 pub mod attitude_recovery;
+pub mod baro_height;
+pub mod baro_mag_updates;
 mod checks;
 pub mod config;
 pub mod ekf;
+pub mod inertial_core;
 pub mod integrity;
 pub mod mag_calibration;
 pub mod mag_heading;

@@ -1,5 +1,5 @@
 //! The navigator: static alignment, then the error-state EKF with baro height, magnetometer heading
-//! and zero-velocity aiding (see [`crate::aided`]), wrapped for the process and its payload.
+//! and zero-velocity aiding (see [`crate::inertial_core`]), wrapped for the process and its payload.
 //!
 //! Sequence. IMU samples fill the alignment window; when it spans `align_s` of device time the window is
 //! checked and either gives the initial attitude and gyro bias or is discarded and restarted (the reason
@@ -20,12 +20,12 @@
 
 use ipc_types::{Integrity, NAV_STATES, NavMode, NavState, aiding};
 
-use crate::aided::AidedNavigator;
-use crate::aiding::AidingOutcome;
 use crate::alignment::{AlignError, Alignment};
 use crate::attitude::quaternion_to_array;
+use crate::baro_mag_updates::AidingOutcome;
 use crate::config::{ConfigError, NavigatorConfig};
 use crate::ekf::{AidingCounts, AidingSource, ErrorStateEkf};
+use crate::inertial_core::AidedNavigator;
 use crate::mechanisation::{NominalState, StepOutcome};
 use crate::takeover::{TakeOverError, peer_solution};
 

@@ -1,61 +1,11 @@
 //! The per-sample path after alignment must not touch the heap.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-
 use rins_earth::normal_gravity;
 use rins_navigator::{Navigator, NavigatorConfig};
-
-/// Counts heap allocations made by the current thread while armed.
-struct CountingAllocator;
-
-thread_local! {
-    static ARMED: Cell<bool> = const { Cell::new(false) };
-    static COUNT: Cell<u64> = const { Cell::new(0) };
-}
-
-fn note_allocation() {
-    if ARMED.with(Cell::get) {
-        COUNT.with(|c| c.set(c.get() + 1));
-    }
-}
-
-// SAFETY: forwards to the system allocator unchanged; only bumps thread-local counters on the side.
-unsafe impl GlobalAlloc for CountingAllocator {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        note_allocation();
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        note_allocation();
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc_zeroed(layout) }
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        note_allocation();
-        // SAFETY: same contract as the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+use rins_test_support::counting_alloc::{CountingAllocator, allocations_during};
 
 #[global_allocator]
 static ALLOCATOR: CountingAllocator = CountingAllocator;
-
-fn allocations_during(f: impl FnOnce()) -> u64 {
-    COUNT.with(|c| c.set(0));
-    ARMED.with(|a| a.set(true));
-    f();
-    ARMED.with(|a| a.set(false));
-    COUNT.with(Cell::get)
-}
 
 #[test]
 fn navigating_samples_do_not_allocate() {
@@ -110,8 +60,8 @@ fn navigating_samples_do_not_allocate() {
 
 #[test]
 fn the_error_state_filter_and_stance_detector_do_not_allocate_per_sample() {
-    use rins_navigator::aided::{AidedNavigator, ZuptConfig};
     use rins_navigator::ekf::AidingSource;
+    use rins_navigator::inertial_core::{AidedNavigator, ZuptConfig};
 
     let config = NavigatorConfig {
         zupt: ZuptConfig {

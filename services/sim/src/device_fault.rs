@@ -3,7 +3,7 @@
 
 use std::fmt;
 
-use crate::fault_command::FaultParseError;
+use crate::fault_parse_error::FaultParseError;
 
 /// Longest accepted disconnect, s: longer is a dead device, not a fault to recover from.
 pub const MAX_DISCONNECT_S: f64 = 3600.0;

@@ -7,6 +7,8 @@ use std::fmt;
 use ipc_types::{MAX_CHANNELS, PAYLOAD_VERSION, SensorType, SimControl, SimFault};
 
 use crate::config::SimConfig;
+use crate::device_fault::{DURATION_RANGE, Disconnect};
+use crate::fault_parse_error::FaultParseError;
 use crate::sensor_model::fault::{ChannelFault, InertialSensor};
 use rins_earth::STANDARD_GRAVITY;
 
@@ -19,32 +21,6 @@ const MAX_INTERMITTENT_PERIOD_S: f64 = 3600.0;
 /// Why a disconnect cannot be given a channel.
 pub const DISCONNECT_HAS_NO_CHANNEL: &str = "disconnect unplugs the whole device: give no channel (rins inject disconnect --duration S, \
      --inject disconnect=S@TIME)";
-
-/// A fault command or schedule entry that could not be understood: `token` names the offending
-/// piece of input (e.g. `bias STEP "abc"`), `reason` says what it must be.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{token}: {reason}")]
-pub struct FaultParseError {
-    pub token: String,
-    pub reason: String,
-}
-
-impl FaultParseError {
-    pub fn new(token: impl Into<String>, reason: impl Into<String>) -> Self {
-        Self {
-            token: token.into(),
-            reason: reason.into(),
-        }
-    }
-
-    /// The same error, located inside a larger piece of input (`where_` is prepended to the token).
-    pub fn within(self, where_: &str) -> Self {
-        Self {
-            token: format!("{where_}: {}", self.token),
-            reason: self.reason,
-        }
-    }
-}
 
 /// One redundant inertial channel: sensor type and 0-based index, written `gyro2`, `accel0`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -172,7 +148,7 @@ pub fn check_param(fault: SimFault, param: f64) -> Result<(), &'static str> {
         SimFault::Intermittent => {
             param.is_finite() && param > 0.0 && param <= MAX_INTERMITTENT_PERIOD_S
         }
-        SimFault::Disconnect => crate::device_fault::Disconnect::new(param).is_ok(),
+        SimFault::Disconnect => Disconnect::new(param).is_ok(),
         SimFault::Clear | SimFault::Dead | SimFault::Stuck | SimFault::Saturate => true,
     };
     if ok {
@@ -183,7 +159,7 @@ pub fn check_param(fault: SimFault, param: f64) -> Result<(), &'static str> {
             "must be a finite number >= 1 (it multiplies the configured white noise)"
         }
         SimFault::Intermittent => "must be > 0 and <= 3600 seconds",
-        SimFault::Disconnect => crate::device_fault::DURATION_RANGE,
+        SimFault::Disconnect => DURATION_RANGE,
         _ => "must be a finite number",
     })
 }

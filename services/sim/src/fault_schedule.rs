@@ -5,7 +5,8 @@
 use ipc_types::SimFault;
 use serde::Deserialize;
 
-use crate::fault_command::{ChannelId, FaultParseError, parse_kind, parse_number};
+use crate::fault_command::{ChannelId, parse_kind, parse_number};
+use crate::fault_parse_error::FaultParseError;
 use crate::sim_command::SimCommand;
 
 /// A command and the device time (s since the simulator started) it takes effect.

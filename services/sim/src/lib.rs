@@ -10,6 +10,7 @@ pub mod config;
 pub mod device_fault;
 pub mod error;
 pub mod fault_command;
+pub mod fault_parse_error;
 pub mod fault_schedule;
 pub mod outage;
 pub mod sensor_model;
@@ -21,6 +22,7 @@ pub mod trajectory;
 
 pub use config::{EarthFieldConfig, SimConfig};
 pub use error::SimError;
+pub use fault_parse_error::FaultParseError;
 pub use sensor_model::SensorModelConfig;
 pub use sensor_model::fault::{ChannelFault, InertialSensor};
 pub use simulator::{Simulator, TickOutput, TruthSample};

@@ -7,7 +7,8 @@ use std::fmt;
 use ipc_types::{PAYLOAD_VERSION, SimControl, SimFault};
 
 use crate::device_fault::Disconnect;
-use crate::fault_command::{ChannelId, ControlError, FaultCommand, FaultParseError};
+use crate::fault_command::{ChannelId, ControlError, FaultCommand};
+use crate::fault_parse_error::FaultParseError;
 
 /// A validated simulator command.
 #[derive(Debug, Clone, Copy, PartialEq)]

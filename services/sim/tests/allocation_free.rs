@@ -2,11 +2,12 @@
 //! largest geometry (16 + 16 channels) in the moving UAV scenario, with faults active.
 
 mod common;
-#[path = "common/counting_alloc.rs"]
-mod counting_alloc;
 
-use counting_alloc::allocations_during;
 use rins_sim::{ChannelFault, InertialSensor, Scenario, Simulator, TickOutput};
+use rins_test_support::counting_alloc::{CountingAllocator, allocations_during};
+
+#[global_allocator]
+static ALLOCATOR: CountingAllocator = CountingAllocator;
 
 #[test]
 fn step_does_not_allocate() {

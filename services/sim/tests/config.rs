@@ -4,6 +4,7 @@ mod common;
 
 use rins_earth::STANDARD_GRAVITY;
 use rins_sim::{Scenario, SensorModelConfig, SimConfig, SimError, Simulator};
+use rins_test_support::pyramid::optimal_pyramid_axes;
 
 #[test]
 fn defaults_are_the_documented_mems_block() {
@@ -119,7 +120,7 @@ fn validation_errors_name_field_and_value() {
 
 #[test]
 fn simulator_rejects_bad_config_and_axes() {
-    let axes = common::optimal_pyramid();
+    let axes = optimal_pyramid_axes();
     let bad = SimConfig {
         imu_rate_hz: 0.0,
         ..SimConfig::default()
@@ -168,7 +169,7 @@ fn simulator_rejects_bad_config_and_axes() {
     let mut many: Vec<[f64; 3]> = (0..4)
         .flat_map(|_| [[2.0, 0.0, 0.0], [0.0, 3.0, 0.0], [0.0, 0.0, 0.5]])
         .collect();
-    many.extend(common::optimal_pyramid());
+    many.extend(optimal_pyramid_axes());
     let s = Simulator::new(&c, &many, &many, 0).unwrap();
     let e = s
         .sensors()

@@ -9,6 +9,7 @@ use rins_protocol::{BaroFrame, ImuFrame, MagFrame, Payload};
 use rins_sim::sensor_model::baro::{isa_altitude_m, isa_pressure_pa};
 use rins_sim::sensor_model::{Environment, SensorModel};
 use rins_sim::{Scenario, SensorModelConfig, SimConfig, Simulator, TickOutput, TruthState};
+use rins_test_support::pyramid::optimal_pyramid_axes;
 
 fn truth(rate: Vector3<f64>, force: Vector3<f64>) -> TruthState {
     TruthState {
@@ -43,7 +44,7 @@ const SATURATION: u16 = ipc_types::status::SATURATION as u16;
 
 #[test]
 fn large_rate_saturates_and_clamps_with_status_bit() {
-    let axes = common::optimal_pyramid();
+    let axes = optimal_pyramid_axes();
     let mut m = model(&SensorModelConfig::default(), &axes);
     let mut frame = ImuFrame::default();
     let lsb = SensorModelConfig::default().gyro_lsb_rps();
@@ -129,7 +130,7 @@ proptest! {
     fn noiseless_counts_are_rounded_projections(
         wx in -8.0f64..8.0, wy in -8.0f64..8.0, wz in -8.0f64..8.0,
     ) {
-        let axes = common::optimal_pyramid();
+        let axes = optimal_pyramid_axes();
         let config = common::noiseless_sensors();
         let lsb = config.gyro_lsb_rps();
         let mut m = model(&config, &axes);
@@ -179,7 +180,7 @@ fn baro_pressure_follows_isa() {
         qnh_pa: 100_800.0,
         ..SimConfig::default().environment()
     };
-    let axes = common::optimal_pyramid();
+    let axes = optimal_pyramid_axes();
     let mut m = SensorModel::new(&config, &env, &axes, &axes, 1000.0, 5).unwrap();
     let n = 2000;
     for h in [0.0, 488.0, 1500.0, 4000.0] {
@@ -210,7 +211,7 @@ fn mean_mag(heading_deg: f64, declination_deg: f64) -> Vector3<f64> {
     let mut config = common::config(Scenario::Static);
     config.initial_heading_deg = heading_deg;
     config.earth_field.declination_deg = declination_deg;
-    let axes = common::optimal_pyramid();
+    let axes = optimal_pyramid_axes();
     let mut sim = Simulator::new(&config, &axes, &axes, 9).unwrap();
     let mut out = TickOutput::default();
     let mut sum = Vector3::zeros();
@@ -260,7 +261,7 @@ fn mag_applies_soft_and_hard_iron() {
         mag_soft_iron: [[1.1, 0.0, 0.0], [0.0, 0.9, 0.0], [0.05, 0.0, 1.0]],
         ..SensorModelConfig::default()
     };
-    let axes = common::optimal_pyramid();
+    let axes = optimal_pyramid_axes();
     let mut m = model(&config, &axes);
     let mut frame = MagFrame::default();
     m.mag(&UnitQuaternion::identity(), &mut frame);

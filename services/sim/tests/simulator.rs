@@ -8,6 +8,7 @@ use rins_sim::sensor_model::baro::isa_pressure_pa;
 use rins_sim::{
     ChannelFault, InertialSensor, Scenario, SimConfig, SimError, Simulator, TickOutput,
 };
+use rins_test_support::pyramid::optimal_pyramid_axes;
 
 fn imu(frame: &Frame) -> ImuFrame {
     match frame.payload {
@@ -17,7 +18,7 @@ fn imu(frame: &Frame) -> ImuFrame {
 }
 
 fn sim(config: &SimConfig, seed: u64) -> Simulator {
-    let axes = common::optimal_pyramid();
+    let axes = optimal_pyramid_axes();
     Simulator::new(config, &axes, &axes, seed).unwrap()
 }
 

@@ -7,6 +7,7 @@ use nalgebra::Vector3;
 use rins_earth::STANDARD_GRAVITY;
 use rins_protocol::Payload;
 use rins_sim::{InertialSensor, Scenario, SimConfig, Simulator, TickOutput};
+use rins_test_support::pyramid::{block_pyramid_axes, optimal_pyramid_axes};
 
 const SECONDS: usize = 10;
 
@@ -49,7 +50,7 @@ fn sample_sigma(density_si: f64, rate_hz: f64, lsb: f64) -> f64 {
 #[test]
 fn averaged_counts_match_projection_plus_true_errors_within_noise_bounds() {
     let config = common::config(Scenario::Static);
-    let axes = common::optimal_pyramid();
+    let axes = optimal_pyramid_axes();
     let mut sim = Simulator::new(&config, &axes, &axes, 7).unwrap();
     let n = SECONDS * 1000;
     let avg = run(&mut sim, n);
@@ -116,7 +117,7 @@ fn averaged_counts_match_projection_plus_true_errors_within_noise_bounds() {
 #[test]
 fn averaged_counts_match_ideal_projection_within_model_tolerance() {
     let config = SimConfig::default();
-    let axes = common::pyramid(28.7);
+    let axes = block_pyramid_axes();
     let s = &config.sensors;
     let mg = 1e-3 * STANDARD_GRAVITY;
     let n = 2000;
@@ -170,7 +171,7 @@ fn averaged_counts_match_ideal_projection_within_model_tolerance() {
 /// 4 kHz, where it doubles. The sample standard deviation of n samples has relative σ ≈ 1/√(2n).
 #[test]
 fn per_sample_noise_scales_with_root_rate() {
-    let axes = common::optimal_pyramid();
+    let axes = optimal_pyramid_axes();
     for rate in [1000.0, 4000.0] {
         let config = SimConfig {
             imu_rate_hz: rate,

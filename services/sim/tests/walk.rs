@@ -3,10 +3,7 @@
 //! swing dynamics, the foot-pressure load, and the configuration switch.
 
 mod common;
-#[path = "common/counting_alloc.rs"]
-mod counting_alloc;
 
-use counting_alloc::allocations_during;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use rins_earth::STANDARD_GRAVITY;
 use rins_earth::{meridian_radius, prime_vertical_radius};
@@ -17,6 +14,11 @@ use rins_sim::trajectory::walk::{
     STANCE_LOAD, STANCE_S, STRIDE_PERIOD_S, SWING_S, WalkPath,
 };
 use rins_sim::{Scenario, SimConfig, Simulator, TickOutput, Trajectory, TruthState};
+use rins_test_support::counting_alloc::{CountingAllocator, allocations_during};
+use rins_test_support::pyramid::optimal_pyramid_axes;
+
+#[global_allocator]
+static ALLOCATOR: CountingAllocator = CountingAllocator;
 
 /// Truth is sampled on the simulator's 1 kHz grid.
 const H: f64 = 1e-3;
@@ -414,7 +416,7 @@ fn foot_load_follows_the_stance_phases() {
 #[test]
 fn simulator_foot_pressure_frames_follow_the_load() {
     let config = walk_config(0.0, 3.0);
-    let axes = common::optimal_pyramid();
+    let axes = optimal_pyramid_axes();
     let mut sim = Simulator::new(&config, &axes, &axes, 5).unwrap();
     let sigma = config.sensors.foot_pressure_noise_counts;
     assert_eq!(sigma, 20.0);
@@ -454,7 +456,7 @@ fn walk_parses_from_toml_and_builds() {
     let c: SimConfig = toml::from_str("scenario = \"walk\"\nstatic_s = 2.0\n").unwrap();
     c.validate().unwrap();
     assert_eq!(c.scenario, Scenario::Walk);
-    let axes = common::optimal_pyramid();
+    let axes = optimal_pyramid_axes();
     let sim = Simulator::new(&c, &axes, &axes, 1).unwrap();
     assert_eq!(sim.trajectory().lift_off_s(), 2.0);
     assert!(sim.trajectory().end_s() > 100.0);

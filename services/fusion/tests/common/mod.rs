@@ -76,18 +76,66 @@ pub fn stacked_two() -> Geometry {
     })
 }
 
-impl Rig {
-    /// `sigma`: one σ for every channel, SI units. `quantize`: feed counts · lsb as the values
-    /// (and tell the monitor about the quantisation noise lsb²/12), else the exact noisy values.
-    pub fn new(
-        sensor: SensorType,
-        geometry: Geometry,
-        sigma: f64,
-        lsb: f64,
-        quantize: bool,
-        config: &FdiConfig,
-        seed: u64,
-    ) -> Self {
+/// Builds a [`Rig`]: the four-axis pyramid, the sensor type's default σ and converter step,
+/// quantised values, the default fault-detection settings and seed 0, unless told otherwise.
+pub struct RigBuilder {
+    sensor: SensorType,
+    geometry: Option<Geometry>,
+    sigma: Option<f64>,
+    lsb: Option<f64>,
+    quantize: bool,
+    config: FdiConfig,
+    seed: u64,
+}
+
+impl RigBuilder {
+    /// The channels' sensitive axes.
+    pub fn geometry(mut self, geometry: Geometry) -> Self {
+        self.geometry = Some(geometry);
+        self
+    }
+
+    /// One σ for every channel, SI units.
+    pub fn sigma(mut self, sigma: f64) -> Self {
+        self.sigma = Some(sigma);
+        self
+    }
+
+    /// The converter step, SI units.
+    pub fn lsb(mut self, lsb: f64) -> Self {
+        self.lsb = Some(lsb);
+        self
+    }
+
+    /// Feed the exact noisy values instead of counts · lsb (and no quantisation noise).
+    pub fn exact(mut self) -> Self {
+        self.quantize = false;
+        self
+    }
+
+    /// The fault-detection settings.
+    pub fn config(mut self, config: &FdiConfig) -> Self {
+        self.config = config.clone();
+        self
+    }
+
+    /// Seed of the noise.
+    pub fn seed(mut self, seed: u64) -> Self {
+        self.seed = seed;
+        self
+    }
+
+    /// The rig: with `quantize`, counts · lsb are the values and the monitor is told about the
+    /// quantisation noise lsb²/12.
+    pub fn build(self) -> Rig {
+        let (default_sigma, default_lsb) = match self.sensor {
+            SensorType::Gyro => (GYRO_SIGMA, GYRO_LSB),
+            SensorType::Accel => (ACCEL_SIGMA, ACCEL_LSB),
+        };
+        let geometry = self.geometry.unwrap_or_else(pyramid4);
+        let sigma = self.sigma.unwrap_or(default_sigma);
+        let lsb = self.lsb.unwrap_or(default_lsb);
+        let quantize = self.quantize;
         let n = geometry.n();
         let mut sig = [0.0; MAX_CHANNELS];
         sig[..n].fill(sigma);
@@ -96,13 +144,13 @@ impl Rig {
         let rails =
             std::array::from_fn(|_| [f64::from(COUNT_MIN) * lsb, f64::from(COUNT_MAX) * lsb]);
         let monitor = SensorMonitor::new(
-            sensor,
+            self.sensor,
             geometry,
             variances,
             rails,
-            config.settings().unwrap(),
+            self.config.settings().unwrap(),
         );
-        Self {
+        Rig {
             monitor,
             geometry,
             sigma: sig,
@@ -112,8 +160,23 @@ impl Rig {
             held: [0; MAX_CHANNELS],
             last_counts: [0; MAX_CHANNELS],
             block: 0,
-            rng: ChaCha8Rng::seed_from_u64(seed),
+            rng: ChaCha8Rng::seed_from_u64(self.seed),
             events: ChannelEvents::EMPTY,
+        }
+    }
+}
+
+impl Rig {
+    /// A rig of one sensor type, with the defaults of [`RigBuilder`].
+    pub fn builder(sensor: SensorType) -> RigBuilder {
+        RigBuilder {
+            sensor,
+            geometry: None,
+            sigma: None,
+            lsb: None,
+            quantize: true,
+            config: FdiConfig::default(),
+            seed: 0,
         }
     }
 

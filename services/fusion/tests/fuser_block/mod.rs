@@ -5,7 +5,7 @@
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
-use rins_fusion::fuser::{default_accel_sigma_mps2, default_gyro_sigma_rps};
+use rins_fusion::config::{default_accel_sigma_mps2, default_gyro_sigma_rps};
 use rins_fusion::{Fused, FusionConfig, Geometry, ImuFuser};
 
 /// Gyro converter step at ±300 °/s over 12 bits, rad/s.

@@ -3,22 +3,6 @@
 
 use rins_sim::{SensorModelConfig, SimConfig};
 
-/// The 4-face pyramid of docs/design.md §4: β_i = 45° + i·90°, elevation α.
-pub fn pyramid(alpha_deg: f64) -> Vec<[f64; 3]> {
-    let a = alpha_deg.to_radians();
-    (0..4)
-        .map(|i| {
-            let b = (45.0 + 90.0 * f64::from(i)).to_radians();
-            [a.cos() * b.cos(), a.cos() * b.sin(), a.sin()]
-        })
-        .collect()
-}
-
-/// Optimal 4-sensor pyramid (HᵀH = 4/3 I).
-pub fn optimal_pyramid() -> Vec<[f64; 3]> {
-    pyramid(35.264_389_682_754_654)
-}
-
 /// A sensor model with every random error and noise switched off.
 pub fn noiseless_sensors() -> SensorModelConfig {
     SensorModelConfig {

@@ -10,7 +10,7 @@ pub mod run;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow};
-use rins_navigator::aided::AidedConfig;
+use rins_navigator::inertial_core::AidedConfig;
 use serde::Serialize;
 
 use crate::datasets::foot::{FootTrial, PeerResult};

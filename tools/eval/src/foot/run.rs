@@ -1,7 +1,7 @@
 //! One foot-mounted recording through the aided navigator, no IPC.
 
 use rins_earth::{meridian_radius, prime_vertical_radius};
-use rins_navigator::aided::{AidedConfig, AidedNavigator};
+use rins_navigator::inertial_core::{AidedConfig, AidedNavigator};
 
 use crate::datasets::foot::FootTrial;
 use crate::integrity_tally::IntegrityTally;

@@ -1,6 +1,7 @@
 //! Monte Carlo comparison of a redundant skewed sensor block with an orthogonal triad built from
-//! the same sensors (the seed-003 experiment, DESIGN §4.1 and §4.5), run in-process on the
-//! product's libraries: simulator → fuser → navigator with the altimeter's baro aiding.
+//! the same sensors (the experiment of the structural-redundancy paper, see docs/design.md), run
+//! in-process on the product's libraries: simulator → fuser → navigator with the altimeter's baro
+//! aiding.
 //!
 //! Per run and system: the simulator flies the UAV profile at the IMU rate; the fuser solves body
 //! rate and specific force by least squares over the valid channels; the navigator aligns on the
@@ -18,6 +19,7 @@ pub mod errors;
 mod pipeline;
 pub mod report;
 pub mod run;
+mod table;
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc;

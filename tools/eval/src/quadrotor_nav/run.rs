@@ -5,8 +5,8 @@
 //! no magnetometer, no zero-velocity updates), which is the navigator's free-inertial path.
 
 use nalgebra::Vector3;
-use rins_navigator::aided::AidedConfig;
 use rins_navigator::ekf::ErrorStateEkf;
+use rins_navigator::inertial_core::AidedConfig;
 use rins_navigator::mechanisation::quaternion_from_euler;
 use rins_navigator::{ImuBias, NominalState};
 

@@ -1,52 +1,16 @@
-//! Barometric height and magnetometer heading updates of the [`AidedNavigator`].
+//! Barometric height and magnetometer heading updates of the [`AidedNavigator`]: the aiding
+//! readings that arrive on their own topics, applied to the inertial core's filter.
 //!
 //! Both arrive on their own topics, older than (or as old as) the IMU sample last propagated; the
 //! filter applies them to its current state. A baro reading further from the navigation time than
 //! `max_lag_s` is dropped rather than applied to the wrong epoch.
 
-use crate::checks::positive;
 use nalgebra::Vector3;
-use serde::{Deserialize, Serialize};
 
-use crate::aided::AidedNavigator;
 use crate::attitude::{rotation_vector_to_quaternion, wrap_pi};
 use crate::ekf::{ATT, AidingSource, POS, UpdateOutcome, VEL};
+use crate::inertial_core::AidedNavigator;
 use crate::mag_heading::{FieldReference, adaptive_sigma, measured_heading};
-
-/// Settings of the barometric height aiding (`[navigator.baro]`).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct BaroAidingConfig {
-    /// Apply baro height updates.
-    pub enabled: bool,
-    /// Smallest σ used, m, whatever variance the altimeter reports (its variance is that of the
-    /// pressure noise; the ISA model and weather add errors it does not see).
-    pub sigma_floor_m: f64,
-    /// Innovation gate (Mahalanobis distance).
-    pub gate: f64,
-    /// Largest accepted |reading time − navigation time|, s.
-    pub max_lag_s: f64,
-}
-
-impl Default for BaroAidingConfig {
-    fn default() -> Self {
-        Self {
-            enabled: true,
-            sigma_floor_m: 0.5,
-            gate: 5.0,
-            max_lag_s: 0.1,
-        }
-    }
-}
-
-impl BaroAidingConfig {
-    /// `(field, value)` of the first out-of-range parameter.
-    pub fn check(&self) -> Result<(), (&'static str, f64)> {
-        positive("sigma_floor_m", self.sigma_floor_m)?;
-        positive("gate", self.gate)?;
-        positive("max_lag_s", self.max_lag_s)
-    }
-}
 
 /// What became of one aiding reading.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -100,13 +64,8 @@ impl AidedNavigator {
             return AidingOutcome::Skipped;
         }
         if returning {
-            let variance = if variance_m2.is_finite() {
-                variance_m2
-            } else {
-                0.0
-            };
             ekf.state_mut().alt = height_m;
-            ekf.reset_component(POS + 2, variance.max(c.sigma_floor_m * c.sigma_floor_m));
+            ekf.reset_component(POS + 2, c.floored_variance(variance_m2));
             self.last_accepted_us[AidingSource::Baro as usize] = Some(t_us);
             return AidingOutcome::Readmitted;
         }
@@ -114,12 +73,7 @@ impl AidedNavigator {
         if lag_s > c.max_lag_s {
             return AidingOutcome::Skipped;
         }
-        let variance = if variance_m2.is_finite() {
-            variance_m2
-        } else {
-            0.0
-        };
-        let sigma = variance.max(c.sigma_floor_m * c.sigma_floor_m).sqrt();
+        let sigma = c.floored_variance(variance_m2).sqrt();
         let outcome = ekf.height(height_m, sigma, c.gate);
         if outcome.is_accepted() {
             self.last_accepted_us[AidingSource::Baro as usize] = Some(t_us);

@@ -30,20 +30,26 @@
 //! status says `block_saturated` and the fused solution is flagged not valid. Nothing is
 //! excluded (an over-range is not a channel fault) and the channels are Suspect (Saturated).
 
+mod health;
+mod parity_decision;
+mod status;
+
 use super::MAX_PARITY;
-use super::channel_health::{COUNT_MAX, COUNT_MIN, ChannelHealth, HealthFindings};
-use super::config::{FdiSettings, ParityNoise, ReadmitPolicy};
-use super::isolation::{self, ParityIsolation, ParityWindow};
+use super::channel_health::ChannelHealth;
+use super::config::{FdiSettings, ParityNoise};
+use super::isolation::ParityWindow;
 use super::noise_estimate::AdaptiveParityNoise;
 use super::offset::ParityOffset;
 use super::parity::ParitySpace;
 use super::persistence::Persistence;
-use super::recovery::{ExclusionRetest, RetestInput};
+use super::recovery::ExclusionRetest;
 use super::report::{ChannelEvents, SensorStatus};
 use super::stationary::ChannelReference;
 use crate::geometry::{Geometry, MAX_CHANNELS};
 use crate::wls::WlsSolver;
 use ipc_types::{ChannelState, FaultReason, SensorType};
+use parity_decision::motion_variance;
+use status::{HealthOutcome, ParityOutcome};
 
 /// One sample of one sensor type as the monitor sees it.
 #[derive(Debug, Clone, Copy)]
@@ -77,28 +83,15 @@ pub struct SensorEstimate {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 #[error("{sensor} channel {channel} does not exist ({n} channels fitted)")]
 pub struct ReadmitError {
+    /// The sensor type's name (`gyro`, `accel`).
     pub sensor: &'static str,
+    /// The channel asked for.
     pub channel: usize,
+    /// Channels the sensor type has.
     pub n: usize,
 }
 
-/// What the parity test of one sample concluded.
-struct ParityOutcome {
-    t: f64,
-    dim: usize,
-    /// Suspects of a detected-but-unisolated fault.
-    candidates: u32,
-    learning: bool,
-}
-
-/// What the health checks and the recovery re-test decided on one sample, for the status.
-struct HealthOutcome {
-    /// Channels Suspect for a genuine over-range.
-    saturated_suspect: u32,
-    block_saturated: bool,
-    auto_readmitted: u32,
-}
-
+/// The indices of the bits set in `mask`, lowest first.
 fn bits(mut mask: u32) -> impl Iterator<Item = usize> {
     std::iter::from_fn(move || {
         (mask != 0).then(|| {
@@ -269,200 +262,6 @@ impl SensorMonitor {
         (estimate, status)
     }
 
-    /// Health verdicts → exclusions; returns the channels Suspect for a genuine over-range.
-    fn apply_health(&mut self, found: &HealthFindings, z: &[f64; MAX_CHANNELS]) -> u32 {
-        for ch in bits(found.stuck & self.active_mask()) {
-            self.exclude(ch, FaultReason::Stuck);
-        }
-        if found.noise_verdict {
-            self.noisy_suspect = 0;
-        }
-        for ch in bits(found.noisy & self.active_mask()) {
-            // A noisy channel is still unbiased: with three left it is better than no solution.
-            if self.active_mask().count_ones() > 3 {
-                self.exclude(ch, FaultReason::Noisy);
-            } else {
-                self.noisy_suspect |= 1 << ch;
-            }
-        }
-        let saturated = found.saturated & self.active_mask();
-        if saturated == 0 {
-            return 0;
-        }
-        let in_range = self.should_be_in_range(saturated, found.at_rail, z);
-        for ch in bits(saturated & in_range) {
-            self.exclude(ch, FaultReason::Saturated);
-        }
-        saturated & !in_range
-    }
-
-    /// Of the `saturated` channels, those that the active channels not at a rail place well
-    /// inside the converter range (inner 90 %): a channel at a rail there is faulty, not
-    /// over-ranged. Needs three channels off the rails; without them nothing can be said.
-    fn should_be_in_range(&self, saturated: u32, at_rail: u32, z: &[f64; MAX_CHANNELS]) -> u32 {
-        let others = self.active_mask() & !at_rail;
-        let n = self.geometry.n();
-        if others.count_ones() < 3 {
-            return 0;
-        }
-        let Ok(solver) = WlsSolver::new(&self.geometry, others, &self.variances[..n]) else {
-            return 0;
-        };
-        let (x, _) = solver.solve(z);
-        let axes = self.geometry.axes();
-        bits(saturated)
-            .filter(|&ch| {
-                let h = axes[ch];
-                let predicted = h[0] * x[0] + h[1] * x[1] + h[2] * x[2];
-                let [lo, hi] = self.rail_values[ch];
-                let margin = 0.05 * (hi - lo);
-                predicted > lo + margin && predicted < hi - margin
-            })
-            .fold(0, |m, ch| m | 1 << ch)
-    }
-
-    /// Parity test, persistence, adaptive noise and isolation. Returns the test statistic, the
-    /// Suspect candidates of a detected-but-unisolated fault (0 when none) and whether the
-    /// adaptive estimate was still learning (declarations suspended).
-    fn parity_test(&mut self, z: &[f64; MAX_CHANNELS], stationary: bool) -> (f64, u32, bool) {
-        let active = self.active_mask();
-        let Some(space) = self.parity.as_mut().filter(|p| p.dimension() > 0) else {
-            self.reference.push(z, active, 0.0, true);
-            return (0.0, 0, false);
-        };
-        let dim = space.dimension();
-        let learning_seen =
-            (self.seen < u64::from(self.settings.learning_samples)).then_some(self.seen);
-        let learning = learning_seen.is_some();
-        self.seen = self.seen.saturating_add(1);
-        let mut p = [0.0; MAX_PARITY];
-        space.parity(z, &mut p);
-        let raw = p;
-        if let Some(offset) = &self.offset {
-            for (v, m) in p.iter_mut().zip(offset.mean()).take(dim) {
-                *v -= m;
-            }
-        }
-        // The motion's share of the channel noise inflates the parity noise uniformly (V has
-        // orthonormal rows); the test and the estimates see the parity scaled back to the
-        // motion-free noise, so the adaptive estimate does not learn the manoeuvres.
-        let base = space.mean_noise_variance();
-        let inflation = if base > 0.0 {
-            1.0 + self.motion_variance / base
-        } else {
-            1.0
-        };
-        let scale = inflation.sqrt().recip();
-        p.iter_mut().take(dim).for_each(|v| *v *= scale);
-        let mut pw = [0.0; MAX_PARITY];
-        let t = space.whiten(&p, &mut pw);
-        let exceeded = t > self.threshold;
-        self.window.push(&pw);
-        let persistent = self.persistence.push(exceeded);
-        self.episode = if self.persistence.count() > 0 {
-            self.episode + 1
-        } else {
-            0
-        };
-        // The estimates learn from every sample while learning, afterwards only while no sample
-        // of the window exceeded: a fault must become neither "offset" nor "noise".
-        if learning || self.persistence.count() == 0 {
-            if let Some(offset) = self.offset.as_mut() {
-                offset.update(&raw, dim, learning_seen);
-            }
-            let truncation = self.settings.truncation[dim];
-            if let Some(estimate) = self.adaptive.as_mut()
-                && estimate.update(&p, learning_seen, truncation)
-            {
-                space.set_noise_covariance(estimate.covariance());
-            }
-        }
-        let declared = persistent && !learning;
-        self.reference.push(z, active, t, !declared);
-        if !declared {
-            return (t, 0, learning);
-        }
-        let isolation = isolation::isolate(
-            space,
-            &self.window,
-            self.episode,
-            self.settings.isolation_margin,
-        );
-        let candidates = match isolation {
-            ParityIsolation::Channel(ch) => {
-                self.exclude(ch, FaultReason::Parity);
-                self.reconfigure();
-                return (t, 0, false);
-            }
-            ParityIsolation::Ambiguous(twins) => twins,
-            ParityIsolation::Unobservable => active,
-        };
-        if stationary
-            && let Some(ch) = self.reference.isolate(
-                candidates,
-                active,
-                &self.variances,
-                self.settings.reference_ratio,
-            )
-        {
-            self.exclude(ch, FaultReason::StationaryReference);
-            self.reconfigure();
-            return (t, 0, false);
-        }
-        (t, candidates, false)
-    }
-
-    fn build_status(
-        &self,
-        parity: &ParityOutcome,
-        health: &HealthOutcome,
-        input: &MonitorInput,
-    ) -> SensorStatus {
-        let saturated_suspect = health.saturated_suspect;
-        let n = self.geometry.n();
-        let candidates = parity.candidates;
-        let mut status = SensorStatus {
-            n,
-            test_statistic: parity.t,
-            threshold: self.threshold,
-            parity_dimension: parity.dim,
-            detected_not_isolated: candidates != 0,
-            device_error: input.device_error,
-            learning: parity.learning,
-            block_saturated: health.block_saturated,
-            auto_readmitted: health.auto_readmitted,
-            ..SensorStatus::ABSENT
-        };
-        for i in 0..n {
-            let bit = 1u32 << i;
-            let (state, reason) = if self.excluded[i] != FaultReason::None {
-                (ChannelState::Excluded, self.excluded[i])
-            } else {
-                let reason = if candidates & bit != 0 {
-                    FaultReason::Parity
-                } else if saturated_suspect & bit != 0 {
-                    FaultReason::Saturated
-                } else if self.noisy_suspect & bit != 0 {
-                    FaultReason::Noisy
-                } else if input.temperature_suspect & bit != 0 {
-                    FaultReason::Temperature
-                } else if input.device_error {
-                    FaultReason::DeviceError
-                } else {
-                    FaultReason::None
-                };
-                if reason == FaultReason::None {
-                    (ChannelState::Ok, reason)
-                } else {
-                    (ChannelState::Suspect, reason)
-                }
-            };
-            status.states[i] = state;
-            status.reasons[i] = reason;
-        }
-        status
-    }
-
     /// Closes a stationary-detector block (see [`super::stationary`]).
     pub fn end_block(&mut self, stationary: bool) {
         let dim = self.parity_dimension();
@@ -508,54 +307,7 @@ impl SensorMonitor {
         Ok(true)
     }
 
-    /// The recovery re-test (see [`super::recovery`]): while the type has no solution and the
-    /// policy allows, excluded channels that are valid, off the rails, varying and consistent with
-    /// the others for `readmit_after_samples` in a row return. Returns the channels re-admitted.
-    fn retest_exclusions(&mut self, input: &MonitorInput) -> u32 {
-        if self.solver.is_some() || self.settings.readmit == ReadmitPolicy::Operator {
-            self.retest.clear();
-            return 0;
-        }
-        let n = self.geometry.n();
-        let off_rail = (0..n)
-            .filter(|&i| {
-                input
-                    .counts
-                    .get(i)
-                    .is_some_and(|&c| c != COUNT_MIN && c != COUNT_MAX)
-            })
-            .fold(0u32, |m, i| m | 1 << i);
-        let candidates = self.active_mask() | (self.excluded_mask & input.valid & off_rail);
-        let mut z = *input.z;
-        for (v, offset) in z.iter_mut().zip(&self.channel_offset).take(n) {
-            *v -= offset;
-        }
-        let retest = RetestInput {
-            candidates,
-            counts: input.counts,
-            z: &z,
-        };
-        let Some(back) = self.retest.push(
-            &self.geometry,
-            &self.variances,
-            &self.settings.thresholds,
-            (self.settings.persistence_k, self.settings.persistence_n),
-            &retest,
-            self.settings.readmit_after_samples,
-        ) else {
-            return 0;
-        };
-        let returned = back & self.excluded_mask;
-        for ch in bits(returned) {
-            self.excluded[ch] = FaultReason::None;
-            self.health.forget(ch);
-        }
-        self.excluded_mask &= !returned;
-        self.reconfigure();
-        self.retest.clear();
-        returned
-    }
-
+    /// Latches the exclusion of `channel` with `reason` (the first reason stays).
     fn exclude(&mut self, channel: usize, reason: FaultReason) {
         if self.excluded[channel] == FaultReason::None {
             self.excluded[channel] = reason;
@@ -652,16 +404,4 @@ impl SensorMonitor {
     pub fn sensor(&self) -> SensorType {
         self.sensor
     }
-}
-
-/// Channel variance added by the motion: `(f·|x|)² + (τ·|x − x_prev|)²`, τ in samples.
-fn motion_variance(settings: &FdiSettings, x: &[f64; 3], last: &[f64; 3]) -> f64 {
-    let norm2 = |v: [f64; 3]| v.iter().map(|c| c * c).sum::<f64>();
-    let f = settings.motion_noise_fraction;
-    let tau = settings.timing_skew_samples;
-    if f == 0.0 && tau == 0.0 {
-        return 0.0;
-    }
-    let change = [x[0] - last[0], x[1] - last[1], x[2] - last[2]];
-    f * f * norm2(*x) + tau * tau * norm2(change)
 }

@@ -1,7 +1,7 @@
 //! The aided navigator's inertial core: static alignment, then the error-state EKF predicted on
 //! every IMU sample, with the zero-velocity update whenever the stance detector fires; barometric
 //! height and magnetometer heading updates arrive through [`AidedNavigator::on_baro`] and
-//! [`AidedNavigator::on_mag`] (see [`crate::aiding`]).
+//! [`AidedNavigator::on_mag`] (see [`crate::baro_mag_updates`]).
 //!
 //! Both profiles run it — a foot-mounted unit (pedestrian) and the airframe (uav); the offline
 //! evaluations and the live navigator share this one code path, so what the real recordings
@@ -10,9 +10,9 @@
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use crate::aiding::BaroAidingConfig;
 use crate::alignment::{AlignConfig, AlignError, Alignment, StaticAligner};
 use crate::attitude_recovery::AttitudeRecovery;
+use crate::baro_height::BaroAidingConfig;
 use crate::ekf::{AidingSource, EkfNoise, ErrorStateEkf, UpdateOutcome};
 use crate::integrity::{IntegrityConfig, IntegrityMonitor};
 use crate::mag_calibration::MagCalibration;

@@ -1,0 +1,11 @@
+//! Helpers the workspace's tests share, so that each is written once: a dev-dependency only,
+//! never part of a product build.
+//!
+//! - [`counting_alloc`]: a global allocator that counts this thread's allocations, for the
+//!   allocation-free checks of the per-sample paths.
+//! - [`pyramid`]: sensitive axes of the skewed pyramid layouts.
+//! - [`signal`]: sending a signal to a child process (or any process a test started).
+
+pub mod counting_alloc;
+pub mod pyramid;
+pub mod signal;
