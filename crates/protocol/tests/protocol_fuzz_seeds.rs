@@ -1,7 +1,7 @@
 //! The seed corpus of the `decoder` fuzz target (fuzz/corpus/decoder) is made of real encoded
 //! frames. These tests check that the committed seeds are what the current encoder produces; after a
 //! protocol change, regenerate them with
-//! `RINS_WRITE_FUZZ_SEEDS=1 cargo test -p rins-acquisition --test protocol_fuzz_seeds`.
+//! `RINS_WRITE_FUZZ_SEEDS=1 cargo test -p rins-protocol --test protocol_fuzz_seeds`.
 
 mod common;
 

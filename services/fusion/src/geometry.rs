@@ -1,10 +1,10 @@
-//! Sensitive-axis geometry of N redundant single-axis sensors (DESIGN §4.1).
+//! Sensitive-axis geometry of N redundant single-axis sensors (docs/design.md §4).
 //!
 //! Sensor i measures `z_i = h_iᵀ x + ε_i`; the rows h_iᵀ form the N×3 matrix H. With equal noise σ
 //! the least-squares estimate has covariance σ²(HᵀH)⁻¹, so diag((HᵀH)⁻¹) are the per-axis variance
 //! factors of a layout and their square roots its noise amplification.
 //!
-//! Layouts (`kind` in the configuration): `pyramid` (n axes on a cone, the seed's layout), `axes`
+//! Layouts (`kind` in the configuration): `pyramid` (n axes on a cone, the layout of [R1]), `axes`
 //! (any 3..=16 vectors), `triad` (orthogonal, no redundancy), `dodecahedron` (6 face normals,
 //! isotropic) and `stacked` (several triaxial IMUs, 3 rows each). What a layout allows for fault
 //! detection and isolation is worked out from these rows by the `capability` module.
@@ -54,7 +54,7 @@ pub enum GeometryConfig {
 }
 
 impl GeometryConfig {
-    /// The seed's four-sensor pyramid: α = 28.7°, β0 = 45°.
+    /// The four-sensor pyramid of [R1]: α = 28.7°, β0 = 45°.
     pub fn seed_pyramid() -> Self {
         GeometryConfig::Pyramid {
             n: 4,

@@ -260,7 +260,9 @@ proptest! {
         for i in 0..n {
             trace += p[i][i];
             for j in 0..n {
-                prop_assert!((p[i][j] - p[j][i]).abs() < 1e-12);
+                // Symmetric to the same rounding as the other identities: the projector is built
+                // through (HᵀH)⁻¹, whose rounding grows with the geometry's condition number.
+                prop_assert!((p[i][j] - p[j][i]).abs() < 1e-9, "P[{i}][{j}] − P[{j}][{i}] = {}", p[i][j] - p[j][i]);
                 // Idempotent: P² = P.
                 let pp: f64 = (0..n).map(|k| p[i][k] * p[k][j]).sum();
                 prop_assert!((pp - p[i][j]).abs() < 1e-9, "P²[{i}][{j}] = {pp} vs {}", p[i][j]);

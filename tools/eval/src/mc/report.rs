@@ -107,7 +107,7 @@ pub struct Ratios {
 }
 
 /// A published figure of the redundant-versus-orthogonal comparison this experiment repeats (the
-/// structural-redundancy paper, see docs/design.md): 2σ after a 5 h simulated UAV flight with
+/// structural-redundancy paper, [R1] in docs/references.md): 2σ after a 5 h simulated UAV flight with
 /// that paper's own aiding.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct PublishedClaim {
@@ -173,7 +173,6 @@ pub struct McReport {
     pub rms_mean_ratio: Ratios,
     /// The published claims, for the ratio: their absolute numbers come from a 5 h flight with
     /// other aiding and are not comparable with these.
-    #[serde(rename = "seed_003")]
     pub published_claims: [PublishedClaim; 4],
     /// Every run, for plots and checks.
     pub records: Vec<RunRecord>,

@@ -47,7 +47,7 @@ impl McReport {
         );
         let _ = writeln!(
             s,
-            "| error | {a} final | {b} final | ratio of 2σ | {a} RMS over flight | {b} RMS over flight | ratio of means | seed 003, 5 h: redundant / orthogonal = ratio |",
+            "| error | {a} final | {b} final | ratio of 2σ | {a} RMS over flight | {b} RMS over flight | ratio of means | [R1], 5 h: redundant / orthogonal = ratio |",
             a = r.label,
             b = o.label
         );
@@ -116,8 +116,8 @@ impl McReport {
             s,
             "\nCells are mean ± 2σ over runs. \"final\": signed error at the end of the flight (roll and \
              pitch pooled, north and east pooled). \"RMS over flight\": per run, the RMS from alignment to \
-             the end, sampled at 100 Hz; roll/pitch per axis, horizontal as the error length. Seed 003 \
-             flew 5 h with its own aiding: compare ratios, not absolute values."
+             the end, sampled at 100 Hz; roll/pitch per axis, horizontal as the error length. The published \
+             experiment [R1] flew 5 h with its own aiding: compare ratios, not absolute values."
         );
         if let (Some(rk), Some(ok)) = (&r.kill, &o.kill) {
             self.kill_table(&mut s, rk, ok);
