@@ -187,7 +187,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     // Only a root this run created is removed at the end (and only when empty).
     let root_created = settings.ensure_root()?;
     let run_dir = ensure_no_live_deployment(&settings)
-        .and_then(|()| settings.ensure_run_dir())
+        .and_then(|()| Ok(settings.ensure_run_dir()?))
         .inspect_err(|_| {
             if root_created {
                 let _ = std::fs::remove_dir(&settings.root);

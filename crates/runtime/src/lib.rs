@@ -5,6 +5,7 @@
 pub mod bounded_file;
 pub mod clock;
 pub mod config_error;
+pub mod error_chain;
 pub mod heartbeat;
 pub mod input_watch;
 pub mod ipc;
