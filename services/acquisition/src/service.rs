@@ -40,11 +40,12 @@ impl Publishers {
         let mut header = to_ipc::origin_header(frame, rx_ns);
         header.stamp(Stage::Acquisition, monotonic_ns());
         match &frame.payload {
-            Payload::Imu(f) => self.imu.publish(to_ipc::raw_imu(f, header)),
-            Payload::Baro(f) => self.baro.publish(to_ipc::raw_baro(f, header)),
-            Payload::Mag(f) => self.mag.publish(to_ipc::raw_mag(f, header)),
-            Payload::Aux(f) => self.aux.publish(to_ipc::raw_aux(f, header)),
+            Payload::Imu(f) => self.imu.publish(to_ipc::raw_imu(f, header))?,
+            Payload::Baro(f) => self.baro.publish(to_ipc::raw_baro(f, header))?,
+            Payload::Mag(f) => self.mag.publish(to_ipc::raw_mag(f, header))?,
+            Payload::Aux(f) => self.aux.publish(to_ipc::raw_aux(f, header))?,
         }
+        Ok(())
     }
 }
 
