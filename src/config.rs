@@ -141,31 +141,6 @@ impl RinsConfig {
         Ok(())
     }
 
-    /// Builds what the services build from this configuration — the geometries, the fuser, the
-    /// altimeter, the navigator — so that a configuration `rins up` accepts is never refused by a
-    /// process it starts. The loader's range checks should make this always succeed; the fuzz
-    /// target and the configuration property tests hold it to that.
-    pub fn build_services(&self) -> Result<()> {
-        let (gyro, accel) = self.geometries()?;
-        if gyro.n() < 3 || accel.n() < 3 {
-            return Err(anyhow!(
-                "fusion.geometry: {} gyro and {} accelerometer axes, need at least 3 each",
-                gyro.n(),
-                accel.n()
-            ));
-        }
-        rins_fusion::ImuFuser::new(
-            &self.fusion,
-            self.device.gyro_lsb_rps(),
-            self.device.accel_lsb_mps2(),
-        )
-        .map_err(|e| anyhow!("{}", e.within("fusion")))?;
-        rins_altimeter::AltitudeEstimator::new(self.altimeter.clone())
-            .map_err(|e| anyhow!("{}", e.within("altimeter")))?;
-        rins_navigator::Navigator::new(self.navigator.clone()).map_err(|e| anyhow!("{e}"))?;
-        Ok(())
-    }
-
     /// The gyro and accelerometer geometries of the configured sensor block.
     pub fn geometries(&self) -> Result<(rins_fusion::Geometry, rins_fusion::Geometry)> {
         let build = |cfg: &rins_fusion::GeometryConfig, field: &str| {

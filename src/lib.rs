@@ -1,5 +1,6 @@
 //! The parts of the `rins` executable other programs build on: its command line and its
 //! configuration loader (the fuzz targets feed the loader arbitrary text).
 
+pub mod built_services;
 pub mod cli;
 pub mod config;

@@ -83,7 +83,7 @@ received_at!(
 fn echo_from<T, S>(
     name: &'static str,
     opts: EchoOptions,
-    open: impl FnOnce(&IpcNode) -> Result<S>,
+    open: impl FnOnce(&IpcNode) -> Result<S, rins_runtime::ipc::IpcError>,
 ) -> Result<()>
 where
     T: Serialize + ReceivedAt,

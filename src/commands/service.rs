@@ -2,13 +2,16 @@
 
 use std::path::Path;
 
-use anyhow::{Result, anyhow};
+use anyhow::Result;
 use rins_runtime::ipc::IpcSettings;
+use rins_runtime::service::{Service, ServiceContext};
 use rins_runtime::shutdown::Shutdown;
 
 use crate::cli::ServiceName;
 use crate::config;
 
+/// Runs service `name` with the configuration at `config_path` (the built-in one when none) and,
+/// for acquisition, the serial device `port`.
 pub fn run(name: ServiceName, config_path: Option<&Path>, port: Option<String>) -> Result<()> {
     let process = name.kind().name();
     rins_runtime::logging::init(process);
@@ -16,37 +19,32 @@ pub fn run(name: ServiceName, config_path: Option<&Path>, port: Option<String>) 
     if let Some(port) = port {
         cfg.acquisition.port = Some(port);
     }
+    let built = cfg.build_services()?;
     let shutdown = Shutdown::install()?;
     let settings = IpcSettings::from_env();
     tracing::info!(service = %process, pid = std::process::id(), prefix = %settings.prefix, "starting");
+    let ctx = ServiceContext::new(settings, shutdown);
     let result = match name {
-        ServiceName::Acquisition => {
-            rins_acquisition::service::run(&cfg.acquisition, &settings, &shutdown)
+        ServiceName::Acquisition => rins_acquisition::service::AcquisitionService {
+            config: cfg.acquisition,
         }
-        ServiceName::Fusion => {
-            let fuser = rins_fusion::ImuFuser::new(
-                &cfg.fusion,
-                cfg.device.gyro_lsb_rps(),
-                cfg.device.accel_lsb_mps2(),
-            )
-            .map_err(|e| anyhow!("{}", e.within("fusion")))?;
-            let deadline = rins_fusion::service::input_deadline(cfg.fusion.sample_rate_hz);
-            rins_fusion::service::run(fuser, deadline, &settings, &shutdown)
+        .run(ctx),
+        ServiceName::Fusion => rins_fusion::service::FusionService {
+            fuser: built.fuser,
+            input_deadline: built.fusion_input_deadline,
         }
-        ServiceName::Altimeter => {
-            let estimator = rins_altimeter::AltitudeEstimator::new(cfg.altimeter.clone())
-                .map_err(|e| anyhow!("{}", e.within("altimeter")))?;
-            rins_altimeter::service::run(estimator, &settings, &shutdown)
+        .run(ctx),
+        ServiceName::Altimeter => rins_altimeter::service::AltimeterService {
+            estimator: built.altimeter,
         }
+        .run(ctx),
         ServiceName::Navigator | ServiceName::NavigatorStandby => {
-            let lane = u8::from(name == ServiceName::NavigatorStandby);
-            rins_navigator::service::run(
-                &cfg.navigator,
-                &settings,
-                &shutdown,
-                lane,
-                cfg.deployment.navigator_lanes,
-            )
+            rins_navigator::service::NavigatorService {
+                navigator: built.navigator,
+                lane: u8::from(name == ServiceName::NavigatorStandby),
+                lanes: cfg.deployment.navigator_lanes,
+            }
+            .run(ctx)
         }
     };
     tracing::info!(service = %process, ok = result.is_ok(), "stopped");

@@ -1,13 +1,14 @@
 //! Once-a-second heartbeat with the process's counters, on the `heartbeat` topic.
 
-use anyhow::Result;
 use ipc_types::{Health, PAYLOAD_VERSION, ServiceKind, names};
 
 use crate::clock::monotonic_ns;
-use crate::ipc::{IpcNode, TopicPublisher};
+use crate::ipc::{IpcError, IpcNode, TopicPublisher};
 
+/// Heartbeat period, ns.
 const PERIOD_NS: u64 = 1_000_000_000;
 
+/// The heartbeat publisher of one process, with what every beat says of the process itself.
 pub struct Heartbeat {
     publisher: TopicPublisher<Health>,
     template: Health,
@@ -15,7 +16,8 @@ pub struct Heartbeat {
 }
 
 impl Heartbeat {
-    pub fn new(node: &IpcNode, service: ServiceKind) -> Result<Self> {
+    /// The heartbeat of a process of kind `service` (this process's pid).
+    pub fn new(node: &IpcNode, service: ServiceKind) -> Result<Self, IpcError> {
         Ok(Self {
             publisher: TopicPublisher::new(node, names::HEARTBEAT)?,
             template: Health {
@@ -29,7 +31,7 @@ impl Heartbeat {
     }
 
     /// Publishes `counters` (service, pid and time filled in here) if a second has passed since the last.
-    pub fn tick(&mut self, counters: &Health) -> Result<()> {
+    pub fn tick(&mut self, counters: &Health) -> Result<(), IpcError> {
         let now = monotonic_ns();
         if now < self.next_due_ns {
             return Ok(());

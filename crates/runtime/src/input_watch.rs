@@ -25,6 +25,7 @@ pub struct InputWatch {
 }
 
 impl InputWatch {
+    /// A watch that calls the input stale after `deadline` without a sample.
     pub fn new(deadline: Duration) -> Self {
         Self {
             deadline_ns: u64::try_from(deadline.as_nanos()).unwrap_or(u64::MAX),

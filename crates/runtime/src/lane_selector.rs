@@ -43,6 +43,7 @@ const PENDING: usize = 512;
 /// Pending samples of the other lane at which a silent selected lane is left at once.
 pub const FORCE_SWITCH_PENDING: usize = PENDING / 2;
 
+/// When the selector leaves a lane for the other.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SelectorConfig {
     /// Samples the other lane must be ahead of the output before the selected lane counts as dead.
@@ -81,10 +82,14 @@ pub enum SwitchReason {
     Untrusted,
 }
 
+/// A change of the lane delivering, and why.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Switch {
+    /// The lane left.
     pub from: usize,
+    /// The lane delivering from now on.
     pub to: usize,
+    /// Why the selector switched.
     pub reason: SwitchReason,
     /// Sequence number of the first sample delivered from the new lane.
     pub at_seq: u64,
@@ -115,6 +120,7 @@ pub fn trusted(s: &NavState, settle: u64) -> bool {
 }
 
 impl LaneSelector {
+    /// A selector with nothing received yet, delivering lane 0 first.
     pub fn new(config: SelectorConfig) -> Self {
         Self {
             config,

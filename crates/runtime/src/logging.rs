@@ -2,6 +2,7 @@
 
 use tracing_subscriber::EnvFilter;
 
+/// Sets up logging to stderr for process `process` (level from `RINS_LOG`).
 pub fn init(process: &str) {
     let filter = EnvFilter::try_from_env("RINS_LOG")
         .unwrap_or_else(|_| EnvFilter::new("info,iceoryx2=warn"));

@@ -4,26 +4,30 @@
 
 use std::time::Duration;
 
-use anyhow::Result;
 use ipc_types::{NavState, names};
 
-use crate::ipc::{IpcNode, SampleSource, TopicSubscriber, wait_any};
+use crate::ipc::{IpcError, IpcNode, SampleSource, TopicSubscriber, TopicWaitSet};
 use crate::lane_selector::{LANES, LaneSelector, SelectorConfig, Switch};
 
+/// Both navigator lanes' topics, merged into the stream consumers see.
 pub struct NavSubscriber {
     lanes: [TopicSubscriber<NavState>; LANES],
+    /// Wakes on either lane.
+    waitset: TopicWaitSet,
     selector: LaneSelector,
     lane_totals: [u64; LANES],
     lane_latest: [Option<NavState>; LANES],
 }
 
 impl NavSubscriber {
-    pub fn new(node: &IpcNode) -> Result<Self> {
+    /// Subscribes to both lanes on `node`.
+    pub fn new(node: &IpcNode) -> Result<Self, IpcError> {
         Ok(Self {
             lanes: [
                 TopicSubscriber::new(node, names::NAV_LANES[0])?,
                 TopicSubscriber::new(node, names::NAV_LANES[1])?,
             ],
+            waitset: TopicWaitSet::new()?,
             selector: LaneSelector::new(SelectorConfig::default()),
             lane_totals: [0; LANES],
             lane_latest: [None; LANES],
@@ -33,7 +37,7 @@ impl NavSubscriber {
     /// Next sample of the merged stream, if one is due. Takes one sample of each lane at a time,
     /// so that a backlog (a consumer that slept) waits in the lanes' queues, which are deep, and
     /// not in the selector's ring, which holds only what a switch needs.
-    pub fn receive(&mut self) -> Result<Option<NavState>> {
+    pub fn receive(&mut self) -> Result<Option<NavState>, IpcError> {
         loop {
             if let Some(s) = self.selector.pop() {
                 return Ok(Some(s));
@@ -54,9 +58,9 @@ impl NavSubscriber {
     }
 
     /// Sleeps until either lane publishes or `timeout` passes.
-    pub fn wait(&self, timeout: Duration) -> Result<bool> {
+    pub fn wait(&self, timeout: Duration) -> Result<bool, IpcError> {
         let [a, b] = &self.lanes;
-        wait_any(&[a, b], timeout)
+        self.waitset.wait(&[a, b], timeout)
     }
 
     /// The lane delivering now.
@@ -86,11 +90,11 @@ impl NavSubscriber {
 }
 
 impl SampleSource<NavState> for NavSubscriber {
-    fn wait(&self, timeout: Duration) -> Result<bool> {
+    fn wait(&self, timeout: Duration) -> Result<bool, IpcError> {
         NavSubscriber::wait(self, timeout)
     }
 
-    fn receive(&mut self) -> Result<Option<NavState>> {
+    fn receive(&mut self) -> Result<Option<NavState>, IpcError> {
         NavSubscriber::receive(self)
     }
 }

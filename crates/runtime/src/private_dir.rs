@@ -40,10 +40,15 @@ pub fn kind_of(meta: &Metadata) -> &'static str {
 /// A path that is not a private directory of the expected user, with what was found there.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct NotPrivate {
+    /// The path checked.
     pub path: PathBuf,
+    /// What it is ("directory", "file", …), for the message.
     pub kind: &'static str,
+    /// Its owner's uid.
     pub owner: u32,
+    /// Its permission bits.
     pub mode: u32,
+    /// The uid that should own it.
     pub expected_owner: u32,
 }
 

@@ -15,7 +15,9 @@ pub const SHM_DIR: &str = "/dev/shm";
 /// A /dev/shm entry named with a deployment's prefix, as lstat(2) sees it.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ShmEntry {
+    /// The file name in /dev/shm.
     pub name: String,
+    /// Its owner's uid.
     pub owner: u32,
     /// A regular file (iceoryx2 segments are); anything else was not made by iceoryx2.
     pub regular: bool,

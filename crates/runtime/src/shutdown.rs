@@ -33,10 +33,12 @@ impl Shutdown {
         Self(Arc::new(AtomicBool::new(false)))
     }
 
+    /// Whether a stop was requested (by a signal or [`Shutdown::request`]).
     pub fn requested(&self) -> bool {
         self.0.load(Ordering::Relaxed)
     }
 
+    /// Requests a stop, as a termination signal would.
     pub fn request(&self) {
         self.0.store(true, Ordering::Relaxed);
     }

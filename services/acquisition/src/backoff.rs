@@ -31,6 +31,7 @@ pub struct Backoff {
 }
 
 impl Backoff {
+    /// A backoff starting at `initial`, doubling up to `max`.
     pub fn new(initial: Duration, max: Duration) -> Self {
         Self {
             initial,
@@ -56,10 +57,12 @@ impl Backoff {
         self.attempt = 0;
     }
 
+    /// The first delay, and the delay after a reset.
     pub fn initial(&self) -> Duration {
         self.initial
     }
 
+    /// The longest delay.
     pub fn max(&self) -> Duration {
         self.max
     }

@@ -2,11 +2,13 @@
 
 use serde::Deserialize;
 
+/// `[acquisition]` of the configuration: the serial device and how it is read.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct AcquisitionConfig {
     /// Serial device path (a real port, or the simulator's link). `rins up` fills it in for the simulator.
     pub port: Option<String>,
+    /// Line speed, baud.
     pub baud: u32,
     /// Longest a read blocks before the loop looks at shutdown and heartbeats again.
     pub read_timeout_ms: u64,
@@ -29,6 +31,7 @@ impl Default for AcquisitionConfig {
 }
 
 impl AcquisitionConfig {
+    /// Checks every value's range; the error names the field and the value.
     pub fn validate(&self) -> Result<(), String> {
         if self.baud == 0 {
             return Err("acquisition.baud = 0: must be > 0".into());

@@ -31,11 +31,22 @@ pub struct Retry {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Opened {
     /// The first open since start-up, after `waited` and `attempts` failed attempts.
-    First { waited: Duration, attempts: u32 },
+    First {
+        /// Time since start-up.
+        waited: Duration,
+        /// Failed attempts before this one.
+        attempts: u32,
+    },
     /// The device is back after being `away` for `attempts` failed attempts.
-    Reconnected { away: Duration, attempts: u32 },
+    Reconnected {
+        /// Time the device was missing.
+        away: Duration,
+        /// Failed attempts before this one.
+        attempts: u32,
+    },
 }
 
+/// Whether the device is open, and since when it is missing: what the log says of each open and loss.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Presence {
     backoff: Backoff,
@@ -50,6 +61,7 @@ fn since(start_ns: u64, now_ns: u64) -> Duration {
 }
 
 impl Presence {
+    /// A device not opened yet, retried with `backoff`.
     pub fn new(backoff: Backoff) -> Self {
         Self {
             backoff,
@@ -134,6 +146,7 @@ impl Presence {
         self.reconnects
     }
 
+    /// The backoff between attempts to open the device.
     pub fn backoff(&self) -> &Backoff {
         &self.backoff
     }

@@ -115,6 +115,7 @@ pub fn save(path: &Path, point: &ResumePoint) -> io::Result<()> {
 pub enum Loaded {
     /// No file: a first start.
     Missing,
+    /// A point written by an earlier run of this deployment.
     Point(ResumePoint),
     /// A file that is not to be trusted or not a point; the reason names the path.
     Ignored(String),

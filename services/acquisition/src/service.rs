@@ -9,8 +9,10 @@ use anyhow::{Result, anyhow};
 use ipc_types::{Health, RawAux, RawBaro, RawImu, RawMag, ServiceKind, Stage, names};
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::heartbeat::Heartbeat;
-use rins_runtime::ipc::{IpcNode, IpcSettings, TopicPublisher, create_node};
+use rins_runtime::ipc::{IpcNode, IpcSettings, create_node};
+use rins_runtime::service::{Service, ServiceContext};
 use rins_runtime::shutdown::Shutdown;
+use rins_runtime::stage_io::StagePublisher;
 
 use crate::backoff::Backoff;
 use crate::config::AcquisitionConfig;
@@ -19,32 +21,43 @@ use crate::resume_file;
 use crate::to_ipc;
 use rins_protocol::{DecodedFrame, Decoder, DecoderStats, FrameType, Payload};
 
+/// The topics acquisition publishes, one per frame type; each sample leaves stamped with the
+/// acquisition's publish time.
 struct Publishers {
-    imu: TopicPublisher<RawImu>,
-    baro: TopicPublisher<RawBaro>,
-    mag: TopicPublisher<RawMag>,
-    aux: TopicPublisher<RawAux>,
+    imu: StagePublisher<RawImu>,
+    baro: StagePublisher<RawBaro>,
+    mag: StagePublisher<RawMag>,
+    aux: StagePublisher<RawAux>,
 }
 
 impl Publishers {
     fn new(node: &IpcNode) -> Result<Self> {
+        let stage = Stage::Acquisition;
         Ok(Self {
-            imu: TopicPublisher::new(node, names::RAW_IMU)?,
-            baro: TopicPublisher::new(node, names::RAW_BARO)?,
-            mag: TopicPublisher::new(node, names::RAW_MAG)?,
-            aux: TopicPublisher::new(node, names::RAW_AUX)?,
+            imu: StagePublisher::new(node, names::RAW_IMU, stage)?,
+            baro: StagePublisher::new(node, names::RAW_BARO, stage)?,
+            mag: StagePublisher::new(node, names::RAW_MAG, stage)?,
+            aux: StagePublisher::new(node, names::RAW_AUX, stage)?,
         })
     }
 
     fn publish(&self, frame: &DecodedFrame, rx_ns: u64) -> Result<()> {
-        let mut header = to_ipc::origin_header(frame, rx_ns);
-        header.stamp(Stage::Acquisition, monotonic_ns());
+        let header = to_ipc::origin_header(frame, rx_ns);
         match &frame.payload {
-            Payload::Imu(f) => self.imu.publish(to_ipc::raw_imu(f, header)),
-            Payload::Baro(f) => self.baro.publish(to_ipc::raw_baro(f, header)),
-            Payload::Mag(f) => self.mag.publish(to_ipc::raw_mag(f, header)),
-            Payload::Aux(f) => self.aux.publish(to_ipc::raw_aux(f, header)),
+            Payload::Imu(f) => {
+                self.imu.publish(to_ipc::raw_imu(f, header))?;
+            }
+            Payload::Baro(f) => {
+                self.baro.publish(to_ipc::raw_baro(f, header))?;
+            }
+            Payload::Mag(f) => {
+                self.mag.publish(to_ipc::raw_mag(f, header))?;
+            }
+            Payload::Aux(f) => {
+                self.aux.publish(to_ipc::raw_aux(f, header))?;
+            }
         }
+        Ok(())
     }
 }
 
@@ -79,13 +92,26 @@ fn open_port(path: &str, config: &AcquisitionConfig) -> Result<serialport::TTYPo
         .map_err(|e| anyhow!("cannot open serial device {path}: {e}"))
 }
 
+/// The acquisition process: reads the configured serial device until a stop is requested.
+pub struct AcquisitionService {
+    /// `[acquisition]` of the configuration, with the device to read.
+    pub config: AcquisitionConfig,
+}
+
+impl Service for AcquisitionService {
+    fn run(self, ctx: ServiceContext) -> Result<()> {
+        run(&self.config, &ctx.settings, &ctx.shutdown)
+    }
+}
+
+/// Reads the serial device of `config` and publishes its frames until `shutdown` is requested.
 pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdown) -> Result<()> {
     let path = config.port.clone().ok_or_else(|| {
         anyhow!(
             "acquisition.port is not set: name the serial device (rins up sets it to the simulator)"
         )
     })?;
-    let node = create_node("acquisition", settings)?;
+    let node = create_node(ServiceKind::Acquisition.name(), settings)?;
     let publishers = Publishers::new(&node)?;
     let mut heartbeat = Heartbeat::new(&node, ServiceKind::Acquisition)?;
     let mut decoder = Decoder::new();

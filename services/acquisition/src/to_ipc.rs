@@ -4,6 +4,7 @@ use ipc_types::{Header, PAYLOAD_VERSION, RawAux, RawBaro, RawImu, RawMag};
 
 use rins_protocol::{AuxFrame, BaroFrame, DecodedFrame, ImuFrame, MagFrame};
 
+/// The header of a decoded frame: its device sequence and time, and when it was received (`rx_ns`).
 pub fn origin_header(frame: &DecodedFrame, rx_ns: u64) -> Header {
     Header {
         origin_seq: frame.seq,
@@ -13,6 +14,7 @@ pub fn origin_header(frame: &DecodedFrame, rx_ns: u64) -> Header {
     }
 }
 
+/// The raw IMU message of an IMU frame.
 pub fn raw_imu(f: &ImuFrame, header: Header) -> RawImu {
     let mut temperature_c = [0.0f32; ipc_types::MAX_TEMPERATURES];
     for (out, centi) in temperature_c.iter_mut().zip(f.temperature_centi_c) {
@@ -33,6 +35,7 @@ pub fn raw_imu(f: &ImuFrame, header: Header) -> RawImu {
     }
 }
 
+/// The raw barometer message of a barometer frame.
 pub fn raw_baro(f: &BaroFrame, header: Header) -> RawBaro {
     RawBaro {
         version: PAYLOAD_VERSION,
@@ -43,6 +46,7 @@ pub fn raw_baro(f: &BaroFrame, header: Header) -> RawBaro {
     }
 }
 
+/// The raw magnetometer message of a magnetometer frame.
 pub fn raw_mag(f: &MagFrame, header: Header) -> RawMag {
     RawMag {
         version: PAYLOAD_VERSION,
@@ -53,6 +57,7 @@ pub fn raw_mag(f: &MagFrame, header: Header) -> RawMag {
     }
 }
 
+/// The raw auxiliary message of an auxiliary frame.
 pub fn raw_aux(f: &AuxFrame, header: Header) -> RawAux {
     RawAux {
         version: PAYLOAD_VERSION,

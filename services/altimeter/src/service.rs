@@ -4,13 +4,13 @@ use std::time::Duration;
 
 use anyhow::Result;
 use ipc_types::{Altitude, Health, PAYLOAD_VERSION, RawBaro, ServiceKind, Stage, names};
-use rins_runtime::clock::monotonic_ns;
-use rins_runtime::heartbeat::Heartbeat;
-use rins_runtime::ipc::{IpcSettings, TopicPublisher, TopicSubscriber, create_node};
-use rins_runtime::shutdown::Shutdown;
+use rins_runtime::service::{Service, ServiceContext};
+use rins_runtime::stage_loop::{PipelineStage, StageLoop, StageTopics, Step};
 
 use crate::estimator::{AltitudeEstimator, AltitudeOutput};
 
+/// The longest sleep waiting for a barometer sample: how often the stop flag and the heartbeat are
+/// served when none comes.
 const WAIT: Duration = Duration::from_millis(100);
 
 /// The altitude message for one barometer sample (fusion stamp left to the caller).
@@ -26,33 +26,48 @@ pub fn altitude_message(raw: &RawBaro, out: &AltitudeOutput) -> Altitude {
     }
 }
 
-pub fn run(
-    mut estimator: AltitudeEstimator,
-    settings: &IpcSettings,
-    shutdown: &Shutdown,
-) -> Result<()> {
-    let node = create_node("altimeter", settings)?;
-    let input = TopicSubscriber::<RawBaro>::new(&node, names::RAW_BARO)?;
-    let output = TopicPublisher::<Altitude>::new(&node, names::ALTITUDE)?;
-    let mut heartbeat = Heartbeat::new(&node, ServiceKind::Altimeter)?;
-    let mut counters = Health::default();
+/// The altimeter as a stage of the pipeline: one altitude per barometer sample.
+struct AltimeterStage {
+    estimator: AltitudeEstimator,
+}
 
-    while !shutdown.requested() {
-        input.wait(WAIT)?;
-        while let Some(raw) = input.receive()? {
-            counters.received += 1;
-            if raw.version != PAYLOAD_VERSION {
-                counters.rejected += 1;
-                continue;
-            }
-            let out = estimator.update(raw.header.origin_device_time_us, raw.pressure_pa);
-            let mut msg = altitude_message(&raw, &out);
-            msg.header.stamp(Stage::Altimeter, monotonic_ns());
-            output.publish(msg)?;
-            counters.published += 1;
-        }
-        counters.rejected = counters.rejected.max(estimator.rejected_count());
-        heartbeat.tick(&counters)?;
+impl PipelineStage for AltimeterStage {
+    type Input = RawBaro;
+    type Output = Altitude;
+
+    fn step(&mut self, raw: &RawBaro) -> Step<Altitude> {
+        let out = self
+            .estimator
+            .update(raw.header.origin_device_time_us, raw.pressure_pa);
+        Step::Publish(altitude_message(raw, &out))
     }
-    Ok(())
+
+    fn after_input(&mut self, _received: u64, counters: &mut Health) {
+        // Samples the estimator refused (out of range, time not advancing) count as rejected too.
+        counters.rejected = counters.rejected.max(self.estimator.rejected_count());
+    }
+}
+
+/// The altimeter process: the estimator driven by the barometer topic until a stop is requested.
+pub struct AltimeterService {
+    /// The estimator built from the configuration.
+    pub estimator: AltitudeEstimator,
+}
+
+impl Service for AltimeterService {
+    fn run(self, ctx: ServiceContext) -> Result<()> {
+        let node = ctx.create_node(ServiceKind::Altimeter)?;
+        let topics = StageTopics {
+            kind: ServiceKind::Altimeter,
+            stage: Stage::Altimeter,
+            input: names::RAW_BARO,
+            output: names::ALTITUDE,
+            wait: WAIT,
+        };
+        let mut stage = AltimeterStage {
+            estimator: self.estimator,
+        };
+        StageLoop::new(&node, &topics, &ctx.shutdown)?.run(&mut stage)?;
+        Ok(())
+    }
 }

@@ -2,23 +2,22 @@
 
 use std::time::Duration;
 
-use anyhow::Result;
 use ipc_types::{
     ChannelState, FusedImu, FusionControl, Health, PAYLOAD_VERSION, RawImu, SensorType,
     ServiceKind, Stage, fused_flags, names,
 };
 use rins_runtime::clock::monotonic_ns;
-use rins_runtime::heartbeat::Heartbeat;
 use rins_runtime::input_watch::{InputChange, InputWatch};
-use rins_runtime::ipc::{IpcSettings, TopicPublisher, TopicSubscriber, create_node};
-use rins_runtime::shutdown::Shutdown;
+use rins_runtime::ipc::IpcError;
+use rins_runtime::service::{Service, ServiceContext};
+use rins_runtime::stage_io::StageInput;
+use rins_runtime::stage_loop::{PipelineStage, StageLoop, StageTopics, Step};
 
 use crate::fuser::{ACCEL_MASK_SHIFT, Fused, ImuFuser};
 
 // The wire's valid mask and the fuser agree on where the accelerometer bits start.
 const _: () = assert!(ACCEL_MASK_SHIFT == 16);
 
-/// Longest sleep between looks at the shutdown flag and the heartbeat.
 /// Longest sleep waiting for input; also how often the input deadline is checked.
 const WAIT: Duration = Duration::from_millis(10);
 
@@ -123,82 +122,81 @@ pub fn input_deadline(sample_rate_hz: f64) -> Duration {
     Duration::from_secs_f64((20.0 / sample_rate_hz).max(0.05))
 }
 
-pub fn run(
-    mut fuser: ImuFuser,
+/// Fusion as a stage of the pipeline: one fused sample (or a rejected one) per raw IMU frame;
+/// re-admission commands read before each batch of frames; the acquisition deadline checked after.
+struct FusionStage {
+    fuser: ImuFuser,
+    control: StageInput<FusionControl>,
+    n_gyro: usize,
+    n_accel: usize,
+    last_seq: Option<u64>,
+    mismatch_reported: bool,
     deadline: Duration,
-    settings: &IpcSettings,
-    shutdown: &Shutdown,
-) -> Result<()> {
-    let node = create_node("fusion", settings)?;
-    let input = TopicSubscriber::<RawImu>::new(&node, names::RAW_IMU)?;
-    let output = TopicPublisher::<FusedImu>::new(&node, names::FUSED_IMU)?;
-    let control = TopicSubscriber::<FusionControl>::new(&node, names::FUSION_CONTROL)?;
-    let mut heartbeat = Heartbeat::new(&node, ServiceKind::Fusion)?;
-    let (n_gyro, n_accel) = (fuser.gyro_geometry().n(), fuser.accel_geometry().n());
-    let mut counters = Health::default();
-    let mut last_seq: Option<u64> = None;
-    let mut mismatch_reported = false;
-    let mut acquisition = InputWatch::new(deadline);
+    acquisition: InputWatch,
+}
 
-    while !shutdown.requested() {
-        input.wait(WAIT)?;
-        while let Some(cmd) = control.receive()? {
-            if cmd.version == PAYLOAD_VERSION {
-                readmit(&mut fuser, &cmd);
-            } else {
-                counters.rejected += 1;
-            }
+impl FusionStage {
+    /// The message for a frame fusion cannot use (another payload version or another sensor
+    /// block), said once in the log.
+    fn reject(&mut self, raw: &RawImu) -> FusedImu {
+        if !self.mismatch_reported {
+            self.mismatch_reported = true;
+            tracing::error!(
+                version = raw.version,
+                n_gyro = raw.n_gyro,
+                n_accel = raw.n_accel,
+                expected_gyro = self.n_gyro,
+                expected_accel = self.n_accel,
+                "raw IMU frame does not match the configured sensor block; rejecting such frames"
+            );
         }
-        let mut received_any = false;
-        while let Some(raw) = input.receive()? {
-            received_any = true;
-            counters.received += 1;
-            if let Some(last) = last_seq
-                && raw.header.origin_seq > last + 1
-            {
-                counters.lost += raw.header.origin_seq - last - 1;
-            }
-            last_seq = Some(raw.header.origin_seq);
-            if raw.version != PAYLOAD_VERSION
-                || usize::from(raw.n_gyro) != n_gyro
-                || usize::from(raw.n_accel) != n_accel
-            {
-                counters.rejected += 1;
-                if !mismatch_reported {
-                    mismatch_reported = true;
-                    tracing::error!(
-                        version = raw.version,
-                        n_gyro = raw.n_gyro,
-                        n_accel = raw.n_accel,
-                        expected_gyro = n_gyro,
-                        expected_accel = n_accel,
-                        "raw IMU frame does not match the configured sensor block; rejecting such frames"
-                    );
-                }
-                let mut msg = rejected_message(&raw, &fuser);
-                msg.header.stamp(Stage::Fusion, monotonic_ns());
-                output.publish(msg)?;
-                counters.published += 1;
-                continue;
-            }
-            let fused = fuser.fuse_raw(&raw);
-            if !fused.events.is_empty() {
-                log_events(&fused, raw.header.origin_device_time_us);
-            }
-            let mut msg = fused_message(&raw, &fused, n_gyro, n_accel);
-            msg.header.stamp(Stage::Fusion, monotonic_ns());
-            output.publish(msg)?;
-            counters.published += 1;
+        rejected_message(raw, &self.fuser)
+    }
+}
+
+impl PipelineStage for FusionStage {
+    type Input = RawImu;
+    type Output = FusedImu;
+
+    fn before_input(&mut self, counters: &mut Health) -> Result<(), IpcError> {
+        let fuser = &mut self.fuser;
+        self.control.drain(counters, |cmd| readmit(fuser, &cmd))
+    }
+
+    fn received(&mut self, raw: &RawImu, counters: &mut Health) {
+        if let Some(last) = self.last_seq
+            && raw.header.origin_seq > last + 1
+        {
+            counters.lost += raw.header.origin_seq - last - 1;
         }
+        self.last_seq = Some(raw.header.origin_seq);
+    }
+
+    fn step(&mut self, raw: &RawImu) -> Step<FusedImu> {
+        if usize::from(raw.n_gyro) != self.n_gyro || usize::from(raw.n_accel) != self.n_accel {
+            return Step::Rejected(self.reject(raw));
+        }
+        let fused = self.fuser.fuse_raw(raw);
+        if !fused.events.is_empty() {
+            log_events(&fused, raw.header.origin_device_time_us);
+        }
+        Step::Publish(fused_message(raw, &fused, self.n_gyro, self.n_accel))
+    }
+
+    fn other_version(&mut self, raw: &RawImu) -> Option<FusedImu> {
+        Some(self.reject(raw))
+    }
+
+    fn after_input(&mut self, received: u64, counters: &mut Health) {
         let now = monotonic_ns();
-        let change = if received_any {
-            acquisition.input(now)
+        let change = if received > 0 {
+            self.acquisition.input(now)
         } else {
-            acquisition.idle(now)
+            self.acquisition.idle(now)
         };
         match change {
             InputChange::WentStale => tracing::warn!(
-                deadline_ms = deadline.as_millis() as u64,
+                deadline_ms = self.deadline.as_millis() as u64,
                 "no raw IMU from acquisition within the deadline: no fused output until it returns"
             ),
             InputChange::CameBack(gap) => tracing::warn!(
@@ -207,9 +205,41 @@ pub fn run(
             ),
             InputChange::None => {}
         }
-        counters.stale_input_episodes = acquisition.episodes;
-        counters.input_stale = u8::from(acquisition.is_stale());
-        heartbeat.tick(&counters)?;
+        counters.stale_input_episodes = self.acquisition.episodes;
+        counters.input_stale = u8::from(self.acquisition.is_stale());
     }
-    Ok(())
+}
+
+/// The fusion process: the fuser driven by the raw IMU topic until a stop is requested.
+pub struct FusionService {
+    /// The fuser built from the configuration.
+    pub fuser: ImuFuser,
+    /// How long fusion waits for raw IMU before it reports acquisition stale ([`input_deadline`]).
+    pub input_deadline: Duration,
+}
+
+impl Service for FusionService {
+    fn run(self, ctx: ServiceContext) -> anyhow::Result<()> {
+        let node = ctx.create_node(ServiceKind::Fusion)?;
+        let topics = StageTopics {
+            kind: ServiceKind::Fusion,
+            stage: Stage::Fusion,
+            input: names::RAW_IMU,
+            output: names::FUSED_IMU,
+            wait: WAIT,
+        };
+        let stage_loop = StageLoop::new(&node, &topics, &ctx.shutdown)?;
+        let mut stage = FusionStage {
+            n_gyro: self.fuser.gyro_geometry().n(),
+            n_accel: self.fuser.accel_geometry().n(),
+            fuser: self.fuser,
+            control: StageInput::new(&node, names::FUSION_CONTROL)?,
+            last_seq: None,
+            mismatch_reported: false,
+            deadline: self.input_deadline,
+            acquisition: InputWatch::new(self.input_deadline),
+        };
+        stage_loop.run(&mut stage)?;
+        Ok(())
+    }
 }

@@ -4,21 +4,22 @@
 
 use std::time::Duration;
 
-use anyhow::{Result, anyhow, bail};
+use anyhow::{Result, bail};
 use ipc_types::{
     Altitude, FusedImu, Health, Integrity, NavMode, NavState, PAYLOAD_VERSION, RawMag, ServiceKind,
     Stage, integrity_reason, names,
 };
-use rins_runtime::clock::monotonic_ns;
-use rins_runtime::heartbeat::Heartbeat;
-use rins_runtime::ipc::{IpcSettings, TopicPublisher, TopicSubscriber, create_node};
-use rins_runtime::shutdown::Shutdown;
+use rins_runtime::ipc::{IpcError, TopicSubscriber};
+use rins_runtime::service::{Service, ServiceContext};
+use rins_runtime::stage_io::StageInput;
+use rins_runtime::stage_loop::{PipelineStage, StageLoop, StageTopics, Step};
 
-use crate::config::NavigatorConfig;
 use crate::ekf::AidingSource;
 use crate::navigator::{Navigator, fused_sample_usable};
 use crate::takeover::Handover;
 
+/// The longest sleep waiting for a fused IMU sample: how often the stop flag and the heartbeat are
+/// served when none comes.
 const WAIT: Duration = Duration::from_millis(100);
 
 /// Feeds one fused IMU sample to the navigator and returns the state to publish (header copied,
@@ -54,8 +55,6 @@ pub fn step(nav: &mut Navigator, imu: &FusedImu, last: &NavState) -> NavState {
     out
 }
 
-/// Runs navigator lane `lane` of `lanes` (lane 0 is the primary, lane 1 the hot standby); each
-/// lane publishes on its own topic, [`names::NAV_LANES`].
 /// When the handover has a peer solution to take over: takes it, integrates the fused IMU samples
 /// kept since, and returns `Some(state of the newest kept sample)` — or `Some(None)` when the peer
 /// is ahead of every kept sample (`last` then stands at the peer's sequence number, so samples up
@@ -119,113 +118,148 @@ fn log_resets(before: [u64; AidingSource::COUNT], now: [u64; AidingSource::COUNT
     }
 }
 
-pub fn run(
-    config: &NavigatorConfig,
-    settings: &IpcSettings,
-    shutdown: &Shutdown,
-    lane: u8,
-    lanes: u8,
-) -> Result<()> {
-    let kind = match (lane, lanes) {
-        (0, 1 | 2) => ServiceKind::Navigator,
-        (1, 2) => ServiceKind::NavigatorStandby,
-        _ => bail!("navigator lane {lane} of {lanes}: lanes must be 1 or 2 and lane below it"),
-    };
-    let mut nav = Navigator::new(config.clone()).map_err(|e| anyhow!("{e}"))?;
-    let node = create_node(kind.name(), settings)?;
-    let imu_in = TopicSubscriber::<FusedImu>::new(&node, names::FUSED_IMU)?;
-    let alt_in = TopicSubscriber::<Altitude>::new(&node, names::ALTITUDE)?;
-    let mag_in = TopicSubscriber::<RawMag>::new(&node, names::RAW_MAG)?;
-    let output = TopicPublisher::<NavState>::new(&node, names::NAV_LANES[usize::from(lane)])?;
-    let mut heartbeat = Heartbeat::new(&node, kind)?;
-    let mut counters = Health::default();
-    let mut last = NavState {
-        lane,
-        ..NavState::default()
-    };
-    // With two lanes, a lane that aligns listens to its peer: restarted in flight, it takes the
-    // peer's solution over instead of waiting for a rest it will not get (see `takeover`).
-    let peer_in = match lanes {
-        2 => Some(TopicSubscriber::<NavState>::new(
-            &node,
-            names::NAV_LANES[usize::from(1 - lane)],
-        )?),
-        _ => None,
-    };
-    let mut handover = Handover::default();
-    let mut resets = nav.resets();
+/// The navigator as a stage of the pipeline: one navigation state per fused IMU sample, the
+/// aiding topics read before each batch, the peer lane listened to while aligning.
+struct NavigatorStage {
+    nav: Navigator,
+    alt_in: StageInput<Altitude>,
+    mag_in: StageInput<RawMag>,
+    /// The other lane's output, with two lanes.
+    peer_in: Option<TopicSubscriber<NavState>>,
+    /// Whether this batch listens to the peer (the lane aligns and has one).
+    listening: bool,
+    handover: Handover,
+    resets: [u64; AidingSource::COUNT],
+    /// The last state published.
+    last: NavState,
+}
 
-    while !shutdown.requested() {
-        imu_in.wait(WAIT)?;
+impl PipelineStage for NavigatorStage {
+    type Input = FusedImu;
+    type Output = NavState;
+
+    fn before_input(&mut self, counters: &mut Health) -> Result<(), IpcError> {
         // Aiding first: it is older than (or as old as) the IMU sample that woke us.
-        while let Some(alt) = alt_in.receive()? {
-            if alt.version == PAYLOAD_VERSION {
-                let _ = nav.on_baro(
-                    alt.header.origin_device_time_us,
-                    alt.height_m,
-                    alt.height_var,
-                    alt.valid != 0,
-                );
-            } else {
-                counters.rejected += 1;
-            }
-        }
-        while let Some(mag) = mag_in.receive()? {
-            if mag.version == PAYLOAD_VERSION {
-                let _ = nav.on_mag(
-                    mag.header.origin_device_time_us,
-                    mag.field_ut.map(f64::from),
-                );
-            } else {
-                counters.rejected += 1;
-            }
-        }
-        let listening = peer_in.as_ref().filter(|_| nav.mode() == NavMode::Aligning);
-        if let Some(peer_in) = listening {
+        let nav = &mut self.nav;
+        self.alt_in.drain(counters, |alt| {
+            let _ = nav.on_baro(
+                alt.header.origin_device_time_us,
+                alt.height_m,
+                alt.height_var,
+                alt.valid != 0,
+            );
+        })?;
+        self.mag_in.drain(counters, |mag| {
+            let _ = nav.on_mag(
+                mag.header.origin_device_time_us,
+                mag.field_ut.map(f64::from),
+            );
+        })?;
+        self.listening = self.peer_in.is_some() && self.nav.mode() == NavMode::Aligning;
+        if let Some(peer_in) = self.peer_in.as_ref().filter(|_| self.listening) {
             while let Some(peer) = peer_in.receive()? {
-                handover.push_peer(peer);
+                self.handover.push_peer(peer);
             }
         }
-        while let Some(imu) = imu_in.receive()? {
-            counters.received += 1;
-            if imu.version != PAYLOAD_VERSION {
-                counters.rejected += 1;
-                continue;
-            }
-            // A restarted fusion replays the raw IMU history it missed, starting before its last
-            // output: samples already integrated are skipped, not integrated twice.
-            if last.header.origin_seq != 0 && imu.header.origin_seq <= last.header.origin_seq {
-                continue;
-            }
-            let taken_over = match listening {
-                Some(_) if nav.mode() == NavMode::Aligning => {
-                    handover.push_imu(imu);
-                    take_over_if_ready(&mut nav, &mut handover, &mut last)
-                }
-                _ => None,
-            };
-            let mut state = match taken_over {
-                Some(Some(state)) => state,
-                // The peer's solution is ahead of this sample: nothing to publish for it.
-                Some(None) => continue,
-                None => step(&mut nav, &imu, &last),
-            };
-            state.version = PAYLOAD_VERSION;
-            state.header.stamp(Stage::Navigator, monotonic_ns());
-            output.publish(state)?;
-            let aligned = NavMode::from_u8(state.mode).is_some_and(|m| m != NavMode::Aligning);
-            if aligned && state.integrity != last.integrity {
-                log_integrity(&state);
-            }
-            if nav.resets() != resets {
-                log_resets(resets, nav.resets(), state.header.origin_device_time_us);
-                resets = nav.resets();
-            }
-            last = state;
-            counters.published += 1;
-        }
-        counters.lost = nav.rejected_imu_samples();
-        heartbeat.tick(&counters)?;
+        Ok(())
     }
-    Ok(())
+
+    fn step(&mut self, imu: &FusedImu) -> Step<NavState> {
+        // A restarted fusion replays the raw IMU history it missed, starting before its last
+        // output: samples already integrated are skipped, not integrated twice.
+        if self.last.header.origin_seq != 0 && imu.header.origin_seq <= self.last.header.origin_seq
+        {
+            return Step::Skip;
+        }
+        let taken_over = if self.listening && self.nav.mode() == NavMode::Aligning {
+            self.handover.push_imu(*imu);
+            take_over_if_ready(&mut self.nav, &mut self.handover, &mut self.last)
+        } else {
+            None
+        };
+        let mut state = match taken_over {
+            Some(Some(state)) => state,
+            // The peer's solution is ahead of this sample: nothing to publish for it.
+            Some(None) => return Step::Skip,
+            None => step(&mut self.nav, imu, &self.last),
+        };
+        state.version = PAYLOAD_VERSION;
+        Step::Publish(state)
+    }
+
+    fn published(&mut self, state: &NavState) {
+        let aligned = NavMode::from_u8(state.mode).is_some_and(|m| m != NavMode::Aligning);
+        if aligned && state.integrity != self.last.integrity {
+            log_integrity(state);
+        }
+        if self.nav.resets() != self.resets {
+            log_resets(
+                self.resets,
+                self.nav.resets(),
+                state.header.origin_device_time_us,
+            );
+            self.resets = self.nav.resets();
+        }
+        self.last = *state;
+    }
+
+    fn after_input(&mut self, _received: u64, counters: &mut Health) {
+        counters.lost = self.nav.rejected_imu_samples();
+    }
+}
+
+/// Navigator lane `lane` of `lanes` (lane 0 is the primary, lane 1 the hot standby), with the
+/// navigator built from the configuration; each lane publishes on its own topic,
+/// [`names::NAV_LANES`].
+pub struct NavigatorService {
+    /// The navigator built from the configuration.
+    pub navigator: Navigator,
+    /// This process's lane.
+    pub lane: u8,
+    /// How many lanes the deployment runs (1 or 2).
+    pub lanes: u8,
+}
+
+impl Service for NavigatorService {
+    fn run(self, ctx: ServiceContext) -> Result<()> {
+        let (lane, lanes) = (self.lane, self.lanes);
+        let kind = match (lane, lanes) {
+            (0, 1 | 2) => ServiceKind::Navigator,
+            (1, 2) => ServiceKind::NavigatorStandby,
+            _ => bail!("navigator lane {lane} of {lanes}: lanes must be 1 or 2 and lane below it"),
+        };
+        let node = ctx.create_node(kind)?;
+        let topics = StageTopics {
+            kind,
+            stage: Stage::Navigator,
+            input: names::FUSED_IMU,
+            output: names::NAV_LANES[usize::from(lane)],
+            wait: WAIT,
+        };
+        let stage_loop = StageLoop::new(&node, &topics, &ctx.shutdown)?;
+        // With two lanes, a lane that aligns listens to its peer: restarted in flight, it takes the
+        // peer's solution over instead of waiting for a rest it will not get (see `takeover`).
+        let peer_in = match lanes {
+            2 => Some(TopicSubscriber::<NavState>::new(
+                &node,
+                names::NAV_LANES[usize::from(1 - lane)],
+            )?),
+            _ => None,
+        };
+        let mut stage = NavigatorStage {
+            resets: self.navigator.resets(),
+            nav: self.navigator,
+            alt_in: StageInput::new(&node, names::ALTITUDE)?,
+            mag_in: StageInput::new(&node, names::RAW_MAG)?,
+            peer_in,
+            listening: false,
+            handover: Handover::default(),
+            last: NavState {
+                lane,
+                ..NavState::default()
+            },
+        };
+        stage_loop.run(&mut stage)?;
+        Ok(())
+    }
 }

@@ -2,6 +2,7 @@
 
 use nalgebra::{Quaternion, UnitQuaternion};
 
+/// RMS and largest of a stream of errors.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct ErrorStats {
     n: u64,
@@ -10,12 +11,14 @@ pub struct ErrorStats {
 }
 
 impl ErrorStats {
+    /// Adds one error sample.
     pub fn push(&mut self, error: f64) {
         self.n += 1;
         self.sum_sq += error * error;
         self.max = self.max.max(error.abs());
     }
 
+    /// Samples added so far.
     pub fn count(&self) -> u64 {
         self.n
     }
@@ -25,6 +28,7 @@ impl ErrorStats {
         (self.n > 0).then(|| (self.sum_sq / self.n as f64).sqrt())
     }
 
+    /// The largest error, once there is a sample.
     pub fn max(&self) -> Option<f64> {
         (self.n > 0).then_some(self.max)
     }
@@ -46,11 +50,14 @@ pub fn attitude_error_deg(truth: [f64; 4], estimate: [f64; 4]) -> f64 {
 /// Attitude and altitude error accumulated over a run.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Accuracy {
+    /// Attitude error, degrees.
     pub attitude_deg: ErrorStats,
+    /// Altitude error, m.
     pub altitude_m: ErrorStats,
 }
 
 impl Accuracy {
+    /// Compares one navigation sample (attitude quaternion, altitude) with the simulator's truth.
     pub fn push(&mut self, truth_q: [f64; 4], truth_alt: f64, nav_q: [f64; 4], nav_alt: f64) {
         self.attitude_deg.push(attitude_error_deg(truth_q, nav_q));
         self.altitude_m.push(nav_alt - truth_alt);

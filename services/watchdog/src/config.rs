@@ -21,18 +21,27 @@ pub const SUPERVISED: [&str; 6] = [
 #[derive(Debug, Clone, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ServiceRestartConfig {
+    /// First restart delay, ms.
     pub restart_initial_backoff_ms: Option<u64>,
+    /// Longest restart delay, ms.
     pub restart_max_backoff_ms: Option<u64>,
+    /// A child running this long, s, restarts with the first delay again.
     pub restart_stable_after_s: Option<f64>,
+    /// Exits allowed within the window before the child is given up.
     pub max_restarts: Option<u32>,
+    /// The window the exits are counted in, s.
     pub restart_window_s: Option<f64>,
+    /// What giving up a child does.
     pub give_up: Option<GiveUp>,
 }
 
+/// `[watchdog]` of the configuration: restarts, the checks that find a hung child, the status line.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct WatchdogConfig {
+    /// First restart delay, ms.
     pub restart_initial_backoff_ms: u64,
+    /// Longest restart delay, ms.
     pub restart_max_backoff_ms: u64,
     /// A child that ran this long has its failure count reset. A crash loop (a child dying within
     /// this time of its start) backs off exponentially; a child that ran for a while and was killed
@@ -80,6 +89,7 @@ impl Default for WatchdogConfig {
 }
 
 impl WatchdogConfig {
+    /// Checks every value's range; the error names the field and the value.
     pub fn validate(&self) -> Result<(), String> {
         self.settings_for(None).validate("watchdog")?;
         for name in self.services.keys() {

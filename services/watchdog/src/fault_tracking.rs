@@ -18,6 +18,7 @@ pub struct FaultRecord {
     pub kind: &'static str,
     /// The fault's parameter (SI units, or the noise factor), if it takes one.
     pub param: Option<f64>,
+    /// When the fault was injected, s since the start of the run.
     pub injected_at_s: f64,
     /// First fused output at or after injection with the channel Suspect or Excluded, or the
     /// type's detected-not-isolated flag set.
@@ -104,6 +105,7 @@ pub struct FaultTracker {
 }
 
 impl FaultTracker {
+    /// A tracker with no fault injected yet.
     pub fn new() -> Self {
         Self::default()
     }

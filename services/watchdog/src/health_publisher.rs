@@ -15,6 +15,7 @@ use crate::supervisor::Supervisor;
 /// Report period.
 pub const PERIOD: Duration = Duration::from_millis(250);
 
+/// Publishes the deployment's health report, once a second.
 pub struct HealthPublisher {
     publisher: TopicPublisher<HealthReport>,
     /// A running process whose heartbeat is older than this is reported silent.
@@ -27,6 +28,7 @@ pub struct HealthPublisher {
 }
 
 impl HealthPublisher {
+    /// The publisher on `node`; a process whose heartbeat is older than `silent_after` is reported silent.
     pub fn new(node: &IpcNode, started: Instant, silent_after: Duration) -> Result<Self> {
         let now = Instant::now();
         Ok(Self {

@@ -10,11 +10,13 @@ use crate::monitor::HeartbeatSeen;
 /// What is known of one process when the report is made.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ProcessView {
+    /// Which process.
     pub kind: ServiceKind,
     /// Current pid; `None` while it waits out its restart backoff or was given up.
     pub pid: Option<u32>,
     /// Exceeded its restart limit: no longer restarted.
     pub given_up: bool,
+    /// Times it was restarted.
     pub restarts: u64,
     /// The last heartbeat of this kind of process.
     pub heartbeat: Option<HeartbeatSeen>,

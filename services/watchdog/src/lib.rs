@@ -3,14 +3,20 @@
 
 pub mod accuracy;
 pub mod config;
+pub mod deployment_checks;
 pub mod fault_tracking;
 pub mod health_publisher;
 pub mod health_report;
+pub mod kill_decisions;
 pub mod monitor;
 pub mod output_deadline;
+pub mod process_graph;
 pub mod restart_policy;
 pub mod restart_timing;
+pub mod run_summary;
 pub mod seq_gaps;
+pub mod sim_start;
 pub mod status;
 pub mod summary;
+pub mod supervision_loop;
 pub mod supervisor;

@@ -22,6 +22,7 @@ pub const COUNTED: [&str; 6] = ["imu", "baro", "mag", "fused", "alt", "nav"];
 /// The last heartbeat of one process kind.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct HeartbeatSeen {
+    /// The process's pid.
     pub pid: u32,
     /// The sender's CLOCK_MONOTONIC time, ns.
     pub at_ns: u64,
@@ -32,17 +33,23 @@ pub struct HeartbeatSeen {
 /// The serial device's counters, as acquisition reports them (see the decoder's `DecoderStats`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct DeviceCounters {
+    /// Serial frames with a bad CRC.
     pub crc_errors: u64,
     /// Valid CRC, malformed content.
     pub malformed_frames: u64,
+    /// Frames missing from the device's sequence.
     pub lost_frames: u64,
     /// Repeated sequence numbers, not published.
     pub duplicate_frames: u64,
     /// Reordered frames that came after a later one, not published, not lost.
     pub late_frames: u64,
+    /// Device sequence-counter discontinuities.
     pub seq_jumps: u64,
+    /// Device-clock discontinuities.
     pub time_rebases: u64,
+    /// Bytes skipped while resynchronising.
     pub resync_bytes: u64,
+    /// Times the device was reopened.
     pub reconnects: u64,
 }
 
@@ -78,6 +85,7 @@ impl DeviceCounters {
     }
 }
 
+/// Every topic the watchdog reads, and what it counted of them.
 pub struct Monitor {
     imu: TopicSubscriber<RawImu>,
     baro: TopicSubscriber<RawBaro>,
@@ -91,8 +99,11 @@ pub struct Monitor {
     fault_events: TopicSubscriber<FaultApplied>,
     /// Samples seen per topic of [`COUNTED`], since start.
     pub totals: [u64; COUNTED.len()],
+    /// Navigation samples missing from the merged stream.
     pub nav_gaps: SeqGaps,
+    /// The newest navigation sample.
     pub last_nav: Option<NavState>,
+    /// Navigation error against the simulator's truth.
     pub accuracy: Accuracy,
     /// Navigation samples after alignment per integrity level (ok, degraded, invalid).
     pub integrity_samples: [u64; 3],
@@ -106,6 +117,7 @@ pub struct Monitor {
 }
 
 impl Monitor {
+    /// Subscribes to every topic the watchdog counts, on `node`.
     pub fn new(node: &IpcNode) -> Result<Self> {
         Ok(Self {
             imu: TopicSubscriber::new(node, names::RAW_IMU)?,

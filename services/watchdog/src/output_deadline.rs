@@ -26,6 +26,7 @@ struct Track {
     armed: bool,
 }
 
+/// The output deadline of each stage: input arriving, output silent for longer is a hung stage.
 #[derive(Debug, Clone)]
 pub struct OutputDeadline {
     deadline: Duration,
@@ -33,6 +34,7 @@ pub struct OutputDeadline {
 }
 
 impl OutputDeadline {
+    /// Deadlines of `deadline`.
     pub fn new(deadline: Duration) -> Self {
         Self {
             deadline,

@@ -18,6 +18,7 @@ pub enum GiveUp {
     LeaveDown,
 }
 
+/// How a child is restarted, and when it is given up.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RestartPolicy {
     /// Delay before the first restart.
@@ -29,7 +30,9 @@ pub struct RestartPolicy {
     pub stable_after: Duration,
     /// At most this many restarts within `window`; one more and the watchdog gives up.
     pub max_restarts: u32,
+    /// The window exits are counted in.
     pub window: Duration,
+    /// What giving up the child does.
     pub give_up: GiveUp,
 }
 

@@ -8,6 +8,7 @@ use ipc_types::ServiceKind;
 
 const KINDS: usize = ServiceKind::ALL.len();
 
+/// Restart-to-publish times: from a child's exit to its first output after the restart.
 #[derive(Debug, Clone, Default)]
 pub struct RestartTiming {
     /// Per kind: when its exit was seen and its output count then.

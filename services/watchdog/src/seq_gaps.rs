@@ -1,5 +1,6 @@
 //! Counting samples missing from a stream of increasing sequence numbers.
 
+/// Counts the numbers missing from a sequence.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct SeqGaps {
     last: Option<u64>,
@@ -10,6 +11,7 @@ pub struct SeqGaps {
 }
 
 impl SeqGaps {
+    /// Takes sequence number `seq`, counting the numbers skipped since the last.
     pub fn observe(&mut self, seq: u64) {
         match self.last {
             Some(last) if seq > last => self.missing += seq - last - 1,
@@ -21,6 +23,7 @@ impl SeqGaps {
         }
     }
 
+    /// The newest sequence number seen.
     pub fn last(&self) -> Option<u64> {
         self.last
     }

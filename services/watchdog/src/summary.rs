@@ -7,8 +7,11 @@ use crate::fault_tracking::FaultRecord;
 /// Navigation samples per integrity level.
 #[derive(Debug, Clone, Copy, Default, Serialize, PartialEq, Eq)]
 pub struct IntegritySamples {
+    /// Samples with integrity ok.
     pub ok: u64,
+    /// Samples with integrity degraded.
     pub degraded: u64,
+    /// Samples with integrity invalid.
     pub invalid: u64,
 }
 
@@ -22,16 +25,21 @@ impl From<[u64; 3]> for IntegritySamples {
     }
 }
 
+/// What `rins up --json` prints at the end of a run.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct Summary {
+    /// Length of the run, s.
     pub duration_s: f64,
     /// IMU frames published by acquisition.
     pub frames: u64,
+    /// Barometer frames published by acquisition.
     pub baro_frames: u64,
+    /// Magnetometer frames published by acquisition.
     pub mag_frames: u64,
     /// IMU frames sent by the device for which no navigation output appeared (serial losses and
     /// pipeline losses together), between the first and the last navigation output.
     pub dropped: u64,
+    /// Serial frames with a bad CRC.
     pub crc_errors: u64,
     /// Frames with a valid CRC but malformed content (unknown type, bad length, counts beyond 12
     /// bits), as counted by acquisition.
@@ -47,29 +55,36 @@ pub struct Summary {
     pub seq_jumps: u64,
     /// Device-clock discontinuities, re-based on the receive clock.
     pub time_rebases: u64,
+    /// Navigation samples of the merged stream.
     pub nav_samples: u64,
+    /// Child restarts.
     pub restarts: u64,
     /// Longest time from a child's exit to the first sample of its output topic from its
     /// successor, ms, and how many restarts were timed so (0 and 0 without restarts).
     pub restart_to_publish_ms_max: f64,
+    /// Restarts whose restart-to-publish time was measured.
     pub restart_measurements: u64,
     /// Per service: name, longest exit-to-publish time (ms), restarts timed.
     pub restart_to_publish_ms_by_service: Vec<(String, f64, u64)>,
     /// Samples received from each navigator lane; lane changes of the selector and samples it took
     /// from the other lane to fill a hole of the delivering one.
     pub nav_lane_samples: [u64; 2],
+    /// Switches between navigator lanes.
     pub nav_lane_switches: u64,
+    /// Samples of one lane filled in from the other.
     pub nav_lane_filled: u64,
     /// Navigation samples after alignment the navigator judged ok, degraded and invalid.
     pub nav_integrity_samples: IntegritySamples,
     /// Attitude error against simulator truth after alignment, degrees (simulator mode only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub att_err_deg_rms: Option<f64>,
+    /// Largest attitude error, degrees (simulator only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub att_err_deg_max: Option<f64>,
     /// Altitude error against simulator truth after alignment, metres (simulator mode only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub alt_err_m_rms: Option<f64>,
+    /// Largest altitude error, m (simulator only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub alt_err_m_max: Option<f64>,
     /// Shared-memory entries of this deployment left after shutdown.

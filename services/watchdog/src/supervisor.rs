@@ -13,9 +13,13 @@ use crate::restart_policy::{GiveUp, RestartPolicy, RestartWindow};
 /// How to start one child, and how to restart it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChildSpec {
+    /// The child's name (its service's name).
     pub name: String,
+    /// The program to run.
     pub program: PathBuf,
+    /// Its arguments.
     pub args: Vec<String>,
+    /// How it is restarted.
     pub policy: RestartPolicy,
 }
 
@@ -30,6 +34,7 @@ struct Managed {
     given_up: bool,
 }
 
+/// The children of the watchdog: started, reaped, restarted, stopped.
 #[derive(Default)]
 pub struct Supervisor {
     children: Vec<Managed>,
@@ -38,9 +43,11 @@ pub struct Supervisor {
 /// One child as [`Supervisor::children`] reports it.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ChildStatus {
+    /// The child's name.
     pub name: String,
     /// `None` while the child waits out its restart backoff or was given up.
     pub pid: Option<u32>,
+    /// Times it was restarted.
     pub restarts: u64,
     /// It exceeded its restart limit and is no longer restarted.
     pub given_up: bool,
@@ -49,21 +56,33 @@ pub struct ChildStatus {
 /// What happened to a child during [`Supervisor::poll`].
 #[derive(Debug, Clone, PartialEq)]
 pub enum ChildEvent {
+    /// The child exited; it is restarted after `restart_in`.
     Exited {
+        /// The child.
         name: String,
+        /// How it exited.
         status: String,
+        /// Delay before the restart.
         restart_in: Duration,
     },
+    /// The child was started again.
     Restarted {
+        /// The child.
         name: String,
+        /// Its new pid.
         pid: u32,
     },
     /// The child exited more often than its limit allows within its window: it is not restarted.
     GaveUp {
+        /// The child.
         name: String,
+        /// How it exited last.
         status: String,
+        /// Exits within the window.
         exits: usize,
+        /// The window.
         window: Duration,
+        /// What giving up does.
         action: GiveUp,
     },
 }
@@ -88,6 +107,7 @@ fn spawn(spec: &ChildSpec) -> Result<Child> {
 }
 
 impl Supervisor {
+    /// A supervisor with no child.
     pub fn new() -> Self {
         Self::default()
     }
@@ -167,6 +187,7 @@ impl Supervisor {
         }
     }
 
+    /// Restarts of every child so far.
     pub fn restarts(&self) -> u64 {
         self.children.iter().map(|m| m.restarts).sum()
     }

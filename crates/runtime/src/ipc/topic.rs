@@ -1,0 +1,216 @@
+//! Topics: a publish-subscribe service plus an event service of the same name, so that a consumer
+//! sleeps until data arrives instead of polling. Every process opens a topic with the same
+//! settings, so whoever comes first creates it.
+
+use std::fmt::Debug;
+use std::time::Duration;
+
+use iceoryx2::port::listener::{Listener, ListenerWaitError};
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::{event, publish_subscribe};
+
+use super::error::IpcError;
+use super::node::IpcNode;
+
+/// Queue depth of every subscriber: a consumer may sleep up to this many samples of a 1 kHz topic
+/// (plus margin at 8 kHz) before the oldest is overwritten.
+const SUBSCRIBER_BUFFER: usize = 512;
+/// Publishers per topic: restarted services leave a dead publisher until it is cleaned up.
+const MAX_PUBLISHERS: usize = 16;
+const MAX_SUBSCRIBERS: usize = 16;
+const MAX_NODES: usize = 64;
+
+/// Samples of the raw IMU topic its publisher keeps for subscribers that connect later: a fusion
+/// process restarted after a crash receives the frames it missed while it was down (up to 256 ms
+/// at 1 kHz) and the navigation output has no hole. Other topics keep none: a late consumer of
+/// them wants what comes next, not what was.
+const RAW_IMU_HISTORY: usize = 256;
+
+fn history_size(name: &str) -> usize {
+    if name == ipc_types::names::RAW_IMU {
+        RAW_IMU_HISTORY
+    } else {
+        0
+    }
+}
+
+fn service_name(topic: &'static str) -> Result<ServiceName, IpcError> {
+    ServiceName::new(topic).map_err(|source| IpcError::TopicName { topic, source })
+}
+
+fn open_pubsub<T: Debug + ZeroCopySend + 'static>(
+    node: &IpcNode,
+    topic: &'static str,
+) -> Result<publish_subscribe::PortFactory<ipc::Service, T, ()>, IpcError> {
+    node.service_builder(&service_name(topic)?)
+        .publish_subscribe::<T>()
+        .max_publishers(MAX_PUBLISHERS)
+        .max_subscribers(MAX_SUBSCRIBERS)
+        .max_nodes(MAX_NODES)
+        .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
+        .history_size(history_size(topic))
+        .enable_safe_overflow(true)
+        .open_or_create()
+        .map_err(|source| IpcError::OpenTopic { topic, source })
+}
+
+fn open_event(
+    node: &IpcNode,
+    topic: &'static str,
+) -> Result<event::PortFactory<ipc::Service>, IpcError> {
+    node.service_builder(&service_name(topic)?)
+        .event()
+        .max_notifiers(MAX_PUBLISHERS)
+        .max_listeners(MAX_SUBSCRIBERS)
+        .max_nodes(MAX_NODES)
+        .open_or_create()
+        .map_err(|source| IpcError::OpenEvent { topic, source })
+}
+
+/// Publishing end of a topic: sends the sample, then wakes the topic's listeners.
+pub struct TopicPublisher<T: Debug + ZeroCopySend + 'static> {
+    publisher: Publisher<ipc::Service, T, ()>,
+    notifier: Notifier<ipc::Service>,
+    name: &'static str,
+}
+
+impl<T: Debug + ZeroCopySend + 'static> TopicPublisher<T> {
+    /// Opens (or creates) topic `name` and a publisher on it.
+    pub fn new(node: &IpcNode, name: &'static str) -> Result<Self, IpcError> {
+        let publisher = open_pubsub::<T>(node, name)?
+            .publisher_builder()
+            .create()
+            .map_err(|source| IpcError::Publisher {
+                topic: name,
+                source,
+            })?;
+        let notifier = open_event(node, name)?
+            .notifier_builder()
+            .create()
+            .map_err(|source| IpcError::Notifier {
+                topic: name,
+                source,
+            })?;
+        Ok(Self {
+            publisher,
+            notifier,
+            name,
+        })
+    }
+
+    /// Writes `value` straight into shared memory and wakes the listeners.
+    pub fn publish(&self, value: T) -> Result<(), IpcError> {
+        let topic = self.name;
+        let sample = self
+            .publisher
+            .loan_uninit()
+            .map_err(|source| IpcError::Loan { topic, source })?;
+        sample
+            .write_payload(value)
+            .send()
+            .map_err(|source| IpcError::Send { topic, source })?;
+        self.notifier
+            .notify()
+            .map_err(|source| IpcError::Notify { topic, source })?;
+        Ok(())
+    }
+}
+
+/// Receiving end of a topic.
+pub struct TopicSubscriber<T: Debug + ZeroCopySend + 'static> {
+    subscriber: Subscriber<ipc::Service, T, ()>,
+    listener: Listener<ipc::Service>,
+    name: &'static str,
+}
+
+impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
+    /// Opens (or creates) topic `name` and a subscriber on it.
+    pub fn new(node: &IpcNode, name: &'static str) -> Result<Self, IpcError> {
+        let subscriber = open_pubsub::<T>(node, name)?
+            .subscriber_builder()
+            .create()
+            .map_err(|source| IpcError::Subscriber {
+                topic: name,
+                source,
+            })?;
+        let listener = open_event(node, name)?
+            .listener_builder()
+            .create()
+            .map_err(|source| IpcError::Listener {
+                topic: name,
+                source,
+            })?;
+        Ok(Self {
+            subscriber,
+            listener,
+            name,
+        })
+    }
+
+    /// Next queued sample, copied out of shared memory (payloads are small and `Copy`).
+    pub fn receive(&self) -> Result<Option<T>, IpcError> {
+        let sample = self
+            .subscriber
+            .receive()
+            .map_err(|source| IpcError::Receive {
+                topic: self.name,
+                source,
+            })?;
+        Ok(sample.map(|s| *s.payload()))
+    }
+
+    /// Sleeps until a publisher signals new data or `timeout` passes. Returns whether a signal came.
+    pub fn wait(&self, timeout: Duration) -> Result<bool, IpcError> {
+        match self.listener.timed_wait(|_| {}, timeout) {
+            Ok(woken) => Ok(woken > 0),
+            // A signal (the termination request the caller polls for) cut the wait short.
+            Err(ListenerWaitError::InterruptSignal) => Ok(false),
+            Err(source) => Err(IpcError::Wait {
+                topic: self.name,
+                source,
+            }),
+        }
+    }
+
+    /// The topic's name.
+    pub fn name(&self) -> &'static str {
+        self.name
+    }
+
+    /// The listener a [`super::TopicWaitSet`] attaches.
+    pub(super) fn listener(&self) -> &Listener<ipc::Service> {
+        &self.listener
+    }
+
+    /// Consumes pending signals without sleeping.
+    pub(super) fn clear_signals(&self) -> Result<(), IpcError> {
+        self.listener
+            .try_wait(|_| {})
+            .map(|_| ())
+            .map_err(|source| IpcError::Wait {
+                topic: self.name,
+                source,
+            })
+    }
+}
+
+/// Something samples of `T` come from: one topic, or a merged stream such as the navigator lanes.
+pub trait SampleSource<T> {
+    /// Sleeps until data may be there or `timeout` passes.
+    fn wait(&self, timeout: Duration) -> Result<bool, IpcError>;
+    /// The next sample, if one is there.
+    fn receive(&mut self) -> Result<Option<T>, IpcError>;
+}
+
+impl<T: Debug + ZeroCopySend + Copy + 'static> SampleSource<T> for TopicSubscriber<T> {
+    fn wait(&self, timeout: Duration) -> Result<bool, IpcError> {
+        TopicSubscriber::wait(self, timeout)
+    }
+
+    fn receive(&mut self) -> Result<Option<T>, IpcError> {
+        TopicSubscriber::receive(self)
+    }
+}

@@ -1,0 +1,101 @@
+//! The two ends of a pipeline stage: the topics it reads, each sample checked against this build's
+//! payload version on receipt (and counted when refused), and the topics it publishes, each sample
+//! stamped with the stage's publish time on its way out.
+
+use std::fmt::Debug;
+use std::time::Duration;
+
+use iceoryx2::prelude::ZeroCopySend;
+use ipc_types::{Health, Stage};
+
+use crate::clock::monotonic_ns;
+use crate::ipc::{IpcError, IpcNode, TopicPublisher, TopicSubscriber};
+use crate::payload::{Stamped, Versioned};
+
+/// A sample as [`StageInput::receive`] hands it over.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Received<T> {
+    /// Written with this build's payload version.
+    Current(T),
+    /// Written with another payload version: already counted in [`Health::rejected`].
+    OtherVersion(T),
+}
+
+impl<T> Received<T> {
+    /// The sample, whatever its version.
+    pub fn payload(&self) -> &T {
+        match self {
+            Received::Current(s) | Received::OtherVersion(s) => s,
+        }
+    }
+}
+
+/// A topic a stage reads.
+pub struct StageInput<T: Debug + ZeroCopySend + 'static> {
+    topic: TopicSubscriber<T>,
+}
+
+impl<T: Versioned + Debug + ZeroCopySend + Copy + 'static> StageInput<T> {
+    /// Subscribes to topic `name`.
+    pub fn new(node: &IpcNode, name: &'static str) -> Result<Self, IpcError> {
+        Ok(Self {
+            topic: TopicSubscriber::new(node, name)?,
+        })
+    }
+
+    /// The next sample, if one is queued. One written with another payload version is counted in
+    /// `counters.rejected` here, the one place the version is checked.
+    pub fn receive(&self, counters: &mut Health) -> Result<Option<Received<T>>, IpcError> {
+        Ok(self.topic.receive()?.map(|sample| {
+            if sample.is_current() {
+                Received::Current(sample)
+            } else {
+                counters.rejected += 1;
+                Received::OtherVersion(sample)
+            }
+        }))
+    }
+
+    /// Hands every queued sample of this build's payload version to `on_sample`, in order; the
+    /// others are counted rejected and dropped.
+    pub fn drain(
+        &self,
+        counters: &mut Health,
+        mut on_sample: impl FnMut(T),
+    ) -> Result<(), IpcError> {
+        while let Some(received) = self.receive(counters)? {
+            if let Received::Current(sample) = received {
+                on_sample(sample);
+            }
+        }
+        Ok(())
+    }
+
+    /// Sleeps until a publisher signals or `timeout` passes; a signal to the process cuts it short.
+    pub fn wait(&self, timeout: Duration) -> Result<bool, IpcError> {
+        self.topic.wait(timeout)
+    }
+}
+
+/// A topic a stage publishes: each sample leaves stamped with the stage's publish time.
+pub struct StagePublisher<T: Debug + ZeroCopySend + 'static> {
+    topic: TopicPublisher<T>,
+    stage: Stage,
+}
+
+impl<T: Stamped + Debug + ZeroCopySend + Copy + 'static> StagePublisher<T> {
+    /// Publishes on topic `name` as `stage`.
+    pub fn new(node: &IpcNode, name: &'static str, stage: Stage) -> Result<Self, IpcError> {
+        Ok(Self {
+            topic: TopicPublisher::new(node, name)?,
+            stage,
+        })
+    }
+
+    /// Stamps `sample` with the stage's publish time, now, and publishes it; returns it as sent.
+    pub fn publish(&self, mut sample: T) -> Result<T, IpcError> {
+        sample.header_mut().stamp(self.stage, monotonic_ns());
+        self.topic.publish(sample)?;
+        Ok(sample)
+    }
+}

@@ -1,0 +1,49 @@
+//! The process graph of a deployment: which services the watchdog starts and in which order.
+
+use ipc_types::ServiceKind;
+
+/// The pipeline's services in start order: consumers first, so that no sample is published before
+/// its subscriber exists. The hot-standby navigator lane runs when the deployment asks for two
+/// navigator lanes. The simulator is not here: it replaces the serial device, and starts last,
+/// once acquisition waits for its terminal.
+pub fn pipeline_services(navigator_lanes: u8) -> Vec<ServiceKind> {
+    let mut kinds = vec![ServiceKind::Navigator];
+    if navigator_lanes == 2 {
+        kinds.push(ServiceKind::NavigatorStandby);
+    }
+    kinds.extend([
+        ServiceKind::Altimeter,
+        ServiceKind::Fusion,
+        ServiceKind::Acquisition,
+    ]);
+    kinds
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn consumers_start_before_their_producers() {
+        let names = |lanes| -> Vec<&str> {
+            pipeline_services(lanes)
+                .into_iter()
+                .map(ServiceKind::name)
+                .collect()
+        };
+        assert_eq!(
+            names(1),
+            ["navigator", "altimeter", "fusion", "acquisition"]
+        );
+        assert_eq!(
+            names(2),
+            [
+                "navigator",
+                "navigator-standby",
+                "altimeter",
+                "fusion",
+                "acquisition"
+            ]
+        );
+    }
+}

@@ -1,0 +1,57 @@
+//! The summary of a run, gathered from what the watchdog counted once its children are stopped.
+
+use std::time::Duration;
+
+use crate::monitor::Monitor;
+use crate::restart_timing::RestartTiming;
+use crate::summary::Summary;
+use crate::supervisor::Supervisor;
+
+/// The run's summary; the accuracy figures only when the simulator was the device (they compare
+/// with its truth). `shm_leaked` is left 0: it is known only once the shared memory is removed.
+pub fn summarise(
+    monitor: &Monitor,
+    supervisor: &Supervisor,
+    timing: &RestartTiming,
+    elapsed: Duration,
+    simulate: bool,
+) -> Summary {
+    let (restart_worst, restart_measurements) = timing.worst();
+    let device = monitor.device_counters();
+    let acc = &monitor.accuracy;
+    let sim = |v: Option<f64>| if simulate { v } else { None };
+    Summary {
+        duration_s: elapsed.as_secs_f64(),
+        frames: monitor.totals[0],
+        baro_frames: monitor.totals[1],
+        mag_frames: monitor.totals[2],
+        dropped: monitor.nav_gaps.missing,
+        crc_errors: device.crc_errors,
+        malformed_frames: device.malformed_frames,
+        lost_frames: device.lost_frames,
+        duplicate_frames: device.duplicate_frames,
+        late_frames: device.late_frames,
+        seq_jumps: device.seq_jumps,
+        time_rebases: device.time_rebases,
+        nav_samples: monitor.totals[5],
+        restarts: supervisor.restarts(),
+        restart_to_publish_ms_max: restart_worst.as_secs_f64() * 1e3,
+        restart_measurements,
+        restart_to_publish_ms_by_service: timing
+            .by_kind()
+            .into_iter()
+            .map(|(kind, worst, n)| (kind.name().to_string(), worst.as_secs_f64() * 1e3, n))
+            .collect(),
+        nav_lane_samples: monitor.nav_lanes().lane_totals(),
+        nav_lane_switches: monitor.nav_lanes().switches().0,
+        nav_lane_filled: monitor.nav_lanes().filled(),
+        nav_integrity_samples: monitor.integrity_samples.into(),
+        att_err_deg_rms: sim(acc.attitude_deg.rms()),
+        att_err_deg_max: sim(acc.attitude_deg.max()),
+        alt_err_m_rms: sim(acc.altitude_m.rms()),
+        alt_err_m_max: sim(acc.altitude_m.max()),
+        shm_leaked: 0,
+        faults: monitor.faults.records().to_vec(),
+        false_alarms: monitor.faults.false_alarms(),
+    }
+}
