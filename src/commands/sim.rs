@@ -2,10 +2,11 @@
 
 use anyhow::{Result, bail};
 use rins_runtime::ipc::IpcSettings;
+use rins_runtime::service::{Service, ServiceContext};
 use rins_runtime::shutdown::Shutdown;
 use rins_sim::Simulator;
 use rins_sim::fault_command::WhiteNoise;
-use rins_sim::service::SimOptions;
+use rins_sim::service::{SimOptions, SimService};
 
 use crate::cli::SimArgs;
 use crate::commands::fault_args;
@@ -35,5 +36,5 @@ pub fn run(args: &SimArgs) -> Result<()> {
         faults,
         noise: WhiteNoise::from_config(&cfg.sim),
     };
-    rins_sim::service::run(sim, &options, &IpcSettings::from_env(), &shutdown)
+    SimService { sim, options }.run(ServiceContext::new(IpcSettings::from_env(), shutdown))
 }

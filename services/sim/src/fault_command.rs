@@ -5,6 +5,7 @@
 use std::fmt;
 
 use ipc_types::{MAX_CHANNELS, PAYLOAD_VERSION, SensorType, SimControl, SimFault};
+use rins_runtime::payload::Versioned;
 
 use crate::config::SimConfig;
 use crate::device_fault::{DURATION_RANGE, Disconnect};
@@ -273,7 +274,7 @@ impl FaultCommand {
 
     /// Decodes and validates an IPC command.
     pub fn from_control(control: &SimControl) -> Result<Self, ControlError> {
-        if control.version != PAYLOAD_VERSION {
+        if !control.is_current() {
             return Err(ControlError::Unknown);
         }
         let sensor = SensorType::from_u8(control.sensor).ok_or(ControlError::Unknown)?;

@@ -13,8 +13,8 @@ use ipc_types::{
 use rins_protocol::{Frame, MAX_FRAME_LEN, encode};
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::heartbeat::Heartbeat;
-use rins_runtime::ipc::{IpcSettings, TopicPublisher, TopicSubscriber, create_node};
-use rins_runtime::shutdown::Shutdown;
+use rins_runtime::ipc::{TopicPublisher, TopicSubscriber};
+use rins_runtime::service::{Service, ServiceContext};
 
 use crate::device_fault::Disconnect;
 use crate::fault_command::{ControlError, FaultCommand, WhiteNoise};
@@ -29,6 +29,7 @@ const FRAMES_PER_TICK: usize = 4;
 /// When a new pseudo-terminal cannot be made, the next try comes this much device time later.
 const PLUG_RETRY_S: f64 = 0.1;
 
+/// How the simulator process runs, beside the simulated device itself.
 pub struct SimOptions {
     /// Also expose the pseudo-terminal under this path (a stable name for acquisition).
     pub link: Option<PathBuf>,
@@ -40,6 +41,7 @@ pub struct SimOptions {
     pub noise: WhiteNoise,
 }
 
+/// The truth topic's sample for one tick of the simulated trajectory.
 pub fn truth_message(t: &TruthSample) -> Truth {
     Truth {
         version: PAYLOAD_VERSION,
@@ -245,12 +247,23 @@ fn rejected(sim: &Simulator, control: &SimControl, e: ControlError) -> FaultAppl
     }
 }
 
-pub fn run(
-    mut sim: Simulator,
-    options: &SimOptions,
-    settings: &IpcSettings,
-    shutdown: &Shutdown,
-) -> Result<()> {
+/// The simulator process: the simulated device and how it runs, ready to stream.
+pub struct SimService {
+    /// The simulated sensor block.
+    pub sim: Simulator,
+    /// Link, duration, scheduled faults, noise unit.
+    pub options: SimOptions,
+}
+
+impl Service for SimService {
+    fn run(self, ctx: ServiceContext) -> Result<()> {
+        run(self.sim, &self.options, &ctx)
+    }
+}
+
+/// Streams the device in real time until `ctx.shutdown` or the configured duration.
+fn run(mut sim: Simulator, options: &SimOptions, ctx: &ServiceContext) -> Result<()> {
+    let shutdown = &ctx.shutdown;
     let line = SerialLine::open(options.link.clone())?;
     let tty = line.tty().unwrap_or_default();
     println!("{tty}");
@@ -261,7 +274,7 @@ pub fn run(
     // SAFETY: prctl on our own process with a plain integer argument.
     unsafe { libc::prctl(libc::PR_SET_TIMERSLACK, 1 as libc::c_ulong) };
 
-    let node = create_node("sim", settings)?;
+    let node = ctx.create_node(ServiceKind::Simulator)?;
     let truth = TopicPublisher::<Truth>::new(&node, names::TRUTH)?;
     let fault_events = TopicPublisher::<FaultApplied>::new(&node, names::SIM_FAULT_APPLIED)?;
     let control = TopicSubscriber::<SimControl>::new(&node, names::SIM_CONTROL)?;

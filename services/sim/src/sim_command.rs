@@ -5,6 +5,7 @@
 use std::fmt;
 
 use ipc_types::{PAYLOAD_VERSION, SimControl, SimFault};
+use rins_runtime::payload::Versioned;
 
 use crate::device_fault::Disconnect;
 use crate::fault_command::{ChannelId, ControlError, FaultCommand};
@@ -147,13 +148,13 @@ impl SimCommand {
 
     /// Decodes and validates an IPC command.
     pub fn from_control(control: &SimControl) -> Result<Self, ControlError> {
+        if !control.is_current() {
+            return Err(ControlError::Unknown);
+        }
         if control.fault != SimFault::Disconnect as u8 {
             return FaultCommand::from_control(control).map(Self::Channel);
         }
-        if control.version != PAYLOAD_VERSION
-            || control.sensor != SimControl::WHOLE_DEVICE
-            || control.channel != 0
-        {
+        if control.sensor != SimControl::WHOLE_DEVICE || control.channel != 0 {
             return Err(ControlError::Unknown);
         }
         Disconnect::new(control.param)
