@@ -88,16 +88,21 @@ pub fn encode(frame: &Frame, out: &mut [u8]) -> Result<usize, EncodeError> {
     Ok(total)
 }
 
-fn validate_imu(imu: &ImuFrame) -> Result<(), EncodeError> {
-    let limits = [
+/// The first channel count of an IMU frame beyond what the frame format carries, as (field, value,
+/// limit): the same limits bind what is encoded and what is decoded.
+fn channel_count_over_limit(imu: &ImuFrame) -> Option<(&'static str, u8, usize)> {
+    [
         ("n_gyro", imu.n_gyro, MAX_CHANNELS),
         ("n_accel", imu.n_accel, MAX_CHANNELS),
         ("n_temperature", imu.n_temperature, MAX_TEMPERATURES),
-    ];
-    for (field, value, max) in limits {
-        if usize::from(value) > max {
-            return Err(EncodeError::TooManyChannels { field, value, max });
-        }
+    ]
+    .into_iter()
+    .find(|&(_, value, max)| usize::from(value) > max)
+}
+
+fn validate_imu(imu: &ImuFrame) -> Result<(), EncodeError> {
+    if let Some((field, value, max)) = channel_count_over_limit(imu) {
+        return Err(EncodeError::TooManyChannels { field, value, max });
     }
     let channels = [
         ("gyro_counts", &imu.gyro_counts[..usize::from(imu.n_gyro)]),
@@ -223,15 +228,8 @@ fn decode_imu(bytes: &[u8]) -> Result<ImuFrame, DecodeError> {
         valid_mask: r.u32().ok_or(short)?,
         ..ImuFrame::default()
     };
-    let limits = [
-        ("n_gyro", imu.n_gyro, MAX_CHANNELS),
-        ("n_accel", imu.n_accel, MAX_CHANNELS),
-        ("n_temperature", imu.n_temperature, MAX_TEMPERATURES),
-    ];
-    for (field, value, max) in limits {
-        if usize::from(value) > max {
-            return Err(DecodeError::TooManyChannels { field, value, max });
-        }
+    if let Some((field, value, max)) = channel_count_over_limit(&imu) {
+        return Err(DecodeError::TooManyChannels { field, value, max });
     }
     let (ng, na, nt) = (
         usize::from(imu.n_gyro),
