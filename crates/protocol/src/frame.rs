@@ -59,8 +59,8 @@ impl FrameType {
 /// IMU frame: N gyro and N accel channels as signed 12-bit ADC counts (-2048..=2047).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ImuFrame {
-    /// Gyro channels present (at most `MAX_CHANNELS`); the first `n_gyro` entries of `gyro_counts` are
-    /// meaningful.
+    /// Gyro channels present (at most `MAX_CHANNELS`); the first `n_gyro` entries of
+    /// `gyro_counts` are meaningful.
     pub n_gyro: u8,
     /// Accelerometer channels present (at most `MAX_CHANNELS`).
     pub n_accel: u8,
@@ -70,8 +70,8 @@ pub struct ImuFrame {
     pub status: u16,
     /// Bit i: gyro i valid; bit 16 + i: accel i valid.
     pub valid_mask: u32,
-    /// Gyro channel outputs, ADC counts along each channel's sensitive axis; entries past `n_gyro` are
-    /// not sent.
+    /// Gyro channel outputs, ADC counts along each channel's sensitive axis; entries past
+    /// `n_gyro` are not sent.
     pub gyro_counts: [i16; MAX_CHANNELS],
     /// Accelerometer channel outputs, ADC counts along each channel's sensitive axis; entries past
     /// `n_accel` are not sent.

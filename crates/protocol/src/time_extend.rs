@@ -50,7 +50,8 @@ struct LastTime {
     rx_ns: u64,
 }
 
-/// The device clock's extension to 64 bits, shared by all frame types (see the module documentation).
+/// The device clock's extension to 64 bits, shared by all frame types (see the module
+/// documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct TimeExtender {
     last: Option<LastTime>,
