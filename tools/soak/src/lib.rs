@@ -74,7 +74,8 @@ const READMIT_AFTER: Duration = Duration::from_millis(200);
 /// What a soak measured: the JSON summary it prints at the end.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct SoakSummary {
-    /// How long the soak ran, minutes (shorter than asked when interrupted).
+    /// Time from the first navigation sample to the end of the fault loop, minutes (less than
+    /// asked when interrupted).
     pub minutes: f64,
     /// SIGKILLs sent (the `kill` faults).
     pub kills: u64,
@@ -294,10 +295,11 @@ fn check_args(args: &SoakArgs) -> Result<Vec<FaultKind>> {
     FaultKind::parse_list(&args.faults).map_err(|e| anyhow!(e))
 }
 
-/// Runs a soak: starts `rins up` (the `uav` scenario), injects faults until `args.minutes` have
-/// passed or the process is asked to stop, stops the pipeline and prints a [`SoakSummary`] as one
-/// JSON line on stdout (progress goes to stderr). Fails on invalid arguments, when `rins up` cannot
-/// be started or prints nothing within 120 s, or when it ends without its JSON summary.
+/// Runs a soak: starts `rins up` (the `uav` scenario), waits for navigation output, injects faults
+/// for `args.minutes` (or until the process is asked to stop), stops the pipeline and prints a
+/// [`SoakSummary`] as one JSON line on stdout (progress goes to stderr). Fails on invalid
+/// arguments, when `rins up` cannot be started, prints nothing or produces no navigation output
+/// within 120 s, or ends without its JSON summary.
 pub fn run(args: &SoakArgs) -> Result<()> {
     let kinds = check_args(args)?;
     let shutdown = Shutdown::install()?;
