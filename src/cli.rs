@@ -256,11 +256,11 @@ impl ServiceName {
 /// A simulator scenario, as the command line names it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ScenarioArg {
-    /// The block at rest.
+    /// Parked level at the origin.
     Static,
-    /// A small UAV's flight.
+    /// A small UAV's flight: take-off, circuits with banked turns, landing.
     Uav,
-    /// A foot-mounted walk.
+    /// A foot-mounted sensor walked round a rectangle.
     Walk,
 }
 
