@@ -10,18 +10,23 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
     version,
     about = "Redundant inertial navigation service"
 )]
+/// The parsed command line of the `rins` executable.
 pub struct Cli {
+    /// What to do.
     #[command(subcommand)]
     pub command: Command,
 }
 
+/// The subcommands: one per process kind and tool.
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Start the whole pipeline (simulator unless --port, every service) under the watchdog.
     Up(UpArgs),
     /// Run one service in this process (the watchdog starts each service this way).
     Service {
+        /// The service to run.
         name: ServiceName,
+        /// Configuration file (default: the built-in configuration).
         #[arg(long)]
         config: Option<PathBuf>,
         /// Serial device for acquisition (overrides acquisition.port).
@@ -67,20 +72,25 @@ pub enum Command {
     },
     /// Measure latency from serial receive through every stage to the navigation state.
     Latency {
+        /// How long to measure, s.
         #[arg(long, default_value_t = 5.0)]
         seconds: f64,
+        /// One JSON object instead of the table.
         #[arg(long)]
         json: bool,
     },
     /// What the configured gyro and accelerometer geometries can do: noise per axis, parity, FDI.
     Geometry {
+        /// Configuration file whose geometries are reported (default: the built-in configuration).
         #[arg(long)]
         config: Option<PathBuf>,
+        /// One JSON object instead of the table.
         #[arg(long)]
         json: bool,
     },
     /// Offline evaluation on recorded data, in-process (no IPC).
     Eval {
+        /// Which evaluation.
         #[command(subcommand)]
         what: EvalCommand,
     },
@@ -88,11 +98,13 @@ pub enum Command {
     Mc(McArgs),
     /// Fit sensor calibrations offline from recorded samples.
     Calibrate {
+        /// Which calibration.
         #[command(subcommand)]
         what: CalibrateCommand,
     },
 }
 
+/// The calibrations `rins calibrate` fits.
 #[derive(Debug, Subcommand)]
 pub enum CalibrateCommand {
     /// Magnetometer hard and soft iron from samples taken while the vehicle is turned through many
@@ -100,6 +112,7 @@ pub enum CalibrateCommand {
     Mag(CalibrateMagArgs),
 }
 
+/// Options of `rins calibrate mag`.
 #[derive(Debug, Args)]
 pub struct CalibrateMagArgs {
     /// CSV file: the output of `rins echo raw-mag --csv`, or a `mx_ut,my_ut,mz_ut` header and rows.
@@ -113,6 +126,7 @@ pub struct CalibrateMagArgs {
     pub json: bool,
 }
 
+/// The evaluations on recorded data `rins eval` runs.
 #[derive(Debug, Subcommand)]
 pub enum EvalCommand {
     /// Fault detection and isolation on the four-IMU quadrotor recordings: false alarms without
@@ -127,31 +141,38 @@ pub enum EvalCommand {
     Quadrotor(EvalQuadrotorArgs),
 }
 
+/// Options of `rins eval quadrotor`.
 #[derive(Debug, Args)]
 pub struct EvalQuadrotorArgs {
     /// Data set directory (holding `<group>/path_<N>/IMU_k.csv` and `GT.csv`).
     pub dir: PathBuf,
+    /// Output format and navigator profile.
     #[command(flatten)]
     pub common: EvalProfileArgs,
 }
 
+/// Options of `rins eval pyshoe`.
 #[derive(Debug, Args)]
 pub struct EvalPyshoeArgs {
     /// Directory of trials (`*.csv`, with the peer's figures in a `.json` beside each).
     pub dir: PathBuf,
+    /// Output format and navigator profile.
     #[command(flatten)]
     pub common: EvalProfileArgs,
 }
 
+/// Options of `rins eval xio`.
 #[derive(Debug, Args)]
 pub struct EvalXioArgs {
     /// Walk files (`Time (s),Gyroscope X (deg/s),…` CSV).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
+    /// Output format and navigator profile.
     #[command(flatten)]
     pub common: EvalProfileArgs,
 }
 
+/// Options the navigation evaluations share: output format and navigator profile.
 #[derive(Debug, Args)]
 pub struct EvalProfileArgs {
     /// One JSON object on stdout instead of a table.
@@ -164,6 +185,7 @@ pub struct EvalProfileArgs {
     pub profile: Option<PathBuf>,
 }
 
+/// Options of `rins eval fdi`.
 #[derive(Debug, Args)]
 pub struct EvalFdiArgs {
     /// Data set directory (holding `<group>/path_<N>/IMU_k.csv`).
@@ -180,6 +202,7 @@ pub struct EvalFdiArgs {
     pub trials: Vec<String>,
 }
 
+/// Options of `rins mc`.
 #[derive(Debug, Args)]
 pub struct McArgs {
     /// Number of runs (default: the comparison's default).
@@ -202,17 +225,23 @@ pub struct McArgs {
     pub config: Option<PathBuf>,
 }
 
+/// A service `rins service` can run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ServiceName {
+    /// Serial acquisition: decodes the sensor block's frames and publishes raw samples.
     Acquisition,
+    /// Redundancy fusion with fault detection and isolation.
     Fusion,
+    /// Barometric altitude filter.
     Altimeter,
+    /// The primary navigator lane.
     Navigator,
     /// The hot-standby navigator lane.
     NavigatorStandby,
 }
 
 impl ServiceName {
+    /// The service kind the watchdog and the health report know it by.
     pub fn kind(self) -> ipc_types::ServiceKind {
         match self {
             ServiceName::Acquisition => ipc_types::ServiceKind::Acquisition,
@@ -224,13 +253,18 @@ impl ServiceName {
     }
 }
 
+/// A simulator scenario, as the command line names it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ScenarioArg {
+    /// Parked level at the origin.
     Static,
+    /// A small UAV's flight: take-off, circuits with banked turns, landing.
     Uav,
+    /// A foot-mounted sensor walked round a rectangle.
     Walk,
 }
 
+/// Options of `rins up`.
 #[derive(Debug, Args)]
 pub struct UpArgs {
     /// Simulator scenario (overrides sim.scenario).
@@ -242,6 +276,7 @@ pub struct UpArgs {
     /// With --duration: print a JSON summary as the last line.
     #[arg(long)]
     pub json: bool,
+    /// Configuration file (default: the built-in configuration).
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// Read a real sensor block on this serial device instead of starting the simulator.
@@ -250,6 +285,7 @@ pub struct UpArgs {
     /// Simulator random seed (overrides sim.seed).
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Faults for the simulator to apply.
     #[command(flatten)]
     pub faults: FaultArgs,
 }
@@ -268,11 +304,13 @@ pub struct FaultArgs {
 }
 
 impl FaultArgs {
+    /// Whether no fault was asked for.
     pub fn is_empty(&self) -> bool {
         self.inject.is_empty() && self.faults.is_none()
     }
 }
 
+/// Options of `rins inject`.
 #[derive(Debug, Args)]
 pub struct InjectArgs {
     /// Channel: gyro or accel followed by its 0-based index, e.g. gyro2, accel0; or `disconnect`
@@ -289,12 +327,16 @@ pub struct InjectArgs {
     pub duration: Option<String>,
 }
 
+/// Options of `rins sim`.
 #[derive(Debug, Args)]
 pub struct SimArgs {
+    /// Simulator scenario (overrides sim.scenario).
     #[arg(long)]
     pub scenario: Option<ScenarioArg>,
+    /// Simulator random seed (overrides sim.seed).
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Configuration file (default: the built-in configuration).
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// Also make this path a symbolic link to the pseudo-terminal (replaced if it exists).
@@ -303,10 +345,12 @@ pub struct SimArgs {
     /// Stop after this many seconds.
     #[arg(long)]
     pub duration: Option<f64>,
+    /// Faults for the simulator to apply.
     #[command(flatten)]
     pub faults: FaultArgs,
 }
 
+/// Options of `rins soak`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct SoakArgs {
     /// How long to run, minutes.

@@ -80,6 +80,8 @@ impl Default for Decoder {
 }
 
 impl Decoder {
+    /// An empty decoder: no buffered bytes, zero counters, no numbering yet (the first frame of
+    /// each type starts its sequence; the first frame of any type starts the device time).
     pub fn new() -> Self {
         Self {
             buf: [0; BUF_LEN],

@@ -8,17 +8,28 @@ use super::frame::FrameType;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EncodeError {
     /// The output buffer is shorter than the encoded frame.
-    BufferTooSmall { needed: usize, available: usize },
+    BufferTooSmall {
+        /// Bytes the encoded frame takes.
+        needed: usize,
+        /// Bytes the caller's buffer has.
+        available: usize,
+    },
     /// A channel count exceeds what the payload can carry.
     TooManyChannels {
+        /// The count's field name (`n_gyro`, `n_accel`, `n_temperature`).
         field: &'static str,
+        /// The count given.
         value: u8,
+        /// The largest count the payload carries.
         max: usize,
     },
     /// A gyro or accelerometer count lies outside the 12-bit range -2048..=2047.
     CountOutOfRange {
+        /// The sample array's field name (`gyro_counts` or `accel_counts`).
         field: &'static str,
+        /// The channel index within that array.
         index: usize,
+        /// The out-of-range count.
         value: i16,
     },
 }
@@ -53,23 +64,46 @@ pub enum DecodeError {
     /// The bytes do not start with the sync word.
     NoSync,
     /// The bytes so far are a valid beginning; the whole frame needs `needed` bytes.
-    Incomplete { needed: usize },
+    Incomplete {
+        /// Bytes needed in all: the header's length until the header is complete, then the whole
+        /// frame's.
+        needed: usize,
+    },
     /// The type byte names no known frame type.
-    UnknownFrameType { value: u8 },
+    UnknownFrameType {
+        /// The type byte received.
+        value: u8,
+    },
     /// The length byte (or the payload's own channel counts) disagree with the frame type.
-    BadPayloadLength { frame_type: FrameType, len: usize },
+    BadPayloadLength {
+        /// The frame type the type byte named.
+        frame_type: FrameType,
+        /// The payload length received, bytes.
+        len: usize,
+    },
     /// The CRC-32C trailer does not match the frame.
-    CrcMismatch { received: u32, computed: u32 },
+    CrcMismatch {
+        /// The CRC-32C in the frame's trailer.
+        received: u32,
+        /// The CRC-32C computed over the frame's bytes.
+        computed: u32,
+    },
     /// An IMU channel count exceeds what the payload can carry.
     TooManyChannels {
+        /// The count's field name (`n_gyro`, `n_accel`, `n_temperature`).
         field: &'static str,
+        /// The count received.
         value: u8,
+        /// The largest count the payload carries.
         max: usize,
     },
     /// A gyro or accelerometer count lies outside the 12-bit range -2048..=2047.
     CountOutOfRange {
+        /// The sample array's field name (`gyro_counts` or `accel_counts`).
         field: &'static str,
+        /// The channel index within that array.
         index: usize,
+        /// The out-of-range count.
         value: i16,
     },
 }

@@ -19,6 +19,8 @@ const BLOCK_MIN_STEPS: u64 = 64;
 const BLOCKS: usize = 5;
 const MIN_BLOCKS: usize = 3;
 
+/// The learnt period of one frame type on the receive clock (see the module documentation); unknown
+/// until enough blocks are complete.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct FramePeriod {
     first_rx_ns: Option<u64>,

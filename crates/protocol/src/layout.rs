@@ -18,10 +18,13 @@ pub const CRC_LEN: usize = 4;
 /// Bytes a frame adds around its payload.
 pub const FRAME_OVERHEAD: usize = HEADER_LEN + CRC_LEN;
 
-/// Offsets of the header fields from the first sync byte.
+/// Offset of the type byte from the first sync byte.
 pub const TYPE_OFFSET: usize = 2;
+/// Offset of the payload length byte from the first sync byte.
 pub const LEN_OFFSET: usize = 3;
+/// Offset of the 16-bit sequence number (little-endian) from the first sync byte.
 pub const SEQ_OFFSET: usize = 4;
+/// Offset of the 32-bit device time, µs (little-endian), from the first sync byte.
 pub const TIME_OFFSET: usize = 6;
 
 /// IMU payload before the sample arrays: n_gyro, n_accel, n_temperature (u8 each), status (u16),
@@ -43,8 +46,9 @@ pub const MAG_PAYLOAD_LEN: usize = 12;
 /// Auxiliary payload: u16 foot pressure.
 pub const AUX_PAYLOAD_LEN: usize = 2;
 
-/// Gyro and accelerometer channels are signed 12-bit ADC counts.
+/// Lowest gyro or accelerometer count: channels are signed 12-bit ADC counts.
 pub const COUNT_MIN: i16 = -2048;
+/// Highest gyro or accelerometer count (the positive converter rail).
 pub const COUNT_MAX: i16 = 2047;
 /// Counts per converter full scale: full scale maps to ±2048 counts, so one count is full scale / 2048.
 pub const COUNTS_PER_FULL_SCALE: f64 = 2048.0;

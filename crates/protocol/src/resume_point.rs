@@ -13,9 +13,13 @@ use super::frame::FrameType;
 /// stand in.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct ResumePoint {
+    /// Last extended sequence number handed out, per frame type; `None` for a type never received.
     pub seq: [Option<u64>; FrameType::COUNT],
+    /// The wire sequence number of that frame, per frame type.
     pub seq_wire: [Option<u16>; FrameType::COUNT],
+    /// Last extended device time handed out, µs; `None` before the first frame.
     pub time_us: Option<u64>,
+    /// The wire device time of that frame, µs.
     pub time_wire: Option<u32>,
 }
 
@@ -27,8 +31,18 @@ pub const MAX_RESUME_TIME_US: u64 = 1 << 62;
 /// Why a resume point was rejected as a whole.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ResumeError {
-    SeqOutOfBounds { frame_type: FrameType, value: u64 },
-    TimeOutOfBounds { value: u64 },
+    /// A sequence number at or above [`MAX_RESUME_SEQ`].
+    SeqOutOfBounds {
+        /// The frame type whose number it is.
+        frame_type: FrameType,
+        /// The rejected number.
+        value: u64,
+    },
+    /// A device time at or above [`MAX_RESUME_TIME_US`].
+    TimeOutOfBounds {
+        /// The rejected time, µs.
+        value: u64,
+    },
 }
 
 impl fmt::Display for ResumeError {

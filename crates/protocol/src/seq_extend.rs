@@ -33,14 +33,20 @@ use super::seq_window::{ReceivedWindow, WINDOW};
 pub enum SeqVerdict {
     /// Deliver it under the extended number `seq`; its step skipped `lost` frames.
     New {
+        /// The frame's extended sequence number.
         seq: u64,
+        /// Frames counted lost before this one (0 after a sequence jump).
         lost: u64,
+        /// Whether the numbering continued, was re-based (a jump), or ignored the resume point.
         continuity: Continuity,
     },
     /// Received before: drop it.
     Duplicate,
     /// Behind the newest, not received before: drop it. `recovered` when it had been counted lost.
-    Late { recovered: bool },
+    Late {
+        /// The frame had been counted lost and no longer is.
+        recovered: bool,
+    },
 }
 
 /// A forward step is a jump when it puts the counter this far ahead of the receive clock: far
@@ -61,6 +67,7 @@ struct Newest {
     rx_ns: u64,
 }
 
+/// One frame type's sequence number extension and classification (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct SeqExtender {
     newest: Option<Newest>,

@@ -37,7 +37,9 @@ const NS_PER_US: u64 = 1_000;
 /// One frame's extended device time.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ExtendedTime {
+    /// Device time extended to 64 bits, µs.
     pub time_us: u64,
+    /// Whether it continued the previous time, was re-based, or ignored the resume point.
     pub continuity: Continuity,
 }
 
@@ -48,6 +50,8 @@ struct LastTime {
     rx_ns: u64,
 }
 
+/// The device clock's extension to 64 bits, shared by all frame types (see the module
+/// documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct TimeExtender {
     last: Option<LastTime>,

@@ -16,16 +16,33 @@ pub const MIN_SINGULAR_RATIO: f64 = 1e-9;
 /// Why no rotation could be estimated.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum InstallationError {
+    /// The two vector lists differ in length.
     #[error("{reference} reference vectors but {other} others: they must be paired")]
-    LengthMismatch { reference: usize, other: usize },
+    LengthMismatch {
+        /// Vectors in the reference frame.
+        reference: usize,
+        /// Vectors in the other frame.
+        other: usize,
+    },
+    /// No vectors were given.
     #[error("no vector pairs")]
     Empty,
+    /// A pair holds a NaN or an infinity.
     #[error("pair {index} is not finite")]
-    NonFinite { index: usize },
+    NonFinite {
+        /// Index of the first such pair.
+        index: usize,
+    },
+    /// The vectors span fewer than two directions (second singular value below
+    /// [`MIN_SINGULAR_RATIO`] of the first), so the rotation is not unique.
     #[error(
         "the vectors span fewer than two directions (singular values {singular_values:?}): the rotation is not unique"
     )]
-    Degenerate { singular_values: [f64; 3] },
+    Degenerate {
+        /// Singular values of the pairs' correlation matrix, largest first.
+        singular_values: [f64; 3],
+    },
+    /// The singular value decomposition did not converge.
     #[error("the singular value decomposition did not converge")]
     NoConvergence,
 }

@@ -15,19 +15,24 @@ pub struct IntegrityTally {
 /// What a report carries of a [`IntegrityTally`].
 #[derive(Debug, Clone, Serialize)]
 pub struct IntegritySummary {
+    /// Fraction of the samples judged ok, 0..=1.
     pub ok_fraction: f64,
+    /// Fraction of the samples judged degraded, 0..=1.
     pub degraded_fraction: f64,
+    /// Fraction of the samples judged invalid, 0..=1.
     pub invalid_fraction: f64,
     /// Every reason seen, comma-separated names.
     pub reasons: String,
 }
 
 impl IntegrityTally {
+    /// Counts one sample's integrity level and its reason bits (`ipc_types::integrity_reason`).
     pub fn push(&mut self, (level, reasons): (Integrity, u32)) {
         self.samples[level as usize] += 1;
         self.reasons |= reasons;
     }
 
+    /// The fractions per level (all 0 when nothing was counted) and the names of every reason seen.
     pub fn summary(&self) -> IntegritySummary {
         let total = self.samples.iter().sum::<u64>().max(1) as f64;
         let fraction = |level: Integrity| self.samples[level as usize] as f64 / total;

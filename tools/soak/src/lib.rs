@@ -42,8 +42,10 @@ pub struct SoakArgs {
     pub minutes: f64,
     /// Seed of the fault schedule.
     pub seed: u64,
-    /// Shortest and longest time between two faults, s.
+    /// Shortest time between two faults, s (at least 0.5).
     pub min_interval_s: f64,
+    /// Longest time between two faults, s (at least `min_interval_s`); each interval is drawn
+    /// between the two.
     pub max_interval_s: f64,
     /// Kinds of fault, comma-separated: kill, hang, sensor, disconnect.
     pub faults: String,
@@ -69,13 +71,17 @@ const FLOWING: Duration = Duration::from_millis(100);
 /// A cleared channel is readmitted this much later, once its samples are healthy again.
 const READMIT_AFTER: Duration = Duration::from_millis(200);
 
+/// What a soak measured: the JSON summary it prints at the end.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct SoakSummary {
+    /// Time from the first navigation sample to the end of the fault loop, minutes (less than
+    /// asked when interrupted).
     pub minutes: f64,
     /// SIGKILLs sent (the `kill` faults).
     pub kills: u64,
     /// Restarts the watchdog made (from its summary): one per kill and per hang.
     pub restarts: u64,
+    /// Navigation samples received through the lane selector.
     pub nav_samples: u64,
     /// Frames with no navigation output (gaps in the frame sequence of the `nav` topic).
     pub lost_nav_samples: u64,
@@ -84,8 +90,9 @@ pub struct SoakSummary {
     /// Samples after the first navigating one that were aligning again (a lane that could not
     /// recover its solution).
     pub not_navigating_samples: u64,
-    /// Lane changes of the selector, and samples it took from the other lane to fill a hole.
+    /// Lane changes of the selector.
     pub lane_switches: u64,
+    /// Samples the selector took from the other lane to fill a hole in the one it follows.
     pub lane_filled: u64,
     /// Faults put off because the pipeline had not recovered from the previous one yet.
     pub faults_deferred: u64,
@@ -288,6 +295,11 @@ fn check_args(args: &SoakArgs) -> Result<Vec<FaultKind>> {
     FaultKind::parse_list(&args.faults).map_err(|e| anyhow!(e))
 }
 
+/// Runs a soak: starts `rins up` (the `uav` scenario), waits for navigation output, injects faults
+/// for `args.minutes` (or until the process is asked to stop), stops the pipeline and prints a
+/// [`SoakSummary`] as one JSON line on stdout (progress goes to stderr). Fails on invalid
+/// arguments, when `rins up` cannot be started, prints nothing or produces no navigation output
+/// within 120 s, or ends without its JSON summary.
 pub fn run(args: &SoakArgs) -> Result<()> {
     let kinds = check_args(args)?;
     let shutdown = Shutdown::install()?;

@@ -19,6 +19,7 @@ const PEER_ANGLE_DEG: f64 = 30.0;
 /// One false-alarm episode of a fault-free run.
 #[derive(Debug, Clone, Serialize)]
 pub struct AlarmEpisode {
+    /// Sensor type of the alarm: `gyro` or `accel`.
     pub sensor: &'static str,
     /// Start of the episode from the start of the trial, s.
     pub at_s: f64,

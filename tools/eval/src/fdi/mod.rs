@@ -87,7 +87,9 @@ pub const BIAS_STEPS_SIGMA: [f64; 2] = [5.0, 20.0];
 /// median of the per-trial parity estimates printed in the report) and used for every trial.
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct NoiseFit {
+    /// Gyro channel noise σ, rad/s.
     pub gyro_sigma_rps: f64,
+    /// Accelerometer channel noise σ, m/s².
     pub accel_sigma_mps2: f64,
 }
 

@@ -8,23 +8,40 @@ use super::NoiseFit;
 use super::runs::Outcome;
 use crate::datasets::quadrotor::IMU_RATE_HZ;
 
+/// Detection and isolation of injected faults, counted. Delays are in faulty samples processed
+/// until the fuser flagged (1 = on the first faulty sample); the median and maximum are filled in
+/// by [`Tally::finish`] (`None` when nothing was detected or isolated).
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct Tally {
+    /// Fault runs counted.
     pub faults_injected: usize,
+    /// Runs in which the fuser raised an alarm on the faulty type.
     pub detected: usize,
+    /// Runs in which the fuser excluded a channel.
     pub isolated: usize,
+    /// Runs in which the channel excluded was the faulty one.
     pub correctly_isolated: usize,
+    /// Detection delay of each detected run, samples.
     #[serde(skip)]
     pub detection_delays: Vec<usize>,
+    /// Isolation delay of each isolated run, samples.
     #[serde(skip)]
     pub isolation_delays: Vec<usize>,
+    /// Median detection delay, samples.
     pub detection_delay_samples_p50: Option<f64>,
+    /// Longest detection delay, samples.
     pub detection_delay_samples_max: Option<usize>,
+    /// Median detection delay, ms at the data set's IMU rate.
     pub detection_delay_ms_p50: Option<f64>,
+    /// Longest detection delay, ms.
     pub detection_delay_ms_max: Option<f64>,
+    /// Median isolation delay, samples.
     pub isolation_delay_samples_p50: Option<f64>,
+    /// Longest isolation delay, samples.
     pub isolation_delay_samples_max: Option<usize>,
+    /// Median isolation delay, ms at the data set's IMU rate.
     pub isolation_delay_ms_p50: Option<f64>,
+    /// Longest isolation delay, ms.
     pub isolation_delay_ms_max: Option<f64>,
 }
 
@@ -44,6 +61,7 @@ fn ms(samples: f64) -> f64 {
 }
 
 impl Tally {
+    /// Counts one fault run whose fault was injected into `channel`.
     pub fn add(&mut self, o: &Outcome, channel: usize) {
         self.faults_injected += 1;
         if let Some(d) = o.detected {
@@ -57,6 +75,8 @@ impl Tally {
         }
     }
 
+    /// Adds another tally's counts and delays (its medians and maxima are not carried: call
+    /// [`Tally::finish`] after the last merge).
     pub fn merge(&mut self, other: &Tally) {
         self.faults_injected += other.faults_injected;
         self.detected += other.detected;
@@ -66,6 +86,7 @@ impl Tally {
         self.isolation_delays.extend(&other.isolation_delays);
     }
 
+    /// Computes the medians and maxima from the delays collected.
     pub fn finish(&mut self) {
         self.detection_delay_samples_p50 = median(&self.detection_delays);
         self.detection_delay_samples_max = self.detection_delays.iter().copied().max();
@@ -78,25 +99,38 @@ impl Tally {
     }
 }
 
+/// One configuration's tally for one sensor type and fault kind, over every trial.
 #[derive(Debug, Clone, Serialize)]
 pub struct FaultBreakdown {
+    /// The configuration: `pyramid4` (four skewed channels, docs/design.md §4) or `stacked12` (the
+    /// four units' triads stacked).
     pub configuration: &'static str,
+    /// Sensor type faulted: `gyro` or `accel`.
     pub sensor: &'static str,
+    /// Fault kind: `dead`, `stuck`, `bias Nσ` or `saturated`.
     pub fault: String,
+    /// The runs' detection and isolation.
     #[serde(flatten)]
     pub tally: Tally,
 }
 
+/// One trial in one configuration: its fault-free run and the data's own figures.
 #[derive(Debug, Clone, Serialize)]
 pub struct TrialReport {
+    /// The trial's name (`<group>/path_<N>`).
     pub trial: String,
+    /// Rows of the trial after preparation.
     pub rows: usize,
+    /// Length of the trial at the IMU rate, s.
     pub seconds: f64,
+    /// The configuration: `pyramid4` (four skewed channels, docs/design.md §4) or `stacked12` (the
+    /// four units' triads stacked).
     pub configuration: &'static str,
     /// Alarm episodes without any fault, gyro and accel.
     pub false_alarms: [usize; 2],
     /// Episodes of genuine over-range (channels Suspect, saturated), gyro and accel.
     pub over_range: [usize; 2],
+    /// Samples in an alarmed state without any fault, gyro and accel.
     pub false_alarm_samples: [usize; 2],
     /// Each false alarm: when, why, and which unit's channel stood out in noise.
     pub alarm_episodes: Vec<super::AlarmEpisode>,
@@ -108,38 +142,63 @@ pub struct TrialReport {
     pub max_relative_bias: [f64; 2],
     /// Channel samples at a converter rail in the data.
     pub clipped_samples: usize,
+    /// Row at which the faults are injected in the fault runs (the middle of the trial).
     pub fault_row: usize,
 }
 
+/// One configuration's figures over every trial.
 #[derive(Debug, Clone, Serialize)]
 pub struct ConfigurationSummary {
+    /// The configuration: `pyramid4` (four skewed channels, docs/design.md §4) or `stacked12` (the
+    /// four units' triads stacked).
     pub configuration: &'static str,
+    /// Channels per sensor type.
     pub channels: usize,
+    /// The channel noise σ fitted for it and used in every trial.
     pub noise: NoiseFit,
+    /// False alarm episodes over every trial, both types.
     pub false_alarms: usize,
+    /// Detection and isolation of every fault run.
     #[serde(flatten)]
     pub tally: Tally,
 }
 
+/// The whole FDI evaluation: settings, totals, and the figures by configuration, fault and trial.
 #[derive(Debug, Clone, Serialize)]
 pub struct FdiReport {
+    /// The data set directory evaluated.
     pub dir: PathBuf,
+    /// Trials evaluated.
     pub trials: usize,
+    /// The data set's IMU rate, Hz.
     pub imu_rate_hz: f64,
+    /// Gyro count resolution the data were quantised to, rad/s.
     pub gyro_lsb_rps: f64,
+    /// Accelerometer count resolution, m/s².
     pub accel_lsb_mps2: f64,
+    /// The detector's k-of-n persistence, `[k, n]` samples.
     pub persistence: [u32; 2],
+    /// Samples of the learning phase at the start of each run (no declarations).
     pub learning_samples: u32,
+    /// False alarm episodes over every trial, configuration and type.
     pub false_alarms: usize,
+    /// Samples in an alarmed state without any fault, over every trial, configuration and type.
     pub false_alarm_samples: usize,
     /// Episodes of genuine over-range (not false alarms).
     pub over_range: usize,
+    /// Scale-factor and misalignment disagreement allowed between channels, fraction of the
+    /// measured quantity ([`super::MOTION_NOISE_FRACTION`]).
     pub motion_noise_fraction: f64,
+    /// Uncertainty of the sampling instants between units, s ([`super::TIMING_SKEW_S`]).
     pub timing_skew_s: f64,
+    /// Detection and isolation over every fault run.
     #[serde(flatten)]
     pub total: Tally,
+    /// Figures per configuration.
     pub configurations: Vec<ConfigurationSummary>,
+    /// Figures per configuration, sensor type and fault kind.
     pub breakdown: Vec<FaultBreakdown>,
+    /// Figures per trial and configuration.
     pub per_trial: Vec<TrialReport>,
 }
 

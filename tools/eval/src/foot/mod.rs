@@ -22,44 +22,65 @@ use run::{FootRun, run_trial};
 /// One pyshoe trial's figures.
 #[derive(Debug, Clone, Serialize)]
 pub struct PyshoeTrial {
+    /// The trial's name.
     pub trial: String,
+    /// Length of the recording, s.
     pub seconds: f64,
+    /// 2-D position RMSE against the Vicon truth from alignment on, after fitting the start and
+    /// the initial heading, m.
     pub rmse_2d_m: f64,
     /// The peer's best 2-D RMSE (its detector threshold tuned for this trial), when known.
     pub peer_rmse_2d_m: Option<f64>,
     /// Initial heading fitted to the truth, degrees.
     pub heading_fit_deg: f64,
+    /// Fraction of the samples the stance detector fired on, 0..=1.
     pub stance_fraction: f64,
+    /// Zero-velocity updates the filter's χ² gate rejected.
     pub zupt_rejected: u64,
+    /// How much of the walk the navigator judged usable.
     pub integrity: IntegritySummary,
 }
 
+/// The pyshoe evaluation of a whole directory.
 #[derive(Debug, Clone, Serialize)]
 pub struct PyshoeReport {
+    /// Every trial's figures, in file order.
     pub trials: Vec<PyshoeTrial>,
+    /// Mean of the trials' 2-D RMSE, m (NaN without trials).
     pub mean_rmse_m: f64,
+    /// Mean of the peer's per-trial RMSE, m; only when every trial has the peer's figure.
     pub peer_mean_rmse_m: Option<f64>,
 }
 
 /// One closed-loop walk's figures.
 #[derive(Debug, Clone, Serialize)]
 pub struct XioWalk {
+    /// The trial's name.
     pub trial: String,
+    /// Length of the recording, s.
     pub seconds: f64,
     /// Distance between the start and end positions (3-D), m.
     pub end_error_m: f64,
     /// Horizontal distance walked (through the foot-down positions), m.
     pub distance_m: f64,
+    /// End error as a percentage of the distance walked.
     pub pct_distance: f64,
+    /// The peer's end error for this walk, m, when known.
     pub peer_end_error_m: Option<f64>,
+    /// Rows the loader dropped because their time equalled the previous kept row's.
     pub dropped_duplicate_rows: usize,
+    /// Fraction of the samples the stance detector fired on, 0..=1.
     pub stance_fraction: f64,
+    /// Zero-velocity updates the filter's χ² gate rejected.
     pub zupt_rejected: u64,
+    /// How much of the walk the navigator judged usable.
     pub integrity: IntegritySummary,
 }
 
+/// The closed-loop evaluation of every walk given.
 #[derive(Debug, Clone, Serialize)]
 pub struct XioReport {
+    /// Every walk's figures, in the order given.
     pub trials: Vec<XioWalk>,
 }
 

@@ -8,6 +8,8 @@ fn opt(v: Option<f64>, scale: f64) -> String {
     v.map_or_else(|| "-".into(), |x| format!("{:.3}", x * scale))
 }
 
+/// The pyshoe evaluation as a text table: one line per trial, then the mean 2-D RMSE beside the
+/// peer's.
 pub fn pyshoe_table(r: &PyshoeReport) -> String {
     let mut s = String::new();
     let _ = writeln!(
@@ -40,6 +42,7 @@ pub fn pyshoe_table(r: &PyshoeReport) -> String {
     s
 }
 
+/// The x-io evaluation as a text table: one line per walk with its end-point error.
 pub fn xio_table(r: &XioReport) -> String {
     let mut s = String::new();
     let _ = writeln!(

@@ -16,7 +16,9 @@ pub struct FootRun {
     pub foot_down_m: Vec<[f64; 3]>,
     /// Samples the stance detector fired on.
     pub stance_samples: usize,
+    /// Zero-velocity updates the filter applied.
     pub zupt_accepted: u64,
+    /// Zero-velocity updates the filter's χ² gate rejected.
     pub zupt_rejected: u64,
     /// Sample at which the alignment completed.
     pub aligned_at: Option<usize>,

@@ -39,6 +39,7 @@ pub struct Motion {
     pub t0_s: f64,
     /// Sample period, s.
     pub dt_s: f64,
+    /// One body-frame sample per row, in row order.
     pub samples: Vec<BodySample>,
 }
 

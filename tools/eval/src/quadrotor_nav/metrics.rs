@@ -89,7 +89,9 @@ pub struct Scores {
     /// IMU file number; absent for the fused solution.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub imu: Option<usize>,
+    /// RMS of the roll error against the truth, degrees.
     pub roll_rmse_deg: f64,
+    /// RMS of the pitch error against the truth, degrees.
     pub pitch_rmse_deg: f64,
     /// RMS of roll and pitch errors pooled: `sqrt(mean((e_roll² + e_pitch²) / 2))`.
     pub roll_pitch_rmse_deg: f64,

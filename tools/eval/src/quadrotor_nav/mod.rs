@@ -58,13 +58,16 @@ pub struct TrialResult {
     pub fused: Scores,
     /// Median of the single units' roll/pitch RMSE, degrees.
     pub median_single_roll_pitch_rmse_deg: f64,
+    /// The fused roll/pitch RMSE is below the median single unit's.
     pub fused_better_than_median_single: bool,
 }
 
 /// The whole data set's figures.
 #[derive(Debug, Clone, Serialize)]
 pub struct QuadrotorReport {
+    /// The data set directory evaluated.
     pub dir: PathBuf,
+    /// Every trial's figures, in the order they were run.
     pub trials: Vec<TrialResult>,
     /// Mean over trials of the fused roll/pitch RMSE, degrees.
     pub roll_pitch_rmse_deg: f64,
@@ -74,6 +77,7 @@ pub struct QuadrotorReport {
     pub fused_better_than_median_single: bool,
     /// Trials where the fused RMSE is below that trial's median single unit.
     pub trials_fused_better: usize,
+    /// The roll/pitch RMSE the fused solution is held to, degrees ([`ROLL_PITCH_TARGET_DEG`]).
     pub roll_pitch_target_deg: f64,
     /// The fused mean roll/pitch RMSE is within [`ROLL_PITCH_TARGET_DEG`].
     pub roll_pitch_target_met: bool,

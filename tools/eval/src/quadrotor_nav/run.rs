@@ -58,7 +58,9 @@ pub fn start_from_truth(truth: &[TruthRow], from_s: f64, to_s: f64) -> Option<St
 pub struct Trace {
     /// Times, s: t0, then every sample after it.
     pub t_s: Vec<f64>,
+    /// Roll at each time, rad (body FRD relative to NED).
     pub roll_rad: Vec<f64>,
+    /// Pitch at each time, rad.
     pub pitch_rad: Vec<f64>,
     /// Height above take-off, m.
     pub height_m: Vec<f64>,
