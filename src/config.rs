@@ -46,6 +46,8 @@ use rins_earth::STANDARD_GRAVITY;
 use rins_protocol::layout::COUNTS_PER_FULL_SCALE;
 
 impl DeviceConfig {
+    /// Checks both full scales (finite, positive, within what a MEMS converter offers); the error
+    /// names the field and its value.
     pub fn validate(&self) -> Result<(), String> {
         for (field, value, max) in [
             (
@@ -66,10 +68,12 @@ impl DeviceConfig {
         Ok(())
     }
 
+    /// One gyro count, rad/s: the full scale spread over the converter's counts.
     pub fn gyro_lsb_rps(&self) -> f64 {
         self.gyro_full_scale_dps.to_radians() / COUNTS_PER_FULL_SCALE
     }
 
+    /// One accelerometer count, m/s².
     pub fn accel_lsb_mps2(&self) -> f64 {
         self.accel_full_scale_g * STANDARD_GRAVITY / COUNTS_PER_FULL_SCALE
     }
@@ -90,6 +94,7 @@ impl Default for DeploymentConfig {
 }
 
 impl DeploymentConfig {
+    /// Checks the number of navigator lanes (1 or 2).
     pub fn validate(&self) -> Result<(), String> {
         if !(1..=2).contains(&self.navigator_lanes) {
             return Err(format!(
@@ -101,20 +106,32 @@ impl DeploymentConfig {
     }
 }
 
+/// The whole configuration file: one table per service plus the device and the deployment. Every
+/// table has defaults, and an unknown key anywhere is refused.
 #[derive(Debug, Clone, PartialEq, Deserialize, Default)]
 #[serde(deny_unknown_fields, default)]
 pub struct RinsConfig {
+    /// `[device]`: the sensor block's converters.
     pub device: DeviceConfig,
+    /// `[sim]`: the device simulator (scenario, sensor models, seed).
     pub sim: SimConfig,
+    /// `[acquisition]`: the serial port and its reconnection.
     pub acquisition: AcquisitionConfig,
+    /// `[fusion]`: geometry, noise, calibration, fault detection and isolation.
     pub fusion: FusionConfig,
+    /// `[altimeter]`: QNH and the vertical filter.
     pub altimeter: AltimeterConfig,
+    /// `[navigator]`: alignment, filter noise, aiding, integrity limits.
     pub navigator: NavigatorConfig,
+    /// `[watchdog]`: restart policy, timeouts, output deadlines.
     pub watchdog: WatchdogConfig,
+    /// `[deployment]`: which processes `rins up` runs.
     pub deployment: DeploymentConfig,
 }
 
 impl RinsConfig {
+    /// Parses and validates a configuration text; errors start with `origin` (the file's path or
+    /// the built-in profile's name) and name the offending field and value.
     pub fn parse(text: &str, origin: &str) -> Result<Self> {
         let mut cfg: RinsConfig =
             toml::from_str(text).map_err(|e| anyhow!("{origin}: {}", e.to_string().trim_end()))?;
@@ -125,6 +142,7 @@ impl RinsConfig {
         Ok(cfg)
     }
 
+    /// Checks every table; the error names the first bad field with its table and its value.
     pub fn validate(&self) -> Result<(), String> {
         self.device.validate()?;
         self.sim.validate().map_err(|e| e.to_string())?;
@@ -152,6 +170,7 @@ impl RinsConfig {
         ))
     }
 
+    /// The simulator scenario's name as the command line spells it.
     pub fn scenario_name(&self) -> &'static str {
         match self.sim.scenario {
             rins_sim::Scenario::Static => "static",
@@ -160,6 +179,7 @@ impl RinsConfig {
         }
     }
 
+    /// Sets the simulator scenario from the command line's choice.
     pub fn set_scenario(&mut self, scenario: ScenarioArg) {
         self.sim.scenario = match scenario {
             ScenarioArg::Static => rins_sim::Scenario::Static,
