@@ -14,7 +14,7 @@ pub enum WlsError {
     /// Fewer than three channels are active.
     #[error("only {active} active channels (mask {mask:#x}); at least 3 are needed")]
     InsufficientChannels {
-        /// Requested channel mask (bit i = channel i).
+        /// Active channels (bit i = channel i), bits beyond the geometry cleared.
         mask: u32,
         /// Number of active channels in the mask.
         active: usize,
@@ -25,7 +25,7 @@ pub enum WlsError {
         "active channels (mask {mask:#x}) are rank deficient: λmin/λmax of HᵀH = {reciprocal_condition:.1e}"
     )]
     RankDeficient {
-        /// Requested channel mask (bit i = channel i).
+        /// Active channels (bit i = channel i), bits beyond the geometry cleared.
         mask: u32,
         /// λ_min/λ_max of HᵀH over the active rows.
         reciprocal_condition: f64,

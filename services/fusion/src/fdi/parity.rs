@@ -33,7 +33,7 @@ pub enum ParityError {
     /// Fewer than three channels are active: no solution, no parity.
     #[error("only {active} active channels (mask {mask:#x}); at least 3 are needed")]
     InsufficientChannels {
-        /// Requested channel mask (bit i = channel i).
+        /// Active channels (bit i = channel i), bits beyond the geometry cleared.
         mask: u32,
         /// Number of active channels in the mask.
         active: usize,
@@ -41,12 +41,12 @@ pub enum ParityError {
     /// The active axes are (nearly) coplanar, so the parity basis is ill-defined.
     #[error("active channels (mask {mask:#x}) do not span 3-D: σ3/σ1 of H = {ratio:.1e}")]
     RankDeficient {
-        /// Requested channel mask (bit i = channel i).
+        /// Active channels (bit i = channel i), bits beyond the geometry cleared.
         mask: u32,
         /// Smallest over largest singular value of the active rows of H.
         ratio: f64,
     },
-    /// The SVD did not converge.
+    /// The SVD of the active rows of H did not converge.
     #[error("singular value decomposition of the active rows of H did not converge")]
     Decomposition,
     /// A channel's noise variance is zero, negative or not finite.

@@ -167,8 +167,8 @@ impl ErrorStateEkf {
         &self.strapdown
     }
 
-    /// The 15×15 error-state covariance, in the order of [`super::STATES`] blocks (`ATT`, `VEL`,
-    /// `POS`, `BG`, `BA`).
+    /// The 15×15 error-state covariance, its blocks starting at [`super::ATT`], [`super::VEL`],
+    /// [`super::POS`], [`super::BG`] and [`super::BA`].
     pub fn covariance(&self) -> &Covariance {
         &self.p
     }
