@@ -28,6 +28,7 @@ pub const MIN_RECIPROCAL_CONDITION: f64 = 1e-6;
 pub enum GeometryConfig {
     /// n axes on a cone: `h_i = [cos α cos β_i, cos α sin β_i, sin α]`, `β_i = β0 + i·360°/n`.
     Pyramid {
+        /// Number of axes, 3 to 16.
         n: usize,
         /// Elevation α of every axis above the x-y plane, degrees, in (-90, 90).
         alpha_deg: f64,
@@ -36,7 +37,10 @@ pub enum GeometryConfig {
     },
     /// Explicit axes, one `[x, y, z]` unit vector per channel: a norm within
     /// [`UNIT_NORM_TOLERANCE`] of 1 (rounded decimals) is normalised, anything else refused.
-    Axes { axes: Vec<[f64; 3]> },
+    Axes {
+        /// One sensitive axis per channel, body frame (FRD), in channel order.
+        axes: Vec<[f64; 3]>,
+    },
     /// Orthogonal triad: the body x, y and z axes (N = 3, no redundancy).
     Triad {},
     /// Six axes normal to the faces of a regular dodecahedron (see [`dodecahedron_axes`]):

@@ -150,8 +150,10 @@ pub enum KalmanError {
     /// The channel set or its noise variances cannot be solved.
     #[error(transparent)]
     Channels(#[from] WlsError),
+    /// The sample period is outside 1e-5..=1 s.
     #[error("sample period = {0} s: must be in 1e-5..=1 s")]
     SamplePeriod(f64),
+    /// The white-jerk process noise PSD is zero, negative or not finite.
     #[error("process noise = {0}: must be finite and > 0")]
     ProcessNoise(f64),
 }

@@ -11,19 +11,41 @@ use nalgebra::Matrix3;
 /// Why a solver cannot be built for a channel set.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum WlsError {
+    /// Fewer than three channels are active.
     #[error("only {active} active channels (mask {mask:#x}); at least 3 are needed")]
-    InsufficientChannels { mask: u32, active: usize },
+    InsufficientChannels {
+        /// Active channels (bit i = channel i), bits beyond the geometry cleared.
+        mask: u32,
+        /// Number of active channels in the mask.
+        active: usize,
+    },
+    /// The active axes are (nearly) coplanar: HᵀH is too ill-conditioned to invert (see
+    /// [`MIN_RECIPROCAL_CONDITION`]).
     #[error(
         "active channels (mask {mask:#x}) are rank deficient: λmin/λmax of HᵀH = {reciprocal_condition:.1e}"
     )]
     RankDeficient {
+        /// Active channels (bit i = channel i), bits beyond the geometry cleared.
         mask: u32,
+        /// λ_min/λ_max of HᵀH over the active rows.
         reciprocal_condition: f64,
     },
+    /// A channel's noise variance is zero, negative or not finite.
     #[error("noise variance of channel {channel} = {value}: must be finite and > 0")]
-    InvalidVariance { channel: usize, value: f64 },
+    InvalidVariance {
+        /// 0-based index of the offending channel.
+        channel: usize,
+        /// The variance given, (rad/s)² or (m/s²)².
+        value: f64,
+    },
+    /// The number of noise variances differs from the number of channels of the geometry.
     #[error("{given} noise variances given for {expected} channels")]
-    VarianceCount { expected: usize, given: usize },
+    VarianceCount {
+        /// Channels of the geometry.
+        expected: usize,
+        /// Variances given.
+        given: usize,
+    },
 }
 
 /// Precomputed least-squares solution for one geometry and active-channel mask.

@@ -84,28 +84,56 @@ pub struct Alignment {
 /// Why a window cannot give an alignment; the caller restarts the window.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum AlignError {
+    /// The window is not over yet: too short in device time or too few IMU samples.
     #[error("alignment window incomplete: {elapsed_s} s of {required_s} s, {samples} IMU samples")]
     Incomplete {
+        /// Device time the window has covered, s.
         elapsed_s: f64,
+        /// Window length required, s.
         required_s: f64,
+        /// IMU samples in the window so far.
         samples: u32,
     },
+    /// The mean specific force is not gravity: the vehicle accelerates (or an accelerometer is
+    /// wrong).
     #[error(
         "vehicle not static: mean specific force {magnitude_mps2} m/s² differs from gravity {gravity_mps2} m/s² by more than {tolerance_mps2} m/s²"
     )]
     SpecificForceMagnitude {
+        /// Norm of the mean specific force over the window, m/s².
         magnitude_mps2: f64,
+        /// Gravity expected at the site, m/s².
         gravity_mps2: f64,
+        /// Largest accepted difference, m/s².
         tolerance_mps2: f64,
     },
+    /// The mean rate is too large for a vehicle at rest (or a gyro bias beyond what alignment
+    /// accepts).
     #[error("vehicle rotating: mean rate {rate_rps} rad/s above {limit_rps} rad/s")]
-    RateTooHigh { rate_rps: f64, limit_rps: f64 },
+    RateTooHigh {
+        /// Norm of the mean rate over the window, rad/s.
+        rate_rps: f64,
+        /// Largest accepted norm, rad/s.
+        limit_rps: f64,
+    },
+    /// The specific force varies too much over the window: the vehicle is not at rest.
     #[error(
         "vehicle not static: specific force standard deviation {std_mps2} m/s² above {limit_mps2} m/s²"
     )]
-    SpecificForceUnsteady { std_mps2: f64, limit_mps2: f64 },
+    SpecificForceUnsteady {
+        /// Largest standard deviation of a specific-force axis, m/s².
+        std_mps2: f64,
+        /// Largest accepted, m/s².
+        limit_mps2: f64,
+    },
+    /// The rate varies too much over the window: the vehicle is not at rest.
     #[error("vehicle not static: rate standard deviation {std_rps} rad/s above {limit_rps} rad/s")]
-    RateUnsteady { std_rps: f64, limit_rps: f64 },
+    RateUnsteady {
+        /// Largest standard deviation of a rate axis, rad/s.
+        std_rps: f64,
+        /// Largest accepted, rad/s.
+        limit_rps: f64,
+    },
 }
 
 /// Running mean and variance per axis (Welford), numerically safe over long windows.

@@ -46,12 +46,19 @@ impl Default for ZuptConfig {
 /// Settings of the inertial core.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AidedConfig {
+    /// Static alignment window and its limits.
     pub align: AlignConfig,
+    /// Strapdown mechanisation options (largest step, coning correction).
     pub strapdown: StrapdownConfig,
+    /// Filter noise and initial uncertainties.
     pub noise: EkfNoise,
+    /// Zero-velocity updates.
     pub zupt: ZuptConfig,
+    /// The stance detector that gates zero-velocity and stance heading updates.
     pub stance: StanceConfig,
+    /// Barometric height updates.
     pub baro: BaroAidingConfig,
+    /// Magnetometer heading updates.
     pub mag: MagAidingConfig,
     /// Applied to every magnetometer sample before use.
     pub mag_calibration: MagCalibration,
@@ -134,6 +141,7 @@ pub struct AidedNavigator {
 }
 
 impl AidedNavigator {
+    /// A navigator that starts aligning with the first IMU sample.
     pub fn new(config: AidedConfig) -> Self {
         let stance = StanceDetector::new(config.stance);
         Self {
@@ -244,6 +252,8 @@ impl AidedNavigator {
         }
     }
 
+    /// The last successful alignment; `None` while aligning and after a take-over from the peer
+    /// lane (which did not align).
     pub fn alignment(&self) -> Option<&Alignment> {
         self.alignment.as_ref()
     }

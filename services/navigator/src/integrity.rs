@@ -57,8 +57,11 @@ pub struct IntegrityConfig {
     /// vertical and horizontal position (metres). Without horizontal aiding the horizontal error
     /// grows without bound by design: set a limit where the mission needs one.
     pub max_tilt_sigma_deg: f64,
+    /// Limit on the heading error σ, degrees (0 = no limit).
     pub max_heading_sigma_deg: f64,
+    /// Limit on the vertical position error σ, m (0 = no limit).
     pub max_vertical_sigma_m: f64,
+    /// Limit on the horizontal position error σ, m (0 = no limit).
     pub max_horizontal_sigma_m: f64,
     /// After the IMU stopped propagating the state for an invalid spell, the attitude is lost:
     /// its error σ on every axis, degrees (see [`crate::attitude_recovery`]).
@@ -68,9 +71,13 @@ pub struct IntegrityConfig {
     /// within the tolerance of g (m/s²) and no rate exceeds the limit (°/s); re-levelling ends
     /// once the tilt σ is below `relevelled_tilt_sigma_deg`.
     pub gravity_window_s: f64,
+    /// Re-levelling: σ of the window's mean specific force as a measurement of gravity, m/s².
     pub gravity_sigma_mps2: f64,
+    /// Re-levelling: largest `| |f̄| − g |` of a quasi-static window, m/s².
     pub gravity_force_tolerance_mps2: f64,
+    /// Re-levelling: largest rate in a quasi-static window, °/s.
     pub gravity_max_rate_dps: f64,
+    /// Re-levelling ends once the tilt σ is below this, degrees.
     pub relevelled_tilt_sigma_deg: f64,
 }
 
@@ -237,6 +244,7 @@ impl IntegrityMonitor {
         }
     }
 
+    /// The settings the monitor was built with.
     pub fn config(&self) -> &IntegrityConfig {
         &self.config
     }

@@ -86,6 +86,7 @@ impl MagCalibration {
 /// A calibration and how well it explains the samples.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct MagFit {
+    /// Hard iron and soft-iron correction, to apply to raw readings.
     pub calibration: MagCalibration,
     /// Magnitude F the corrected field is scaled to, µT.
     pub field_ut: f64,
@@ -105,34 +106,60 @@ pub struct MagFit {
 /// Why a set of samples gives no calibration.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum MagCalibrationError {
+    /// Fewer than [`MIN_SAMPLES`] samples.
     #[error("{count} samples: at least {MIN_SAMPLES} are needed")]
-    TooFewSamples { count: usize },
+    TooFewSamples {
+        /// Samples given.
+        count: usize,
+    },
+    /// A sample component is not finite or beyond [`MAX_SAMPLE_UT`].
     #[error("sample {index} axis {axis} = {value} µT: must be finite, |x| <= {MAX_SAMPLE_UT:e}")]
     SampleOutOfRange {
+        /// 0-based index of the sample.
         index: usize,
+        /// Axis 0, 1 or 2 (x, y, z).
         axis: usize,
+        /// The reading, µT.
         value: f64,
     },
+    /// The field magnitude given by the caller is not finite and positive.
     #[error("field_ut = {value}: must be finite and > 0 µT")]
-    InvalidField { value: f64 },
+    InvalidField {
+        /// The magnitude given, µT.
+        value: f64,
+    },
+    /// The samples do not cover enough directions for the soft iron to be observable.
     #[error(
         "the samples span too few directions (smallest direction variance {spread:.4}, at least \
          {MIN_DIRECTION_SPREAD} is needed; a whole sphere gives 0.333): rotate the vehicle \
          through more orientations"
     )]
-    InsufficientCoverage { spread: f64 },
+    InsufficientCoverage {
+        /// Smallest eigenvalue of the covariance of the sample directions, about their mean before
+        /// the fit, corrected after it (1/3 for the whole sphere).
+        spread: f64,
+    },
+    /// The fit is ill-determined: more than one ellipsoid explains the samples.
     #[error(
         "the samples fit a family of ellipsoids rather than one (second-smallest singular value \
          of the fit only {gap:.1} times the smallest, at least {MIN_SINGULAR_GAP} is needed): \
          rotate the vehicle through more orientations"
     )]
-    Underdetermined { gap: f64 },
+    Underdetermined {
+        /// Second-smallest singular value of the fit over the smallest.
+        gap: f64,
+    },
+    /// The fitted quadric is not an ellipsoid (mixed signs or too elongated).
     #[error(
         "the samples do not lie on an ellipsoid: the fitted quadric has eigenvalues \
          {:.3e}, {:.3e}, {:.3e} (an ellipsoid needs one sign and an axis ratio below 100)",
         eigenvalues[0], eigenvalues[1], eigenvalues[2]
     )]
-    NotEllipsoid { eigenvalues: [f64; 3] },
+    NotEllipsoid {
+        /// Eigenvalues of the quadric's second-order (3×3) part, in the fit's normalised coordinates.
+        eigenvalues: [f64; 3],
+    },
+    /// A decomposition in the fit (SVD, eigenvalues, square root) failed or gave non-finite values.
     #[error("the singular value decomposition of the quadric fit did not converge")]
     Decomposition,
 }

@@ -56,9 +56,11 @@ pub struct NavOutput {
     pub counts: [AidingCounts; AidingSource::COUNT],
     /// Estimated gyro bias (rad/s) and accelerometer bias (m/s²), body FRD.
     pub gyro_bias_rps: [f64; 3],
+    /// Estimated accelerometer bias, body FRD, m/s².
     pub accel_bias_mps2: [f64; 3],
     /// Whether the solution can be used, and why not (bits of [`ipc_types::integrity_reason`]).
     pub integrity: Integrity,
+    /// Reasons for the integrity verdict, bits of [`ipc_types::integrity_reason`].
     pub integrity_reasons: u32,
     /// Resets of the filter from each aiding source so far, per [`AidingSource`].
     pub resets: [u64; AidingSource::COUNT],

@@ -24,16 +24,19 @@ pub const MAX_MIN_SAMPLES: usize = 10_000;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum StanceTest {
+    /// Magnitude thresholds: stance while `|f|` is close to g and `|ω|` is small [R2, R3].
     Thresholds {
         /// Largest `| |f| − g |`, m/s².
         accel_tolerance_mps2: f64,
         /// Largest `|ω|`, rad/s.
         gyro_max_rps: f64,
     },
+    /// A foot-pressure sensor [R3].
     Fsr {
         /// Normalised foot pressure (0..1) above which the foot is on the ground.
         threshold: f64,
     },
+    /// The SHOE detector [R4] (docs/design.md §6.5).
     Shoe {
         /// Accelerometer noise σ, m/s².
         accel_sigma_mps2: f64,

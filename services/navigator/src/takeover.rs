@@ -21,24 +21,43 @@ use crate::mechanisation::{ImuBias, NominalState};
 /// Why a peer state cannot be taken over.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum TakeOverError {
+    /// The peer's mode is not a usable navigating mode; the value is its wire byte.
     #[error("the peer lane is not navigating (mode {0})")]
     NotNavigating(u8),
+    /// The peer's solution has not run for the lane selector's settling time.
     #[error("the peer's solution is not settled yet (seq {seq}, started at {start})")]
-    NotSettled { seq: u64, start: u64 },
+    NotSettled {
+        /// Origin sequence number of the peer's sample.
+        seq: u64,
+        /// Sequence number at which the peer's solution started (`solution_start_seq`).
+        start: u64,
+    },
+    /// A component of the peer's state is NaN or infinite; names the component.
     #[error("the peer's {0} is not finite")]
     NotFinite(&'static str),
+    /// The peer's attitude quaternion is not of unit norm.
     #[error("the peer's quaternion has norm {0}, not 1")]
     NotUnit(f64),
+    /// An error variance in the peer's sample is negative or not finite.
     #[error("the peer's variance of error state {index} is {value}: must be finite and >= 0")]
-    BadVariance { index: usize, value: f64 },
+    BadVariance {
+        /// Index of the error state.
+        index: usize,
+        /// The variance in the sample.
+        value: f64,
+    },
 }
 
 /// The filter state in a peer's sample: device time (µs), nominal state, biases, error variances.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PeerSolution {
+    /// Device time of the fused IMU sample the state belongs to, µs.
     pub device_time_us: u64,
+    /// Attitude, velocity and position.
     pub state: NominalState,
+    /// Gyro and accelerometer bias estimates.
     pub bias: ImuBias,
+    /// Diagonal of the error-state covariance, in the filter's state order.
     pub covariance_diag: [f64; NAV_STATES],
 }
 

@@ -15,6 +15,7 @@ pub const DURATION_RANGE: &str = "must be a number of seconds > 0 and <= 3600";
 /// as a new port under the same path. Frames the device produces meanwhile are lost.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Disconnect {
+    /// Length of the outage in device time, s; in (0, 3600] ([`MAX_DISCONNECT_S`]).
     pub duration_s: f64,
 }
 

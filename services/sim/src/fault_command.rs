@@ -26,7 +26,10 @@ pub const DISCONNECT_HAS_NO_CHANNEL: &str = "disconnect unplugs the whole device
 /// One redundant inertial channel: sensor type and 0-based index, written `gyro2`, `accel0`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ChannelId {
+    /// Gyro or accelerometer.
     pub sensor: SensorType,
+    /// 0-based channel index within its type, below `MAX_CHANNELS`; whether the block has it is checked
+    /// separately ([`ChannelId::check_fitted`]).
     pub index: u8,
 }
 
@@ -200,7 +203,9 @@ pub fn parse_kind(text: &str) -> Result<SimFault, FaultParseError> {
 /// A validated fault command for one channel.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FaultCommand {
+    /// The channel the fault is applied to.
     pub channel: ChannelId,
+    /// The kind of fault; it decides whether `param` is used and its unit.
     pub fault: SimFault,
     /// SI parameter (see [`SimFault`]); 0 for faults without one.
     pub param: f64,
@@ -360,7 +365,9 @@ pub enum ControlError {
 /// Configured white-noise σ per sample of each inertial sensor type (SI units).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WhiteNoise {
+    /// Gyro σ per sample, rad/s.
     pub gyro_rps: f64,
+    /// Accelerometer σ per sample, m/s².
     pub accel_mps2: f64,
 }
 
@@ -375,6 +382,7 @@ impl WhiteNoise {
         }
     }
 
+    /// The σ per sample of `sensor`'s channels, in its SI unit (rad/s or m/s²).
     pub fn sigma(&self, sensor: SensorType) -> f64 {
         match sensor {
             SensorType::Gyro => self.gyro_rps,

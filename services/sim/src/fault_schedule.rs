@@ -12,7 +12,9 @@ use crate::sim_command::SimCommand;
 /// A command and the device time (s since the simulator started) it takes effect.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ScheduledFault {
+    /// Device time the command takes effect, s since the simulator started; finite and >= 0.
     pub at_s: f64,
+    /// The channel fault or device disconnect to apply.
     pub command: SimCommand,
 }
 
@@ -84,6 +86,7 @@ impl ScheduledFault {
 #[derive(Debug, Clone, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FaultFile {
+    /// The `[[fault]]` tables in file order; none when the file has no faults.
     #[serde(default)]
     pub fault: Vec<FaultFileEntry>,
 }

@@ -1,6 +1,7 @@
 //! When an unplugged serial line comes back, counted in IMU ticks so that the outage is exact in
 //! device time whatever the load on the machine. Pure bookkeeping for the service loop.
 
+/// Whether the simulated serial line is unplugged, and the IMU tick at which it is due back.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Outage {
     /// First tick at which the line is plugged in again; `None` while it is up.
@@ -30,6 +31,7 @@ impl Outage {
         self.back_at.is_some_and(|back| tick >= back)
     }
 
+    /// Whether the line is unplugged (due back or not).
     pub fn is_down(&self) -> bool {
         self.back_at.is_some()
     }

@@ -40,6 +40,8 @@ impl Port {
     }
 }
 
+/// The simulated serial line: a pseudo-terminal the simulator writes frames into, optionally reached
+/// through a fixed symlink, which can be unplugged and plugged in again as a new terminal.
 pub struct SerialLine {
     link: Option<PathBuf>,
     /// `None` while unplugged.
@@ -71,6 +73,7 @@ impl SerialLine {
         self.port.as_ref().map(|p| p.tty.as_str())
     }
 
+    /// Whether a terminal is in (the line is not unplugged).
     pub fn is_plugged(&self) -> bool {
         self.port.is_some()
     }

@@ -44,9 +44,14 @@ pub const COUNT_MAX: i16 = 2047;
 /// Thresholds of the channel-health checks (validated by the configuration).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HealthSettings {
+    /// Samples in a row at a converter rail before a channel counts as saturated.
     pub saturation_samples: u32,
+    /// Identical counts in a row that make a channel stuck.
     pub stuck_samples: u32,
+    /// Block length of the noise-outlier check, samples.
     pub noise_window: u32,
+    /// A channel is noisy when its first-difference variance exceeds this multiple of the median of
+    /// the other channels'.
     pub noise_ratio: f64,
 }
 

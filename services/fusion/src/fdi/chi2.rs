@@ -9,8 +9,10 @@
 /// Why a χ² quantile cannot be computed.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum Chi2Error {
+    /// Zero degrees of freedom were asked for.
     #[error("χ² degrees of freedom = {0}: must be >= 1")]
     DegreesOfFreedom(usize),
+    /// The tail probability is not strictly between 0 and 1.
     #[error("tail probability = {0}: must be in (0, 1)")]
     Probability(f64),
 }

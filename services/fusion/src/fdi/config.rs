@@ -126,24 +126,35 @@ impl Default for FdiConfig {
 /// Validated settings with the derived thresholds, ready for the per-sample path.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FdiSettings {
+    /// Exceedances needed within the last `persistence_n` samples to declare a fault.
     pub persistence_k: u32,
+    /// Length of the persistence window, samples.
     pub persistence_n: u32,
+    /// GLT isolation margin over the runner-up (see [`FdiConfig::isolation_margin`]).
     pub isolation_margin: f64,
+    /// Which parity noise covariance the detector whitens with.
     pub parity_noise: ParityNoise,
+    /// Averaging length of the adaptive noise estimate, samples.
     pub adaptive_window: u32,
     /// 0: no offset estimate.
     pub parity_offset_window: u32,
     /// Length of the learning phase (0 when neither the offset nor the adaptive noise is on).
     pub learning_samples: u32,
+    /// Thresholds of the per-channel health checks.
     pub health: HealthSettings,
+    /// Thresholds of the stationary detector behind the zero-rate/gravity reference.
     pub stationary: StationarySettings,
+    /// Ratio of standard scores by which the isolated channel must stand out against the stationary
+    /// reference (see [`FdiConfig::reference_ratio`]).
     pub reference_ratio: f64,
     /// See [`FdiConfig::motion_noise_fraction`].
     pub motion_noise_fraction: f64,
     /// [`FdiConfig::timing_skew_s`] in samples; set by the fuser, which knows the sample rate
     /// (0 from [`FdiConfig::settings`]).
     pub timing_skew_samples: f64,
+    /// Whether a sensor type left without a solution re-admits its excluded channels by itself.
     pub readmit: ReadmitPolicy,
+    /// Samples in a row an excluded channel must pass every check before it returns by itself.
     pub readmit_after_samples: u32,
     /// Per-sample exceedance probability α₁ behind the thresholds.
     pub exceedance_probability: f64,

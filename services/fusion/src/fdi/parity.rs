@@ -30,14 +30,33 @@ use faer::Mat;
 /// Why a parity space cannot be built for a channel set.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum ParityError {
+    /// Fewer than three channels are active: no solution, no parity.
     #[error("only {active} active channels (mask {mask:#x}); at least 3 are needed")]
-    InsufficientChannels { mask: u32, active: usize },
+    InsufficientChannels {
+        /// Active channels (bit i = channel i), bits beyond the geometry cleared.
+        mask: u32,
+        /// Number of active channels in the mask.
+        active: usize,
+    },
+    /// The active axes are (nearly) coplanar, so the parity basis is ill-defined.
     #[error("active channels (mask {mask:#x}) do not span 3-D: σ3/σ1 of H = {ratio:.1e}")]
-    RankDeficient { mask: u32, ratio: f64 },
+    RankDeficient {
+        /// Active channels (bit i = channel i), bits beyond the geometry cleared.
+        mask: u32,
+        /// Smallest over largest singular value of the active rows of H.
+        ratio: f64,
+    },
+    /// The SVD of the active rows of H did not converge.
     #[error("singular value decomposition of the active rows of H did not converge")]
     Decomposition,
+    /// A channel's noise variance is zero, negative or not finite.
     #[error("noise variance of channel {channel} = {value}: must be finite and > 0")]
-    InvalidVariance { channel: usize, value: f64 },
+    InvalidVariance {
+        /// 0-based index of the offending channel.
+        channel: usize,
+        /// The variance given, (rad/s)² or (m/s²)².
+        value: f64,
+    },
 }
 
 /// Parity basis, whitening and isolation geometry of one active channel set.

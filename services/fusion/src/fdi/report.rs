@@ -68,9 +68,13 @@ impl Default for SensorStatus {
 /// A change of one channel's state or reason.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ChannelEvent {
+    /// Gyro or accelerometer.
     pub sensor: SensorType,
+    /// 0-based channel index within its type.
     pub channel: u8,
+    /// State before the change.
     pub old_state: ChannelState,
+    /// State after the change.
     pub new_state: ChannelState,
     /// Reason before the change.
     pub old_reason: FaultReason,
@@ -109,10 +113,12 @@ impl ChannelEvents {
         &self.events[..self.len]
     }
 
+    /// Number of events this sample.
     pub fn len(&self) -> usize {
         self.len
     }
 
+    /// Whether no channel changed this sample.
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }

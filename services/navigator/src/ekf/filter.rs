@@ -14,16 +14,22 @@ const MIN_COS_LATITUDE: f64 = 1e-6;
 /// Where a measurement comes from, for the accepted/rejected counts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AidingSource {
+    /// Barometric height (docs/design.md §6.5).
     Baro = 0,
+    /// Magnetometer heading update (docs/design.md §6.5), whatever the stance.
     Mag = 1,
+    /// Zero-velocity update in stance.
     Zupt = 2,
+    /// Magnetometer heading update applied only in stance (pedestrian profile).
     Hupt = 3,
     /// The specific force of a quasi-static vehicle as the direction of gravity (tilt).
     Gravity = 4,
 }
 
 impl AidingSource {
+    /// Number of sources, the length of per-source arrays.
     pub const COUNT: usize = 5;
+    /// Every source, in index order.
     pub const ALL: [AidingSource; Self::COUNT] = [
         AidingSource::Baro,
         AidingSource::Mag,
@@ -32,6 +38,7 @@ impl AidingSource {
         AidingSource::Gravity,
     ];
 
+    /// Lower-case name for logs and reports.
     pub fn name(self) -> &'static str {
         match self {
             AidingSource::Baro => "baro",
@@ -46,7 +53,9 @@ impl AidingSource {
 /// Measurements of one source that passed and failed the innovation gate.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct AidingCounts {
+    /// Measurements applied.
     pub accepted: u64,
+    /// Measurements outside the gate (or with a non-finite innovation), not applied.
     pub rejected: u64,
 }
 
@@ -55,14 +64,21 @@ pub struct AidingCounts {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum UpdateOutcome {
     /// Applied; `d2` is the innovation's squared Mahalanobis distance.
-    Accepted { d2: f64 },
+    Accepted {
+        /// Squared Mahalanobis distance of the innovation.
+        d2: f64,
+    },
     /// Outside the gate (or not finite): not applied.
-    Rejected { d2: f64 },
+    Rejected {
+        /// Squared Mahalanobis distance of the innovation (may be NaN or infinite).
+        d2: f64,
+    },
     /// The innovation covariance was not positive definite: not applied.
     Singular,
 }
 
 impl UpdateOutcome {
+    /// Whether the measurement was applied.
     pub fn is_accepted(self) -> bool {
         matches!(self, UpdateOutcome::Accepted { .. })
     }
@@ -125,6 +141,7 @@ impl ErrorStateEkf {
         }
     }
 
+    /// The nominal state: attitude, velocity and position.
     pub fn state(&self) -> &NominalState {
         self.strapdown.state()
     }
@@ -135,6 +152,7 @@ impl ErrorStateEkf {
         self.strapdown.state_mut()
     }
 
+    /// The current gyro and accelerometer bias estimates, body FRD.
     pub fn bias(&self) -> &ImuBias {
         self.strapdown.bias()
     }
@@ -144,10 +162,13 @@ impl ErrorStateEkf {
         *self.strapdown.bias_mut() = bias;
     }
 
+    /// The mechanisation the filter wraps, with its nominal state and biases.
     pub fn strapdown(&self) -> &Strapdown {
         &self.strapdown
     }
 
+    /// The 15×15 error-state covariance, its blocks starting at [`super::ATT`], [`super::VEL`],
+    /// [`super::POS`], [`super::BG`] and [`super::BA`].
     pub fn covariance(&self) -> &Covariance {
         &self.p
     }
@@ -177,6 +198,7 @@ impl ErrorStateEkf {
         self.p[(i, i)].max(0.0).sqrt()
     }
 
+    /// Accepted and rejected measurements of `source` since the filter started.
     pub fn counts(&self, source: AidingSource) -> AidingCounts {
         self.counts[source as usize]
     }

@@ -30,9 +30,13 @@ pub use noise::EkfNoise;
 pub const STATES: usize = 15;
 /// Index of the first component of each error block.
 pub const ATT: usize = 0;
+/// Velocity error block, NED, m/s.
 pub const VEL: usize = 3;
+/// Position error block, north/east/down metres.
 pub const POS: usize = 6;
+/// Gyro bias error block, body FRD, rad/s.
 pub const BG: usize = 9;
+/// Accelerometer bias error block, body FRD, m/s².
 pub const BA: usize = 12;
 
 /// Error-state covariance.

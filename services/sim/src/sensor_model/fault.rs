@@ -5,7 +5,9 @@ use crate::error::SimError;
 /// Which kind of inertial channel a fault addresses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum InertialSensor {
+    /// A single-axis rate gyro (rad/s).
     Gyro,
+    /// A single-axis accelerometer (m/s², specific force).
     Accel,
 }
 
@@ -27,15 +29,29 @@ pub enum ChannelFault {
     /// The counts freeze at the last value output before the fault.
     Stuck,
     /// A constant bias is added.
-    BiasStep { bias: f64 },
+    BiasStep {
+        /// Bias added to every sample, rad/s or m/s².
+        bias: f64,
+    },
     /// A bias growing linearly from zero at injection time is added.
-    Ramp { rate_per_s: f64 },
+    Ramp {
+        /// Growth of the bias, rad/s or m/s² per second of device time.
+        rate_per_s: f64,
+    },
     /// Extra white noise of this σ per sample is added.
-    NoiseBurst { sigma: f64 },
+    NoiseBurst {
+        /// σ per sample of the added noise, rad/s or m/s².
+        sigma: f64,
+    },
     /// The channel reads positive full scale and reports saturation.
     Saturated,
     /// Dead for the first `dropout_s` of every `period_s`, counted from injection.
-    Intermittent { period_s: f64, dropout_s: f64 },
+    Intermittent {
+        /// Length of one dead-then-alive cycle, s.
+        period_s: f64,
+        /// Dead time at the start of each cycle, s; 0 to `period_s`.
+        dropout_s: f64,
+    },
 }
 
 impl ChannelFault {

@@ -19,8 +19,11 @@ pub fn geodetic_rates(latitude_rad: f64, altitude_m: f64, v_north: f64, v_east: 
 /// Kinematic inputs of the position integral at one instant.
 #[derive(Debug, Clone, Copy)]
 pub struct Kinematics {
+    /// North velocity, m/s.
     pub v_north: f64,
+    /// East velocity, m/s.
     pub v_east: f64,
+    /// Altitude above the ellipsoid, m.
     pub altitude_m: f64,
 }
 
