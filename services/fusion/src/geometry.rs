@@ -4,7 +4,7 @@
 //! the least-squares estimate has covariance σ²(HᵀH)⁻¹, so diag((HᵀH)⁻¹) are the per-axis variance
 //! factors of a layout and their square roots its noise amplification.
 //!
-//! Layouts (`kind` in the configuration): `pyramid` (n axes on a cone, the layout of [R1]), `axes`
+//! Layouts (`kind` in the configuration): `pyramid` (n axes on a cone, the layout of \[R1\]), `axes`
 //! (any 3..=16 vectors), `triad` (orthogonal, no redundancy), `dodecahedron` (6 face normals,
 //! isotropic) and `stacked` (several triaxial IMUs, 3 rows each). What a layout allows for fault
 //! detection and isolation is worked out from these rows by the `capability` module.
@@ -58,7 +58,7 @@ pub enum GeometryConfig {
 }
 
 impl GeometryConfig {
-    /// The four-sensor pyramid of [R1]: α = 28.7°, β0 = 45°.
+    /// The four-sensor pyramid of \[R1\]: α = 28.7°, β0 = 45°.
     pub fn seed_pyramid() -> Self {
         GeometryConfig::Pyramid {
             n: 4,

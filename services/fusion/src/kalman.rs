@@ -1,4 +1,4 @@
-//! Kalman fusion of one sensor type over an active channel set (docs/design.md §4, "Kalman option"; [R1] in docs/references.md).
+//! Kalman fusion of one sensor type over an active channel set (docs/design.md §4, "Kalman option"; \[R1\] in docs/references.md).
 //!
 //! State `x = [r, ṙ]` (rate or specific force r in 3 axes, and its derivative), a constant-derivative
 //! model driven by white jerk of power spectral density q per axis, in (unit/s³)²/Hz, e.g.

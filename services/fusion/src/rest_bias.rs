@@ -1,4 +1,4 @@
-//! Per-channel gyro bias from a start-up window at rest (docs/design.md §6.1; [R3] eq. 1).
+//! Per-channel gyro bias from a start-up window at rest (docs/design.md §6.1; \[R3\] eq. 1).
 //!
 //! **Why per channel.** The navigator estimates a gyro bias on the fused body axes during its
 //! static alignment: `b_body = G b`, with G the least-squares matrix of the channel set in use and

@@ -4,7 +4,7 @@
 //! the reaction to gravity, `fⁿ = −gⁿ = [0, 0, −g]`, so
 //! `fᵇ = C_nbᵀ [0, 0, −g] = −g · (third row of C_nb)ᵀ = [g sinθ, −g sinφ cosθ, −g cosφ cosθ]`.
 //! Hence `θ = atan2(f_x, √(f_y² + f_z²))` (= asin(f_x/|f|)) and `φ = atan2(−f_y, −f_z)`; level gives
-//! `f = [0, 0, −g]` and nose-up pitch gives `f_x > 0`. [R3]'s `θ = −asin(f_x/g)`, `γ = atan2(f_y, f_z)`
+//! `f = [0, 0, −g]` and nose-up pitch gives `f_x > 0`. \[R3\]'s `θ = −asin(f_x/g)`, `γ = atan2(f_y, f_z)`
 //! are the same relations written for the accelerometer output taken as `−f` (gravity rather than its
 //! reaction). The atan2 form stays accurate at any pitch and does not depend on the exact value of g.
 //!
@@ -14,7 +14,7 @@
 //! intensity B_h pointing at magnetic north, `H_x = B_h cos(ψ − D)` and `H_y = −B_h sin(ψ − D)`, so
 //! `ψ = atan2(−H_y, H_x) + D` with the declination D positive east.
 //!
-//! Gyro bias is the mean rate over the window ([R3] eq. 1); it includes the Earth rate, which is what a
+//! Gyro bias is the mean rate over the window (\[R3\] eq. 1); it includes the Earth rate, which is what a
 //! non-rotating mechanisation should subtract.
 
 use nalgebra::{UnitQuaternion, Vector3};
@@ -329,7 +329,7 @@ impl StaticAligner {
     }
 }
 
-/// Magnetic heading `atan2(−H_y, H_x)` of the tilt-compensated field ([R3] eq. 9), rad, or `None` when
+/// Magnetic heading `atan2(−H_y, H_x)` of the tilt-compensated field (\[R3\] eq. 9), rad, or `None` when
 /// the horizontal field is too weak to define it.
 pub fn magnetic_heading(field_body: &Vector3<f64>, roll: f64, pitch: f64) -> Option<f64> {
     let (sr, cr) = roll.sin_cos();

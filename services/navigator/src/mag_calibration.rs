@@ -1,4 +1,4 @@
-//! Magnetometer hard- and soft-iron calibration from samples taken in many orientations ([R3]
+//! Magnetometer hard- and soft-iron calibration from samples taken in many orientations (\[R3\]
 //! eq. 2–6).
 //!
 //! **Model.** The sensor reads `m = A h + b`: the body-frame field h distorted by the soft-iron

@@ -1,12 +1,12 @@
-//! Magnetometer heading aiding with an adaptive measurement noise (docs/design.md §6.5; [R2], [R3]).
+//! Magnetometer heading aiding with an adaptive measurement noise (docs/design.md §6.5; \[R2\], \[R3\]).
 //!
 //! **Measurement.** The calibrated body field is rotated into the navigation frame with the
 //! filter's attitude; its azimuth `α = atan2(H_E, H_N)` is where the filter believes magnetic north
 //! to be. With a heading error δ (estimate = true + δ) the estimated rotation turns the field by
 //! δ too, so `α = D + δ` and the measured heading is `ψ_mag = ψ̂ − (α − D)` (D the declination).
-//! Only roll and pitch enter it in the end, which is the tilt compensation of [R3] eq. 9.
+//! Only roll and pitch enter it in the end, which is the tilt compensation of \[R3\] eq. 9.
 //!
-//! **Adaptive R ([R2]).** The magnetometer heading is only as good as two assumptions: the
+//! **Adaptive R (\[R2\]).** The magnetometer heading is only as good as two assumptions: the
 //! accelerometer measures gravity alone (else the tilt used to level the field is wrong) and the
 //! field is the undisturbed Earth field. Each is checked per sample against a tolerance — `| |f| −
 //! g |`, `| |m| − |m_ref| |` and the dip angle's departure from the reference — and the largest

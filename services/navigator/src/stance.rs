@@ -1,9 +1,9 @@
-//! Stance (zero-velocity) detection for a foot-mounted unit (docs/design.md §6.5; [R2], [R3], [R4]).
+//! Stance (zero-velocity) detection for a foot-mounted unit (docs/design.md §6.5; \[R2\], \[R3\], \[R4\]).
 //!
 //! Three detectors over a trailing window of the last `window` samples:
 //! * `thresholds` — every sample of the window has `| |f| − g | < accel_tolerance` and
-//!   `|ω| < gyro_max` (the magnitude tests of [R2] and [R3]);
-//! * `fsr` — the foot-pressure reading of the latest sample exceeds `threshold` ([R3]);
+//!   `|ω| < gyro_max` (the magnitude tests of \[R2\] and \[R3\]);
+//! * `fsr` — the foot-pressure reading of the latest sample exceeds `threshold` (\[R3\]);
 //! * `shoe` — the stance hypothesis likelihood test (Skog et al.):
 //!   `T = (1/W) Σ ( |y_a − g ȳ_a/|ȳ_a||²/σ_a² + |y_ω|²/σ_ω² ) < γ`, with `ȳ_a` the window's mean
 //!   specific force.
@@ -31,12 +31,12 @@ pub enum StanceTest {
         /// Largest `|ω|`, rad/s.
         gyro_max_rps: f64,
     },
-    /// A foot-pressure sensor [R3].
+    /// A foot-pressure sensor \[R3\].
     Fsr {
         /// Normalised foot pressure (0..1) above which the foot is on the ground.
         threshold: f64,
     },
-    /// The SHOE detector [R4] (docs/design.md §6.5).
+    /// The SHOE detector \[R4\] (docs/design.md §6.5).
     Shoe {
         /// Accelerometer noise σ, m/s².
         accel_sigma_mps2: f64,

@@ -5,7 +5,7 @@
 //! constant offset of 1 σ of the parity noise multiplies the per-sample exceedance probability
 //! by about ten and the k-of-n false-alarm rate by about a thousand — a false alarm every few
 //! seconds at 1 kHz. The parity-visible part of the biases, Vβ, is exactly the mean of p, so it is
-//! learnt the way the gyro bias is learnt at rest before a walk ([R3]):
+//! learnt the way the gyro bias is learnt at rest before a walk (\[R3\]):
 //!
 //! - learning phase (the first `learning_samples` samples): running mean of p, no parity
 //!   declarations (the channel-health checks stay active);

@@ -13,7 +13,7 @@
 //! **GLT weighting.** A bias f on channel i moves p' by `f·w_i`, w_i the i-th column of V_w. The
 //! generalised likelihood ratio of "bias on channel i" against "no fault", maximised over f, is
 //! `(w_iᵀ p')² / (w_iᵀ w_i)` — the squared projection of the whitened parity on the fault
-//! direction. This is the textbook `(v_iᵀ p)²/(v_iᵀ v_i)` ([R12]) made correct for unequal channel noise; with
+//! direction. This is the textbook `(v_iᵀ p)²/(v_iᵀ v_i)` (\[R12\]) made correct for unequal channel noise; with
 //! equal σ it is that expression divided by σ², so the argmax is the same.
 //!
 //! Two channels whose columns are parallel ("twins") produce the same parity signature and cannot

@@ -9,7 +9,7 @@
 //!
 //! With `f̂ = f_meas − b̂_a` and `ω̂ = ω_meas − b̂_g` the linearised dynamics are
 //! `δθ' = −Ĉ δb_g`, `δv' = −[fⁿ×] δθ − Ĉ δb_a`, `δp' = δv`, biases random walks (the signs
-//! of [R3] eq. 14 with this document's error definitions). Transport-rate and Earth-rate terms are
+//! of \[R3\] eq. 14 with this document's error definitions). Transport-rate and Earth-rate terms are
 //! left out: the missions are short (minutes) and local (kilometres), where they stay below the
 //! sensor errors.
 //!

@@ -1,5 +1,5 @@
 //! A foot-mounted sensor on a person walking once round the 50 m × 12.9 m rectangle of the
-//! walking experiment of [R3] (docs/references.md), for testing zero-velocity-aided pedestrian navigation.
+//! walking experiment of \[R3\] (docs/references.md), for testing zero-velocity-aided pedestrian navigation.
 //!
 //! The person stands still for `static_s`, then walks the four sides clockwise seen from above
 //! (right turns), starting along the initial heading, and stops back at the start point, facing

@@ -41,7 +41,7 @@ pub struct SystemSpec {
 }
 
 impl SystemSpec {
-    /// The redundant block of [R1]: 4 skewed axes on a pyramid, α = 28.7°, β0 = 45°.
+    /// The redundant block of \[R1\]: 4 skewed axes on a pyramid, α = 28.7°, β0 = 45°.
     pub fn skewed_pyramid() -> Self {
         Self {
             label: "skewed 4 (pyramid α 28.7°, β0 45°)".into(),

@@ -107,7 +107,7 @@ pub struct Ratios {
 }
 
 /// A published figure of the redundant-versus-orthogonal comparison this experiment repeats (the
-/// structural-redundancy paper, [R1] in docs/references.md): 2σ after a 5 h simulated UAV flight with
+/// structural-redundancy paper, \[R1\] in docs/references.md): 2σ after a 5 h simulated UAV flight with
 /// that paper's own aiding.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct PublishedClaim {
