@@ -22,12 +22,15 @@ pub struct NavSubscriber {
 impl NavSubscriber {
     /// Subscribes to both lanes on `node`.
     pub fn new(node: &IpcNode) -> Result<Self, IpcError> {
+        let lanes = [
+            TopicSubscriber::new(node, names::NAV_LANES[0])?,
+            TopicSubscriber::new(node, names::NAV_LANES[1])?,
+        ];
+        let [a, b] = &lanes;
+        let waitset = TopicWaitSet::new(&[a, b])?;
         Ok(Self {
-            lanes: [
-                TopicSubscriber::new(node, names::NAV_LANES[0])?,
-                TopicSubscriber::new(node, names::NAV_LANES[1])?,
-            ],
-            waitset: TopicWaitSet::new()?,
+            lanes,
+            waitset,
             selector: LaneSelector::new(SelectorConfig::default()),
             lane_totals: [0; LANES],
             lane_latest: [None; LANES],
@@ -59,8 +62,7 @@ impl NavSubscriber {
 
     /// Sleeps until either lane publishes or `timeout` passes.
     pub fn wait(&self, timeout: Duration) -> Result<bool, IpcError> {
-        let [a, b] = &self.lanes;
-        self.waitset.wait(&[a, b], timeout)
+        self.waitset.wait(timeout)
     }
 
     /// The lane delivering now.

@@ -29,16 +29,14 @@ fn a_sample_on_any_of_six_topics_wakes_the_wait_once() {
             .map(|t| TopicPublisher::new(&node, t).expect("publisher"))
             .collect();
         let topics: Vec<&TopicSubscriber<u64>> = subscribers.iter().collect();
-        let waitset = TopicWaitSet::new().expect("wait set");
+        let waitset = TopicWaitSet::new(&topics).expect("wait set");
         let short = Duration::from_millis(20);
 
-        assert!(!waitset.wait(&topics, short).expect("wait"), "nothing sent");
+        assert!(!waitset.wait(short).expect("wait"), "nothing sent");
         for (i, publisher) in publishers.iter().enumerate().rev() {
             publisher.publish(100 + i as u64).expect("publish");
             assert!(
-                waitset
-                    .wait(&topics, Duration::from_secs(30))
-                    .expect("wait"),
+                waitset.wait(Duration::from_secs(30)).expect("wait"),
                 "a sample on {} wakes the wait",
                 TOPICS[i]
             );
@@ -47,11 +45,7 @@ fn a_sample_on_any_of_six_topics_wakes_the_wait_once() {
                 Some(100 + i as u64)
             );
             // Reported once: the next wait sleeps until its timeout.
-            assert!(
-                !waitset.wait(&topics, short).expect("wait"),
-                "{}",
-                TOPICS[i]
-            );
+            assert!(!waitset.wait(short).expect("wait"), "{}", TOPICS[i]);
         }
     }
     shm_cleanup::remove_all(&settings, true);

@@ -3,6 +3,7 @@
 //! settings, so whoever comes first creates it.
 
 use std::fmt::Debug;
+use std::rc::Rc;
 use std::time::Duration;
 
 use iceoryx2::port::listener::{Listener, ListenerWaitError};
@@ -122,7 +123,9 @@ impl<T: Debug + ZeroCopySend + 'static> TopicPublisher<T> {
 /// Receiving end of a topic.
 pub struct TopicSubscriber<T: Debug + ZeroCopySend + 'static> {
     subscriber: Subscriber<ipc::Service, T, ()>,
-    listener: Listener<ipc::Service>,
+    /// Shared with a [`super::TopicWaitSet`] that waits on this topic among others: the wait set
+    /// keeps the listener attached for as long as it lives.
+    listener: Rc<Listener<ipc::Service>>,
     name: &'static str,
 }
 
@@ -145,7 +148,7 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
             })?;
         Ok(Self {
             subscriber,
-            listener,
+            listener: Rc::new(listener),
             name,
         })
     }
@@ -180,20 +183,9 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
         self.name
     }
 
-    /// The listener a [`super::TopicWaitSet`] attaches.
-    pub(super) fn listener(&self) -> &Listener<ipc::Service> {
-        &self.listener
-    }
-
-    /// Consumes pending signals without sleeping.
-    pub(super) fn clear_signals(&self) -> Result<(), IpcError> {
-        self.listener
-            .try_wait(|_| {})
-            .map(|_| ())
-            .map_err(|source| IpcError::Wait {
-                topic: self.name,
-                source,
-            })
+    /// The listener a [`super::TopicWaitSet`] attaches (and keeps attached).
+    pub(super) fn listener(&self) -> Rc<Listener<ipc::Service>> {
+        Rc::clone(&self.listener)
     }
 }
 
