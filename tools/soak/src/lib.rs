@@ -9,16 +9,21 @@
 //! service is running again, the navigation output flows, both navigator lanes hold settled
 //! solutions and every sensor channel is back in the fused solution.
 
+mod args;
 mod fault_ledger;
 mod fault_plan;
 mod nav_watch;
+mod summary;
+
+pub use args::SoakArgs;
+pub use summary::SoakSummary;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, bail};
 use ipc_types::{
     ChannelState, FusedImu, HealthReport, ServiceKind, ServiceState, fused_flags, names,
 };
@@ -29,27 +34,11 @@ use rins_runtime::lane_selector::{SelectorConfig, trusted};
 use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::shutdown::Shutdown;
 use rins_sim::fault_command::ChannelId;
-use serde::Serialize;
 
-use fault_ledger::{FaultLedger, KindFigures};
+use args::check_args;
+use fault_ledger::FaultLedger;
 use fault_plan::{Fault, FaultKind};
 use nav_watch::NavWatch;
-
-/// What a soak runs (the command line's `rins soak` options).
-#[derive(Debug, Clone, PartialEq)]
-pub struct SoakArgs {
-    /// How long to run, minutes.
-    pub minutes: f64,
-    /// Seed of the fault schedule.
-    pub seed: u64,
-    /// Shortest time between two faults, s (at least 0.5).
-    pub min_interval_s: f64,
-    /// Longest time between two faults, s (at least `min_interval_s`); each interval is drawn
-    /// between the two.
-    pub max_interval_s: f64,
-    /// Kinds of fault, comma-separated: kill, hang, sensor, disconnect.
-    pub faults: String,
-}
 
 /// Quiet time at the end of the run, beyond the longest recovery of the kinds asked for, so the
 /// last fault is over and every service publishing again when the pipeline is stopped.
@@ -70,38 +59,6 @@ const FLOWING: Duration = Duration::from_millis(100);
 
 /// A cleared channel is readmitted this much later, once its samples are healthy again.
 const READMIT_AFTER: Duration = Duration::from_millis(200);
-
-/// What a soak measured: the JSON summary it prints at the end.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
-pub struct SoakSummary {
-    /// Time from the first navigation sample to the end of the fault loop, minutes (less than
-    /// asked when interrupted).
-    pub minutes: f64,
-    /// SIGKILLs sent (the `kill` faults).
-    pub kills: u64,
-    /// Restarts the watchdog made (from its summary): one per kill and per hang.
-    pub restarts: u64,
-    /// Navigation samples received through the lane selector.
-    pub nav_samples: u64,
-    /// Frames with no navigation output (gaps in the frame sequence of the `nav` topic).
-    pub lost_nav_samples: u64,
-    /// Longest wall-clock interval between two navigation samples, ms.
-    pub max_gap_ms: f64,
-    /// Samples after the first navigating one that were aligning again (a lane that could not
-    /// recover its solution).
-    pub not_navigating_samples: u64,
-    /// Lane changes of the selector.
-    pub lane_switches: u64,
-    /// Samples the selector took from the other lane to fill a hole in the one it follows.
-    pub lane_filled: u64,
-    /// Faults put off because the pipeline had not recovered from the previous one yet.
-    pub faults_deferred: u64,
-    /// Per kind asked for: count, targets, navigation samples lost and longest gap while its
-    /// faults lasted, failed and unrecovered faults.
-    pub faults: std::collections::BTreeMap<&'static str, KindFigures>,
-    /// Shared-memory entries left after the pipeline stopped (from the watchdog's summary).
-    pub shm_leaked: u64,
-}
 
 /// What the soak last heard from the pipeline.
 #[derive(Default)]
@@ -275,24 +232,6 @@ fn recovery_allowance(kind: FaultKind) -> Duration {
         // The unplug, then the reconnect backoff (at most 1 s late).
         FaultKind::Disconnect => fault_plan::DISCONNECT_S.1 + 1.5,
     })
-}
-
-fn check_args(args: &SoakArgs) -> Result<Vec<FaultKind>> {
-    if !(args.minutes.is_finite() && args.minutes > 0.0 && args.minutes <= 24.0 * 60.0) {
-        bail!("--minutes {}: must be in (0, 1440]", args.minutes);
-    }
-    if !(args.min_interval_s.is_finite()
-        && args.min_interval_s >= 0.5
-        && args.max_interval_s.is_finite()
-        && args.max_interval_s >= args.min_interval_s)
-    {
-        bail!(
-            "--min-interval {} / --max-interval {}: need 0.5 <= min <= max seconds",
-            args.min_interval_s,
-            args.max_interval_s
-        );
-    }
-    FaultKind::parse_list(&args.faults).map_err(|e| anyhow!(e))
 }
 
 /// Runs a soak: starts `rins up` (the `uav` scenario), waits for navigation output, injects faults

@@ -17,7 +17,7 @@ use iceoryx2::service::builder::publish_subscribe::PublishSubscribeOpenOrCreateE
 use iceoryx2::service::service_name::ServiceNameError;
 use iceoryx2::waitset::{WaitSetAttachmentError, WaitSetCreateError, WaitSetRunError};
 
-use super::settings::{PREFIX_ENV, ROOT_ENV};
+use super::env::{PREFIX_ENV, ROOT_ENV};
 
 /// An error that is not iceoryx2's (a directory check, a file of our own), kept as the source.
 pub type OtherError = Box<dyn std::error::Error + Send + Sync + 'static>;

@@ -3,16 +3,10 @@
 
 use iceoryx2::prelude::{Config, FileName, Path, SemanticString};
 
+use super::env::{OWNER_ENV, PREFIX_ENV, ROOT_ENV};
 use super::error::IpcError;
 use crate::{private_dir, user};
 
-/// Environment variable naming the shared-memory prefix; every process of one deployment uses the same.
-pub const PREFIX_ENV: &str = "RINS_IPC_PREFIX";
-/// Environment variable naming the iceoryx2 root directory (node and service records).
-pub const ROOT_ENV: &str = "RINS_IPC_ROOT";
-/// Environment variable naming the user (name or uid) whose deployment a tool may join; the tool's
-/// own effective user when unset.
-pub const OWNER_ENV: &str = "RINS_IPC_OWNER";
 /// Environment variable iceoryx2-style per-user runtime directories come from.
 const XDG_RUNTIME_DIR: &str = "XDG_RUNTIME_DIR";
 
