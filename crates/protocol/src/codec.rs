@@ -3,7 +3,7 @@
 
 use ipc_types::{MAX_CHANNELS, MAX_TEMPERATURES};
 
-use super::error::{DecodeError, EncodeError};
+use super::error::{DecodeError, EncodeError, ImuContentError};
 use super::frame::{AuxFrame, BaroFrame, Frame, FrameType, ImuFrame, MagFrame, Payload};
 use super::layout::{
     AUX_PAYLOAD_LEN, BARO_PAYLOAD_LEN, CRC_LEN, CRC32C, FRAME_OVERHEAD, HEADER_LEN, LEN_OFFSET,
@@ -88,22 +88,24 @@ pub fn encode(frame: &Frame, out: &mut [u8]) -> Result<usize, EncodeError> {
     Ok(total)
 }
 
-/// The first channel count of an IMU frame beyond what the frame format carries, as (field, value,
-/// limit): the same limits bind what is encoded and what is decoded.
-fn channel_count_over_limit(imu: &ImuFrame) -> Option<(&'static str, u8, usize)> {
-    [
+/// Refuses an IMU frame whose channel counts exceed what the frame format carries, naming the
+/// first such count: the same limits bind what is encoded and what is decoded.
+fn channel_counts_within_limits(imu: &ImuFrame) -> Result<(), ImuContentError> {
+    match [
         ("n_gyro", imu.n_gyro, MAX_CHANNELS),
         ("n_accel", imu.n_accel, MAX_CHANNELS),
         ("n_temperature", imu.n_temperature, MAX_TEMPERATURES),
     ]
     .into_iter()
     .find(|&(_, value, max)| usize::from(value) > max)
+    {
+        Some((field, value, max)) => Err(ImuContentError::TooManyChannels { field, value, max }),
+        None => Ok(()),
+    }
 }
 
 fn validate_imu(imu: &ImuFrame) -> Result<(), EncodeError> {
-    if let Some((field, value, max)) = channel_count_over_limit(imu) {
-        return Err(EncodeError::TooManyChannels { field, value, max });
-    }
+    channel_counts_within_limits(imu)?;
     let channels = [
         ("gyro_counts", &imu.gyro_counts[..usize::from(imu.n_gyro)]),
         (
@@ -117,11 +119,12 @@ fn validate_imu(imu: &ImuFrame) -> Result<(), EncodeError> {
             .enumerate()
             .find(|(_, c)| !count_in_range(**c))
         {
-            return Err(EncodeError::CountOutOfRange {
+            return Err(ImuContentError::CountOutOfRange {
                 field,
                 index,
                 value,
-            });
+            }
+            .into());
         }
     }
     Ok(())
@@ -228,9 +231,7 @@ fn decode_imu(bytes: &[u8]) -> Result<ImuFrame, DecodeError> {
         valid_mask: r.u32().ok_or(short)?,
         ..ImuFrame::default()
     };
-    if let Some((field, value, max)) = channel_count_over_limit(&imu) {
-        return Err(DecodeError::TooManyChannels { field, value, max });
-    }
+    channel_counts_within_limits(&imu)?;
     let (ng, na, nt) = (
         usize::from(imu.n_gyro),
         usize::from(imu.n_accel),
@@ -247,11 +248,12 @@ fn decode_imu(bytes: &[u8]) -> Result<ImuFrame, DecodeError> {
         for (index, slot) in counts.iter_mut().enumerate() {
             let value = r.i16().ok_or(short)?;
             if !count_in_range(value) {
-                return Err(DecodeError::CountOutOfRange {
+                return Err(ImuContentError::CountOutOfRange {
                     field,
                     index,
                     value,
-                });
+                }
+                .into());
             }
             *slot = value;
         }

@@ -4,21 +4,15 @@ use core::fmt;
 
 use super::frame::FrameType;
 
-/// Why a frame could not be encoded.
+/// An IMU frame whose content breaks the format's limits: the same limits bind what is encoded
+/// and what is decoded, so both errors carry this one.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum EncodeError {
-    /// The output buffer is shorter than the encoded frame.
-    BufferTooSmall {
-        /// Bytes the encoded frame takes.
-        needed: usize,
-        /// Bytes the caller's buffer has.
-        available: usize,
-    },
+pub enum ImuContentError {
     /// A channel count exceeds what the payload can carry.
     TooManyChannels {
         /// The count's field name (`n_gyro`, `n_accel`, `n_temperature`).
         field: &'static str,
-        /// The count given.
+        /// The count given or received.
         value: u8,
         /// The largest count the payload carries.
         max: usize,
@@ -34,17 +28,13 @@ pub enum EncodeError {
     },
 }
 
-impl fmt::Display for EncodeError {
+impl fmt::Display for ImuContentError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            EncodeError::BufferTooSmall { needed, available } => write!(
-                f,
-                "output buffer too small: frame needs {needed} bytes, buffer has {available}"
-            ),
-            EncodeError::TooManyChannels { field, value, max } => {
+            ImuContentError::TooManyChannels { field, value, max } => {
                 write!(f, "{field} = {value} exceeds the maximum of {max}")
             }
-            EncodeError::CountOutOfRange {
+            ImuContentError::CountOutOfRange {
                 field,
                 index,
                 value,
@@ -52,6 +42,46 @@ impl fmt::Display for EncodeError {
                 f,
                 "{field}[{index}] = {value} is outside the 12-bit range -2048..=2047"
             ),
+        }
+    }
+}
+
+impl std::error::Error for ImuContentError {}
+
+impl From<ImuContentError> for EncodeError {
+    fn from(e: ImuContentError) -> Self {
+        EncodeError::Content(e)
+    }
+}
+
+impl From<ImuContentError> for DecodeError {
+    fn from(e: ImuContentError) -> Self {
+        DecodeError::Content(e)
+    }
+}
+
+/// Why a frame could not be encoded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EncodeError {
+    /// The output buffer is shorter than the encoded frame.
+    BufferTooSmall {
+        /// Bytes the encoded frame takes.
+        needed: usize,
+        /// Bytes the caller's buffer has.
+        available: usize,
+    },
+    /// The IMU frame's content breaks the format's limits.
+    Content(ImuContentError),
+}
+
+impl fmt::Display for EncodeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            EncodeError::BufferTooSmall { needed, available } => write!(
+                f,
+                "output buffer too small: frame needs {needed} bytes, buffer has {available}"
+            ),
+            EncodeError::Content(e) => e.fmt(f),
         }
     }
 }
@@ -88,24 +118,8 @@ pub enum DecodeError {
         /// The CRC-32C computed over the frame's bytes.
         computed: u32,
     },
-    /// An IMU channel count exceeds what the payload can carry.
-    TooManyChannels {
-        /// The count's field name (`n_gyro`, `n_accel`, `n_temperature`).
-        field: &'static str,
-        /// The count received.
-        value: u8,
-        /// The largest count the payload carries.
-        max: usize,
-    },
-    /// A gyro or accelerometer count lies outside the 12-bit range -2048..=2047.
-    CountOutOfRange {
-        /// The sample array's field name (`gyro_counts` or `accel_counts`).
-        field: &'static str,
-        /// The channel index within that array.
-        index: usize,
-        /// The out-of-range count.
-        value: i16,
-    },
+    /// The IMU frame's content breaks the format's limits (valid CRC, insane values).
+    Content(ImuContentError),
 }
 
 impl DecodeError {
@@ -135,17 +149,7 @@ impl fmt::Display for DecodeError {
                 f,
                 "crc = {received:#010x} does not match the computed {computed:#010x}"
             ),
-            DecodeError::TooManyChannels { field, value, max } => {
-                write!(f, "{field} = {value} exceeds the maximum of {max}")
-            }
-            DecodeError::CountOutOfRange {
-                field,
-                index,
-                value,
-            } => write!(
-                f,
-                "{field}[{index}] = {value} is outside the 12-bit range -2048..=2047"
-            ),
+            DecodeError::Content(e) => e.fmt(f),
         }
     }
 }

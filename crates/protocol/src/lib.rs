@@ -18,7 +18,7 @@ pub mod time_extend;
 pub use codec::{decode_frame, encode, peek_frame_len};
 pub use continuity::Continuity;
 pub use decoder::{Decoder, DecoderStats};
-pub use error::{DecodeError, EncodeError};
+pub use error::{DecodeError, EncodeError, ImuContentError};
 pub use frame::*;
 pub use layout::{MAX_FRAME_LEN, MAX_PAYLOAD_LEN};
 pub use resume_point::{ResumeError, ResumePoint};

@@ -4,8 +4,8 @@ mod common;
 
 use common::{encode_one, example_imu_frame};
 use rins_protocol::{
-    AuxFrame, BaroFrame, DecodeError, EncodeError, Frame, ImuFrame, MAX_FRAME_LEN, MAX_PAYLOAD_LEN,
-    MagFrame, Payload, decode_frame, encode, peek_frame_len,
+    AuxFrame, BaroFrame, DecodeError, EncodeError, Frame, ImuContentError, ImuFrame, MAX_FRAME_LEN,
+    MAX_PAYLOAD_LEN, MagFrame, Payload, decode_frame, encode, peek_frame_len,
 };
 
 /// The worked example of `docs/protocol.md`, byte for byte.
@@ -165,11 +165,11 @@ fn encode_rejects_counts_outside_12_bits_and_too_many_channels() {
     let err = encode(&frame_of(imu), &mut buf).unwrap_err();
     assert_eq!(
         err,
-        EncodeError::CountOutOfRange {
+        EncodeError::Content(ImuContentError::CountOutOfRange {
             field: "accel_counts",
             index: 7,
             value: 2048
-        }
+        })
     );
     assert!(err.to_string().contains("accel_counts[7] = 2048"));
 
@@ -177,11 +177,11 @@ fn encode_rejects_counts_outside_12_bits_and_too_many_channels() {
     imu.gyro_counts[0] = -2049;
     assert!(matches!(
         encode(&frame_of(imu), &mut buf),
-        Err(EncodeError::CountOutOfRange {
+        Err(EncodeError::Content(ImuContentError::CountOutOfRange {
             field: "gyro_counts",
             index: 0,
             value: -2049
-        })
+        }))
     ));
 
     // Entries past the channel count are not sent, so they are not checked either.
@@ -214,7 +214,9 @@ fn encode_rejects_counts_outside_12_bits_and_too_many_channels() {
         ),
     ] {
         match encode(&frame_of(imu), &mut buf) {
-            Err(EncodeError::TooManyChannels { field: f, .. }) => assert_eq!(f, field),
+            Err(EncodeError::Content(ImuContentError::TooManyChannels { field: f, .. })) => {
+                assert_eq!(f, field)
+            }
             other => panic!("{field}: expected TooManyChannels, got {other:?}"),
         }
     }
@@ -268,11 +270,11 @@ fn decode_reports_each_kind_of_defect() {
     fix_crc(&mut out_of_range);
     assert_eq!(
         decode_frame(&out_of_range),
-        Err(DecodeError::CountOutOfRange {
+        Err(DecodeError::Content(ImuContentError::CountOutOfRange {
             field: "gyro_counts",
             index: 0,
             value: 2048
-        })
+        }))
     );
 
     let mut too_many = good.clone();
@@ -280,11 +282,11 @@ fn decode_reports_each_kind_of_defect() {
     fix_crc(&mut too_many);
     assert!(matches!(
         decode_frame(&too_many),
-        Err(DecodeError::TooManyChannels {
+        Err(DecodeError::Content(ImuContentError::TooManyChannels {
             field: "n_gyro",
             value: 17,
             ..
-        })
+        }))
     ));
 
     // Channel counts that disagree with the length byte: 5 gyros need 2 more bytes than sent.
