@@ -133,6 +133,18 @@ pub struct ChannelRow {
     pub accel_mps2: [f64; MAX_CHANNELS],
 }
 
+impl ChannelRow {
+    /// A row at `t_s` with `n` channels in use, every channel zero until filled.
+    fn zeroed(t_s: f64, n: usize) -> Self {
+        Self {
+            t_s,
+            n,
+            gyro_rps: [0.0; MAX_CHANNELS],
+            accel_mps2: [0.0; MAX_CHANNELS],
+        }
+    }
+}
+
 fn check_installation(trial: &Trial, installation: &Installation) -> Result<(), DatasetError> {
     let same = installation.imus.len() == trial.imus.len()
         && installation
@@ -177,12 +189,7 @@ pub fn project_to_pyramid(
         .collect();
     Ok((0..trial.len())
         .map(|j| {
-            let mut row = ChannelRow {
-                t_s: trial.imus[0].samples[j].t_s,
-                n,
-                gyro_rps: [0.0; MAX_CHANNELS],
-                accel_mps2: [0.0; MAX_CHANNELS],
-            };
+            let mut row = ChannelRow::zeroed(trial.imus[0].samples[j].t_s, n);
             for (i, (p, series)) in projectors.iter().zip(&trial.imus).enumerate() {
                 let s = &series.samples[j];
                 row.gyro_rps[i] = p.dot(&Vector3::from(s.gyro_rps));
@@ -209,12 +216,7 @@ pub fn stack_triads(
     }
     Ok((0..trial.len())
         .map(|j| {
-            let mut row = ChannelRow {
-                t_s: trial.imus[0].samples[j].t_s,
-                n,
-                gyro_rps: [0.0; MAX_CHANNELS],
-                accel_mps2: [0.0; MAX_CHANNELS],
-            };
+            let mut row = ChannelRow::zeroed(trial.imus[0].samples[j].t_s, n);
             for (k, (inst, series)) in installation.imus.iter().zip(&trial.imus).enumerate() {
                 let s = &series.samples[j];
                 let g = inst.rotation * Vector3::from(s.gyro_rps);
