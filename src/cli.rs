@@ -141,11 +141,24 @@ pub enum EvalCommand {
     Quadrotor(EvalQuadrotorArgs),
 }
 
+/// What `rins eval quadrotor` runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum QuadrotorMode {
+    /// Free-inertial from the reference at t0: no aiding at all.
+    Free,
+    /// The navigator's tilt updates (AHRS), cross-validated leave-one-flight-out, beside each
+    /// unit alone and each unit's own on-board filter.
+    Ahrs,
+}
+
 /// Options of `rins eval quadrotor`.
 #[derive(Debug, Args)]
 pub struct EvalQuadrotorArgs {
     /// Data set directory (holding `<group>/path_<N>/IMU_k.csv` and `GT.csv`).
     pub dir: PathBuf,
+    /// What to run.
+    #[arg(long, value_enum, default_value = "free")]
+    pub mode: QuadrotorMode,
     /// Output format and navigator profile.
     #[command(flatten)]
     pub common: EvalProfileArgs,

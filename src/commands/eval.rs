@@ -4,7 +4,9 @@
 use anyhow::Result;
 use rins_eval::fdi::{FdiRequest, evaluate, to_table};
 
-use crate::cli::{EvalFdiArgs, EvalProfileArgs, EvalPyshoeArgs, EvalQuadrotorArgs, EvalXioArgs};
+use crate::cli::{
+    EvalFdiArgs, EvalProfileArgs, EvalPyshoeArgs, EvalQuadrotorArgs, EvalXioArgs, QuadrotorMode,
+};
 use crate::config;
 
 pub fn run_fdi(args: &EvalFdiArgs) -> Result<()> {
@@ -70,6 +72,16 @@ pub fn run_quadrotor(args: &EvalQuadrotorArgs) -> Result<()> {
         .navigator
         .aided_config();
     let mut bar = super::progress::Progress::new("eval quadrotor");
+    if args.mode == QuadrotorMode::Ahrs {
+        let report =
+            rins_eval::quadrotor_ahrs::evaluate(&args.dir, &aided, &mut |d, t| bar.set(d, t))?;
+        bar.finish();
+        return print(
+            args.common.json,
+            &report,
+            rins_eval::quadrotor_ahrs::report::to_table,
+        );
+    }
     let report = rins_eval::quadrotor_nav::evaluate(&args.dir, &aided, &mut |d, t| bar.set(d, t))?;
     bar.finish();
     print(

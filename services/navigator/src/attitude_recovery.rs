@@ -14,22 +14,14 @@
 use nalgebra::Vector3;
 
 use crate::ekf::{ATT, ErrorStateEkf, UpdateOutcome};
+use crate::force_window::ForceWindow;
 use crate::integrity::IntegrityConfig;
-
-/// Accumulated specific force and rate of one window.
-#[derive(Debug, Clone, Copy, Default)]
-struct Window {
-    start_us: Option<u64>,
-    force_sum: Vector3<f64>,
-    samples: u32,
-    max_rate: f64,
-}
 
 /// Re-levelling after a loss of attitude.
 #[derive(Debug, Clone, Default)]
 pub struct AttitudeRecovery {
     lost: bool,
-    window: Window,
+    window: ForceWindow,
 }
 
 impl AttitudeRecovery {
@@ -45,7 +37,7 @@ impl AttitudeRecovery {
             ekf.reset_component(i, sigma * sigma);
         }
         self.lost = true;
-        self.window = Window::default();
+        self.window.clear();
     }
 
     /// One propagated IMU sample at `t_us`: specific force as measured and bias-corrected rate.
@@ -61,23 +53,19 @@ impl AttitudeRecovery {
         if !self.lost {
             return None;
         }
-        let w = &mut self.window;
-        let start = *w.start_us.get_or_insert(t_us);
-        w.force_sum += Vector3::from(force_body);
-        w.samples += 1;
-        w.max_rate = w.max_rate.max(rate_body.norm());
-        if (t_us.saturating_sub(start) as f64) * 1e-6 < config.gravity_window_s {
-            return None;
-        }
-        let mean = w.force_sum / f64::from(w.samples);
-        let quiet = (mean.norm() - ekf.strapdown().gravity()).abs()
+        let mean = self.window.push(
+            t_us,
+            config.gravity_window_s,
+            &Vector3::from(force_body),
+            rate_body,
+        )?;
+        let quiet = (mean.force.norm() - ekf.strapdown().gravity()).abs()
             <= config.gravity_force_tolerance_mps2
-            && w.max_rate <= config.gravity_max_rate_dps.to_radians();
-        self.window = Window::default();
+            && mean.max_rate <= config.gravity_max_rate_dps.to_radians();
         if !quiet {
             return None;
         }
-        let outcome = ekf.gravity_tilt(mean.into(), config.gravity_sigma_mps2, f64::INFINITY);
+        let outcome = ekf.gravity_tilt(mean.force.into(), config.gravity_sigma_mps2, f64::INFINITY);
         let tilt = ekf.sigma(ATT).max(ekf.sigma(ATT + 1));
         if tilt <= config.relevelled_tilt_sigma_deg.to_radians() {
             self.lost = false;

@@ -11,6 +11,7 @@ use crate::mag_calibration::MagCalibration;
 use crate::mag_heading::MagAidingConfig;
 use crate::mechanisation::StrapdownConfig;
 use crate::stance::StanceConfig;
+use crate::tilt_aiding::TiltAidingConfig;
 use rins_earth::normal_gravity;
 
 pub use rins_runtime::config_error::ConfigError;
@@ -54,6 +55,8 @@ pub struct NavigatorConfig {
     pub baro: BaroAidingConfig,
     /// Magnetometer heading updates (`[navigator.mag]`).
     pub mag: MagAidingConfig,
+    /// Tilt updates from the specific force, the AHRS (`[navigator.tilt]`).
+    pub tilt: TiltAidingConfig,
     /// Hard- and soft-iron correction of the magnetometer (`[navigator.mag_calibration]`, as
     /// printed by `rins calibrate mag`).
     pub mag_calibration: MagCalibration,
@@ -83,6 +86,7 @@ impl Default for NavigatorConfig {
             stance: StanceConfig::default(),
             baro: BaroAidingConfig::default(),
             mag: MagAidingConfig::default(),
+            tilt: TiltAidingConfig::default(),
             mag_calibration: MagCalibration::default(),
             integrity: IntegrityConfig::default(),
         }
@@ -211,6 +215,12 @@ impl NavigatorConfig {
             )
             .within("navigator.mag"));
         }
+        if let Err((field, value)) = self.tilt.check() {
+            return Err(
+                ConfigError::new(field, value, "must be finite and > 0 (the gains >= 0)")
+                    .within("navigator.tilt"),
+            );
+        }
         if let Err((field, value)) = self.integrity.check() {
             return Err(ConfigError::new(
                 field,
@@ -243,6 +253,7 @@ impl NavigatorConfig {
             stance: self.stance,
             baro: self.baro,
             mag: self.mag,
+            tilt: self.tilt,
             mag_calibration: self.mag_calibration,
             stale_after_s: self.aiding_timeout_s,
             declination_rad: self.declination_deg.to_radians(),

@@ -19,6 +19,7 @@ use crate::mag_calibration::MagCalibration;
 use crate::mag_heading::{FieldReference, MagAidingConfig};
 use crate::mechanisation::{ImuBias, NominalState, StepOutcome, StrapdownConfig};
 use crate::stance::{StanceConfig, StanceDetector};
+use crate::tilt_aiding::{TiltAiding, TiltAidingConfig};
 use ipc_types::Integrity;
 
 /// Settings of the zero-velocity aiding (`[navigator.zupt]`).
@@ -60,6 +61,8 @@ pub struct AidedConfig {
     pub baro: BaroAidingConfig,
     /// Magnetometer heading updates.
     pub mag: MagAidingConfig,
+    /// Tilt updates from the specific force (AHRS).
+    pub tilt: TiltAidingConfig,
     /// Applied to every magnetometer sample before use.
     pub mag_calibration: MagCalibration,
     /// An aiding source whose last reading is older than this is stale: the filter coasts on the
@@ -105,6 +108,19 @@ pub struct ImuStep {
     pub zupt: Option<UpdateOutcome>,
 }
 
+/// Books a tilt update from the specific force (recovery or AHRS) for the integrity monitor.
+fn record_gravity_update(
+    last_accepted_us: &mut [Option<u64>; AidingSource::COUNT],
+    integrity: &mut IntegrityMonitor,
+    t_us: u64,
+    result: UpdateOutcome,
+) {
+    if result.is_accepted() {
+        last_accepted_us[AidingSource::Gravity as usize] = Some(t_us);
+    }
+    integrity.on_update(AidingSource::Gravity, t_us, result, 2);
+}
+
 /// Alignment followed by the EKF with zero-velocity updates. Allocation-free per sample once
 /// aligned.
 #[derive(Debug, Clone)]
@@ -138,6 +154,8 @@ pub struct AidedNavigator {
     pub(crate) integrity: IntegrityMonitor,
     /// Re-levelling after the attitude was lost (see [`crate::attitude_recovery`]).
     attitude_recovery: AttitudeRecovery,
+    /// Tilt updates in normal navigation (see [`crate::tilt_aiding`]).
+    tilt: TiltAiding,
 }
 
 impl AidedNavigator {
@@ -162,6 +180,7 @@ impl AidedNavigator {
             reference_from_next_mag: false,
             integrity: IntegrityMonitor::new(config.integrity, config.configured_sources()),
             attitude_recovery: AttitudeRecovery::default(),
+            tilt: TiltAiding::default(),
         }
     }
 
@@ -189,6 +208,7 @@ impl AidedNavigator {
         self.integrity =
             IntegrityMonitor::new(self.config.integrity, self.config.configured_sources());
         self.attitude_recovery = AttitudeRecovery::default();
+        self.tilt.reset();
         self.phase = Phase::Navigating(ekf);
     }
 
@@ -330,11 +350,25 @@ impl AidedNavigator {
                         &rate,
                     )
                 {
-                    if result.is_accepted() {
-                        self.last_accepted_us[AidingSource::Gravity as usize] = Some(t_us);
-                    }
-                    self.integrity
-                        .on_update(AidingSource::Gravity, t_us, result, 2);
+                    record_gravity_update(
+                        &mut self.last_accepted_us,
+                        &mut self.integrity,
+                        t_us,
+                        result,
+                    );
+                }
+                let tilt = &self.config.tilt;
+                if outcome.is_applied()
+                    && tilt.enabled
+                    && !self.attitude_recovery.is_lost()
+                    && let Some(result) = self.tilt.push(ekf, tilt, t_us, specific_force, &rate)
+                {
+                    record_gravity_update(
+                        &mut self.last_accepted_us,
+                        &mut self.integrity,
+                        t_us,
+                        result,
+                    );
                 }
                 let g = ekf.strapdown().gravity();
                 step.stance = self.stance.push(rate.into(), force.into(), pressure, g);

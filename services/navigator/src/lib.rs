@@ -1,5 +1,5 @@
 //! Navigator core: static alignment, quaternion strapdown mechanisation, the error-state EKF and its
-//! aiding (baro height, magnetometer heading, zero-velocity updates).
+//! aiding (baro height, magnetometer heading, zero-velocity updates, tilt from the specific force).
 //!
 //! Pure functions and small structs, no I/O. Frames: NED navigation, FRD body; quaternions rotate
 //! body → NED (Hamilton, scalar first); SI units inside, degrees only in [`NavigatorConfig`].
@@ -12,6 +12,7 @@ pub mod baro_mag_updates;
 mod checks;
 pub mod config;
 pub mod ekf;
+pub mod force_window;
 pub mod inertial_core;
 pub mod integrity;
 pub mod mag_calibration;
@@ -21,6 +22,7 @@ pub mod navigator;
 pub mod service;
 pub mod stance;
 pub mod takeover;
+pub mod tilt_aiding;
 
 pub use alignment::{AlignConfig, AlignError, Alignment, StaticAligner};
 pub use config::{ConfigError, NavigatorConfig};

@@ -18,5 +18,6 @@ pub mod foot;
 pub mod installation;
 pub mod integrity_tally;
 pub mod mc;
+pub mod quadrotor_ahrs;
 pub mod quadrotor_nav;
 pub mod stats;

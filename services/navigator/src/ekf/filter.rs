@@ -22,7 +22,8 @@ pub enum AidingSource {
     Zupt = 2,
     /// Magnetometer heading update applied only in stance (pedestrian profile).
     Hupt = 3,
-    /// The specific force of a quasi-static vehicle as the direction of gravity (tilt).
+    /// Tilt from the specific force: its direction as gravity's (a quasi-static vehicle, or the
+    /// AHRS updates of `[navigator.tilt]`), or its body x/y part as rotor drag (multirotor).
     Gravity = 4,
 }
 
@@ -94,7 +95,7 @@ pub struct ErrorStateEkf {
 }
 
 /// `[v×]`, the matrix of `x ↦ v × x`.
-fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
+pub(crate) fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
 }
 

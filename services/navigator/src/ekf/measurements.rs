@@ -3,7 +3,7 @@
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector1};
 
-use super::filter::{AidingSource, ErrorStateEkf, UpdateOutcome};
+use super::filter::{AidingSource, ErrorStateEkf, UpdateOutcome, skew};
 use super::{ATT, BA, POS, STATES, VEL};
 use crate::attitude::wrap_pi;
 
@@ -68,6 +68,40 @@ impl ErrorStateEkf {
             h[(1, BA + k)] = -c[(1, k)];
         }
         let innovation = SVector::<f64, 2>::new(-f_n.x, -f_n.y);
+        let r = SMatrix::<f64, 2, 2>::identity() * (sigma_mps2 * sigma_mps2);
+        self.update(AidingSource::Gravity, &h, &innovation, &r, gate)
+    }
+
+    /// Rotor drag of a multirotor (as PX4's EKF2 models it): the specific force along the body x
+    /// and y axes is the drag `−μ v_b` of the body-frame velocity through still air (the thrust acts
+    /// along z only), plus the accelerometer bias; `force_body` is the measured (mean) specific
+    /// force, each of x and y with σ `sigma_mps2`; `drag_per_s` holds μ for x and for y. With `v_b = Cᵀ v` and `C = (I + [δθ×]) Ĉ`,
+    /// `v_b ≈ Ĉᵀ v̂ + Ĉᵀ δv + Ĉᵀ [v̂×] δθ`: a tilt error shows through the velocity it makes the
+    /// filter integrate, which the drag measures, so tilt and the horizontal gyro biases become
+    /// observable without any position aiding.
+    pub fn rotor_drag(
+        &mut self,
+        force_body: [f64; 3],
+        drag_per_s: [f64; 2],
+        sigma_mps2: f64,
+        gate: f64,
+    ) -> UpdateOutcome {
+        let c = self.state().attitude.to_rotation_matrix().into_inner();
+        let v = self.state().velocity_ned;
+        let ct = c.transpose();
+        let v_body = ct * v;
+        let ct_vx = ct * skew(&v);
+        let b = self.bias().accel_mps2;
+        let mut h = SMatrix::<f64, 2, STATES>::zeros();
+        let mut innovation = SVector::<f64, 2>::zeros();
+        for (k, mu) in drag_per_s.into_iter().enumerate() {
+            for j in 0..3 {
+                h[(k, VEL + j)] = -mu * ct[(k, j)];
+                h[(k, ATT + j)] = -mu * ct_vx[(k, j)];
+            }
+            h[(k, BA + k)] = 1.0;
+            innovation[k] = force_body[k] - (b[k] - mu * v_body[k]);
+        }
         let r = SMatrix::<f64, 2, 2>::identity() * (sigma_mps2 * sigma_mps2);
         self.update(AidingSource::Gravity, &h, &innovation, &r, gate)
     }

@@ -1,0 +1,282 @@
+//! Gravity-referenced attitude (AHRS) for flight without position aiding: the mean specific force
+//! of each short window levels the filter, so roll, pitch and the horizontal gyro biases no longer
+//! drift freely.
+//!
+//! Two models of what the accelerometers measure, chosen by `[navigator.tilt] model`:
+//! * `gravity` — the mean force is gravity's reaction (`ErrorStateEkf::gravity_tilt`). Wrong by the
+//!   vehicle's own acceleration, so its σ grows with what betrays acceleration: the departure of
+//!   |f̄| from g (`force_error_gain`) and the rotation rate (`rate_gain_mps`: a turn at rate ω and
+//!   speed v accelerates the vehicle by v ω), and windows with | |f̄| − g | above
+//!   `max_force_error_mps2` are not used at all.
+//! * `drag` — a multirotor's body x/y force is rotor drag, `−μ v_b` (`ErrorStateEkf::rotor_drag`):
+//!   right during accelerations, which a multirotor makes by tilting, where the gravity model
+//!   reads the tilt as level.
+//!
+//! One update per window of `window_s`; allocation-free.
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use crate::ekf::{ErrorStateEkf, UpdateOutcome};
+use crate::force_window::ForceWindow;
+
+/// What the mean specific force is taken to measure.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum TiltModel {
+    /// The reaction to gravity (a vehicle that is not accelerating).
+    #[default]
+    Gravity,
+    /// Rotor drag in the body x/y plane, thrust along body z (a multirotor).
+    Drag,
+}
+
+impl TiltModel {
+    /// Name as written in the configuration.
+    pub fn name(self) -> &'static str {
+        match self {
+            TiltModel::Gravity => "gravity",
+            TiltModel::Drag => "drag",
+        }
+    }
+}
+
+/// Settings of the tilt updates (`[navigator.tilt]`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TiltAidingConfig {
+    /// Level the filter from the specific force in normal navigation.
+    pub enabled: bool,
+    /// What the specific force measures.
+    pub model: TiltModel,
+    /// Averaging window, s of device time: one update per window.
+    pub window_s: f64,
+    /// σ of each horizontal component of the window's mean force, m/s², before inflation.
+    pub sigma_mps2: f64,
+    /// σ grows by this times | |f̄| − g | (dimensionless).
+    pub force_error_gain: f64,
+    /// σ grows by this times the window's mean rate magnitude, m/s (rad/s × m/s = m/s²).
+    pub rate_gain_mps: f64,
+    /// Windows with | |f̄| − g | above this are not used, m/s².
+    pub max_force_error_mps2: f64,
+    /// Rotor drag coefficient μ of the `drag` model along body x, 1/s (specific force per unit
+    /// airspeed).
+    pub drag_per_s: f64,
+    /// The same along body y, 1/s (an airframe is seldom as draggy sideways as forwards).
+    pub lateral_drag_per_s: f64,
+    /// Innovation gate: largest accepted Mahalanobis distance.
+    pub gate: f64,
+}
+
+impl Default for TiltAidingConfig {
+    fn default() -> Self {
+        Self {
+            enabled: false,
+            model: TiltModel::Gravity,
+            window_s: 0.1,
+            sigma_mps2: 0.5,
+            force_error_gain: 2.0,
+            rate_gain_mps: 2.0,
+            max_force_error_mps2: 2.0,
+            drag_per_s: 0.6,
+            lateral_drag_per_s: 0.6,
+            gate: 5.0,
+        }
+    }
+}
+
+impl TiltAidingConfig {
+    /// Every number must be finite and positive (the gains may be zero): `(field, value)` of the
+    /// first that is not.
+    pub fn check(&self) -> Result<(), (&'static str, f64)> {
+        let positive = [
+            ("window_s", self.window_s),
+            ("sigma_mps2", self.sigma_mps2),
+            ("max_force_error_mps2", self.max_force_error_mps2),
+            ("drag_per_s", self.drag_per_s),
+            ("lateral_drag_per_s", self.lateral_drag_per_s),
+            ("gate", self.gate),
+        ];
+        let non_negative = [
+            ("force_error_gain", self.force_error_gain),
+            ("rate_gain_mps", self.rate_gain_mps),
+        ];
+        if let Some(bad) = positive
+            .into_iter()
+            .find(|(_, v)| !(v.is_finite() && *v > 0.0))
+        {
+            return Err(bad);
+        }
+        match non_negative
+            .into_iter()
+            .find(|(_, v)| !(v.is_finite() && *v >= 0.0))
+        {
+            Some(bad) => Err(bad),
+            None => Ok(()),
+        }
+    }
+}
+
+/// The window in progress.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct TiltAiding {
+    window: ForceWindow,
+}
+
+impl TiltAiding {
+    /// One propagated sample at `t_us`: specific force as measured, rate bias-corrected. Returns
+    /// the update made when a window closed (`None` while it is open or when it was not used).
+    pub fn push(
+        &mut self,
+        ekf: &mut ErrorStateEkf,
+        config: &TiltAidingConfig,
+        t_us: u64,
+        force_body: [f64; 3],
+        rate_body: &Vector3<f64>,
+    ) -> Option<UpdateOutcome> {
+        let mean =
+            self.window
+                .push(t_us, config.window_s, &Vector3::from(force_body), rate_body)?;
+        let force_error = (mean.force.norm() - ekf.strapdown().gravity()).abs();
+        if force_error > config.max_force_error_mps2 {
+            return None;
+        }
+        let sigma = config.sigma_mps2
+            + config.force_error_gain * force_error
+            + config.rate_gain_mps * mean.rate.norm();
+        Some(match config.model {
+            TiltModel::Gravity => ekf.gravity_tilt(mean.force.into(), sigma, config.gate),
+            TiltModel::Drag => ekf.rotor_drag(
+                mean.force.into(),
+                [config.drag_per_s, config.lateral_drag_per_s],
+                sigma,
+                config.gate,
+            ),
+        })
+    }
+
+    /// Forgets the open window (after a take-over or a loss of attitude).
+    pub fn reset(&mut self) {
+        self.window.clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ekf::{ATT, BG, EkfNoise};
+    use crate::mechanisation::{ImuBias, NominalState, StrapdownConfig, quaternion_from_euler};
+
+    const RATE_HZ: f64 = 100.0;
+
+    /// A filter at rest at 45° N whose attitude is off by `roll_error` about x, with the
+    /// process noise and the accelerometer-bias prior so small that only the tilt is learnt.
+    fn filter(roll_error: f64, gyro_bias_sigma: f64) -> ErrorStateEkf {
+        let mut state = NominalState::at_rest(45_f64.to_radians(), 0.0, 100.0);
+        state.attitude = quaternion_from_euler(roll_error, 0.0, 0.0);
+        let noise = EkfNoise {
+            gyro_noise_density: 1e-12,
+            accel_noise_density: 1e-12,
+            gyro_bias_walk: 1e-12,
+            accel_bias_walk: 1e-12,
+            initial_tilt_sigma: 2_f64.to_radians(),
+            initial_heading_sigma: 2_f64.to_radians(),
+            initial_velocity_sigma: 1.0,
+            initial_position_sigma: 1.0,
+            initial_gyro_bias_sigma: gyro_bias_sigma,
+            initial_accel_bias_sigma: 1e-9,
+        };
+        ErrorStateEkf::new(state, ImuBias::default(), StrapdownConfig::default(), noise)
+    }
+
+    fn gravity_config(sigma_mps2: f64) -> TiltAidingConfig {
+        TiltAidingConfig {
+            enabled: true,
+            sigma_mps2,
+            force_error_gain: 0.0,
+            rate_gain_mps: 0.0,
+            gate: 1e6,
+            ..TiltAidingConfig::default()
+        }
+    }
+
+    /// Level and still: the true specific force is straight up; with a roll error δ the filter
+    /// predicts a horizontal force g·δ. Each window is then one scalar measurement of δ with
+    /// variance (σ/g)², and with no process noise the estimate after n windows is the
+    /// information-weighted mean: the remaining error is δ · (1/P₀) / (1/P₀ + n g²/σ²).
+    #[test]
+    fn tilt_converges_as_the_information_form_predicts() {
+        let delta = 1.5_f64.to_radians();
+        let mut ekf = filter(delta, 1e-12);
+        let g = ekf.strapdown().gravity();
+        let sigma = 0.2;
+        let config = gravity_config(sigma);
+        let mut aiding = TiltAiding::default();
+        let mut windows = 0;
+        for k in 1..=100u64 {
+            let force = [0.0, 0.0, -g];
+            assert!(ekf.predict([0.0; 3], force, 1.0 / RATE_HZ).is_applied());
+            let t_us = k * 10_000;
+            if let Some(o) = aiding.push(&mut ekf, &config, t_us, force, &Vector3::zeros()) {
+                assert!(o.is_accepted(), "{o:?}");
+                windows += 1;
+            }
+        }
+        let p0 = 2_f64.to_radians().powi(2);
+        let expected =
+            delta * (1.0 / p0) / (1.0 / p0 + f64::from(windows) * g * g / (sigma * sigma));
+        let [roll, _, _] = ekf.state().euler();
+        assert!(windows >= 9, "{windows}");
+        // Second-order terms (the small-angle model, the velocity the tilt error makes the filter
+        // integrate) stay below 1 % of the correction.
+        assert!(
+            (roll - expected).abs() < 0.01 * delta,
+            "roll {roll} expected {expected}"
+        );
+        // And the correction is most of the error: about 3 % of it is left.
+        assert!(expected < 0.05 * delta, "{expected}");
+    }
+
+    /// A gyro bias tilts a still vehicle's solution at a constant rate; the tilt updates see it
+    /// and the filter learns the bias of both horizontal axes.
+    #[test]
+    fn learns_a_horizontal_gyro_bias_on_a_still_vehicle() {
+        let bias = [0.3_f64.to_radians(), -0.2_f64.to_radians(), 0.0];
+        let mut ekf = filter(0.0, 0.5_f64.to_radians());
+        let g = ekf.strapdown().gravity();
+        let config = gravity_config(0.1);
+        let mut aiding = TiltAiding::default();
+        for k in 1..=(120.0 * RATE_HZ) as u64 {
+            let force = [0.0, 0.0, -g];
+            assert!(ekf.predict(bias, force, 1.0 / RATE_HZ).is_applied());
+            let rate = Vector3::from(bias) - ekf.bias().gyro_rps;
+            let _ = aiding.push(&mut ekf, &config, k * 10_000, force, &rate);
+        }
+        let learnt = ekf.bias().gyro_rps;
+        for axis in 0..2 {
+            assert!(
+                (learnt[axis] - bias[axis]).abs() < 0.005_f64.to_radians(),
+                "axis {axis}: {} against {}",
+                learnt[axis].to_degrees(),
+                bias[axis].to_degrees()
+            );
+            assert!(ekf.sigma(BG + axis) < 0.01_f64.to_radians());
+        }
+        let [roll, pitch, _] = ekf.state().euler();
+        assert!(roll.abs().max(pitch.abs()) < 0.01_f64.to_radians());
+        assert!(ekf.sigma(ATT) < 0.05_f64.to_radians());
+    }
+
+    #[test]
+    fn a_bad_setting_is_named() {
+        let mut c = TiltAidingConfig::default();
+        assert_eq!(c.check(), Ok(()));
+        c.sigma_mps2 = -1.0;
+        assert_eq!(c.check(), Err(("sigma_mps2", -1.0)));
+        c = TiltAidingConfig {
+            rate_gain_mps: f64::NAN,
+            ..TiltAidingConfig::default()
+        };
+        assert!(matches!(c.check(), Err(("rate_gain_mps", v)) if v.is_nan()));
+    }
+}

@@ -1,0 +1,406 @@
+//! Attitude without position aiding on the four-IMU quadrotor recordings (`rins eval quadrotor
+//! --mode ahrs`): the navigator's tilt updates (AHRS) against the airframe's reference attitude,
+//! beside each unit alone and each unit's own on-board filter (the peer), every figure
+//! cross-validated leave-one-flight-out.
+//!
+//! Per flight: each unit's rate and specific force in the reference unit's axes, the four fused
+//! ([`crate::quadrotor_nav::frames`]); the filter starts from the reference at t0 (attitude, height,
+//! velocity with σ 5 m/s: the drag model's velocity is the airspeed, which differs from the
+//! ground speed by the wind) with an unknown gyro bias (σ 0.5 °/s: the units ran long before the
+//! recording starts), and is never told the reference again ([`run`]).
+//!
+//! Cross-validation, for each flight F in turn:
+//! 1. for every candidate setting of `[navigator.tilt]` ([`candidates`]), the mounting tilt of the
+//!    fused solution is fitted on the other flights and the candidate is scored on them;
+//! 2. the candidate with the lowest mean roll/pitch RMSE on the other flights is run on F, and F
+//!    is scored with the mounting fitted on the other flights;
+//! 3. each unit alone (same candidate) and each unit's on-board filter are scored the same way,
+//!    each with its own mounting fitted on the other flights.
+//!
+//! Nothing learnt from F is used to score F. A flight that cannot be loaded or prepared is
+//! reported with its reason and left out; the evaluation goes on.
+
+pub mod candidates;
+pub mod mounting;
+pub mod report;
+pub mod run;
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Result, anyhow};
+use nalgebra::UnitQuaternion;
+use rins_navigator::attitude::quaternion_from_euler;
+use rins_navigator::inertial_core::AidedConfig;
+use serde::Serialize;
+
+use crate::datasets::quadrotor::projection::estimate_installation;
+use crate::datasets::quadrotor::{IMU_RATE_HZ, MAX_IMUS, Trial, list_trials, load_trial};
+use crate::quadrotor_nav::frames::{self, Motion};
+use crate::quadrotor_nav::metrics::mean;
+use crate::quadrotor_nav::run::{Start, start_from_truth};
+use crate::quadrotor_nav::vehicle_from_reference;
+use candidates::Candidate;
+use mounting::{Paired, fit_mounting, roll_pitch_rmse_deg};
+use run::{AttitudeTrace, navigate_ahrs};
+
+/// Initial velocity σ of every run, m/s (see the module docs).
+pub const INITIAL_VELOCITY_SIGMA_MPS: f64 = 5.0;
+/// Initial gyro bias σ of every run, °/s (see the module docs).
+pub const INITIAL_GYRO_BIAS_SIGMA_DPS: f64 = 0.5;
+/// The fused roll/pitch RMSE the mode is held to, degrees.
+pub const ROLL_PITCH_TARGET_DEG: f64 = 0.6;
+
+/// A flight ready to run.
+struct Flight {
+    name: String,
+    imus: Vec<usize>,
+    fused: Motion,
+    singles: Vec<Motion>,
+    start: Start,
+    /// Reference rows after t0: time, roll, pitch.
+    rows: Vec<(f64, f64, f64)>,
+    /// Each unit's on-board attitude paired with the reference rows.
+    peers: Vec<Paired>,
+    truth_offset_s: f64,
+    unit_lag_s: Vec<f64>,
+    notes: Vec<String>,
+}
+
+/// A flight left out, and why.
+#[derive(Debug, Clone, Serialize)]
+pub struct FlightFailure {
+    /// `<group>/path_<N>`.
+    pub name: String,
+    /// What went wrong.
+    pub reason: String,
+}
+
+/// One flight's cross-validated figures.
+#[derive(Debug, Clone, Serialize)]
+pub struct FlightResult {
+    /// `<group>/path_<N>`.
+    pub name: String,
+    /// IMU file numbers present.
+    pub imus: Vec<usize>,
+    /// Reference rows scored.
+    pub rows: usize,
+    /// The candidate chosen on the other flights.
+    pub candidate: String,
+    /// Fused units (a single unit when only one is present), roll/pitch RMSE, degrees.
+    pub fused_roll_pitch_rmse_deg: f64,
+    /// Each unit alone through rins, by unit number 1..=4 (null when absent).
+    pub single_roll_pitch_rmse_deg: [Option<f64>; MAX_IMUS],
+    /// Each unit's own on-board filter, by unit number (null when absent).
+    pub peer_roll_pitch_rmse_deg: [Option<f64>; MAX_IMUS],
+    /// Added to the reference's file times to put them on the reference unit's clock, s.
+    pub truth_offset_s: f64,
+    /// Each present unit's lag behind the reference unit, s.
+    pub unit_lag_s: Vec<f64>,
+    /// What the loader repaired or noticed.
+    pub notes: Vec<String>,
+}
+
+/// One candidate's in-sample figure (every flight, mounting fitted on all of them): shown for
+/// transparency, not used to choose.
+#[derive(Debug, Clone, Serialize)]
+pub struct CandidateFigure {
+    /// The candidate.
+    pub name: String,
+    /// Mean fused roll/pitch RMSE over the flights, degrees.
+    pub in_sample_roll_pitch_rmse_deg: f64,
+    /// Flights on which the cross-validation chose it.
+    pub chosen: usize,
+}
+
+/// The whole data set.
+#[derive(Debug, Clone, Serialize)]
+pub struct AhrsReport {
+    /// Data set directory.
+    pub dir: PathBuf,
+    /// Flights listed.
+    pub flights_total: usize,
+    /// Flights evaluated.
+    pub flights_evaluated: usize,
+    /// Flights left out, with reasons.
+    pub failures: Vec<FlightFailure>,
+    /// Counts of what the loader repaired, by kind.
+    pub repairs: Vec<(String, usize)>,
+    /// Mean over flights of the fused roll/pitch RMSE, degrees (cross-validated).
+    pub roll_pitch_rmse_deg: f64,
+    /// Per unit (1..=4): mean over the flights that have it of its roll/pitch RMSE through rins.
+    pub single_roll_pitch_rmse_deg: [Option<f64>; MAX_IMUS],
+    /// Per unit: mean of its on-board filter's roll/pitch RMSE, scored the same way.
+    pub peer_roll_pitch_rmse_deg: [Option<f64>; MAX_IMUS],
+    /// The fused mean is below every unit's on-board filter's.
+    pub fused_better_than_every_peer: bool,
+    /// The fused mean is below every unit's alone.
+    pub fused_better_than_every_single: bool,
+    /// Target for the fused mean, degrees ([`ROLL_PITCH_TARGET_DEG`]).
+    pub roll_pitch_target_deg: f64,
+    /// The fused mean meets the target.
+    pub roll_pitch_target_met: bool,
+    /// Every candidate's in-sample figure and how often it was chosen.
+    pub candidates: Vec<CandidateFigure>,
+    /// Per flight.
+    pub flights: Vec<FlightResult>,
+}
+
+/// The reference's attitude pairs for `trace` at the flight's rows.
+fn pair(trace: &AttitudeTrace, rows: &[(f64, f64, f64)]) -> Paired {
+    let mut p = Paired::default();
+    for &(t, roll, pitch) in rows {
+        if let Some(q) = trace.at(t) {
+            p.push(q, roll, pitch);
+        }
+    }
+    p
+}
+
+fn prepare(trial: Trial) -> Result<Flight> {
+    let installation = estimate_installation(&trial)?;
+    let vehicle = vehicle_from_reference();
+    let fused = frames::fused(&trial, &installation, &vehicle)?;
+    let singles = (0..trial.imus.len())
+        .map(|k| frames::single(&trial, &installation, &vehicle, k))
+        .collect::<Result<Vec<_>>>()?;
+    let start = start_from_truth(&trial.truth, fused.t0_s, fused.end_s()).ok_or_else(|| {
+        anyhow!(
+            "no reference row inside the IMU recording ({:.2}..{:.2} s) to start from",
+            fused.t0_s,
+            fused.end_s()
+        )
+    })?;
+    let rows: Vec<(f64, f64, f64)> = trial
+        .truth
+        .iter()
+        .skip(start.row + 1)
+        .filter(|r| r.t_s <= fused.end_s())
+        .map(|r| (r.t_s, r.roll_rad, r.pitch_rad))
+        .collect();
+    let peers = trial
+        .imus
+        .iter()
+        .map(|series| {
+            let trace = AttitudeTrace {
+                t_s: series.samples.iter().map(|s| s.t_s).collect(),
+                attitude: series
+                    .samples
+                    .iter()
+                    .map(|s| quaternion_from_euler(s.euler_rad[0], s.euler_rad[1], s.euler_rad[2]))
+                    .collect::<Vec<UnitQuaternion<f64>>>(),
+            };
+            pair(&trace, &rows)
+        })
+        .collect();
+    Ok(Flight {
+        name: trial.name.clone(),
+        imus: trial.imus.iter().map(|s| s.imu).collect(),
+        unit_lag_s: trial
+            .imus
+            .iter()
+            .map(|s| {
+                (s.lag_rows as f64 + 0.5 * (s.residual_lag_rows[0] + s.residual_lag_rows[1]))
+                    / IMU_RATE_HZ
+            })
+            .collect(),
+        truth_offset_s: trial.truth_offset_s,
+        notes: trial.notes,
+        fused,
+        singles,
+        start,
+        rows,
+        peers,
+    })
+}
+
+/// The profile's settings with the candidate's tilt updates and the eval's start rules.
+fn with_candidate(base: &AidedConfig, candidate: &Candidate) -> AidedConfig {
+    let mut config = *base;
+    config.tilt = candidate.tilt;
+    config.baro.enabled = false;
+    config.mag.enabled = false;
+    config.zupt.enabled = false;
+    config.noise.initial_velocity_sigma = INITIAL_VELOCITY_SIGMA_MPS;
+    config.noise.initial_gyro_bias_sigma = INITIAL_GYRO_BIAS_SIGMA_DPS.to_radians();
+    config
+}
+
+/// Score of `runs[f]` with the mounting fitted on every other run.
+fn held_out_score(runs: &[&Paired], f: usize) -> f64 {
+    let others: Vec<&Paired> = (0..runs.len())
+        .filter(|&g| g != f)
+        .map(|g| runs[g])
+        .collect();
+    roll_pitch_rmse_deg(runs[f], fit_mounting(&others))
+}
+
+/// Mean score over `runs` of the mounting fitted on all of them (the training figure).
+fn in_sample_score(runs: &[&Paired]) -> f64 {
+    let tilt = fit_mounting(runs);
+    mean(
+        &runs
+            .iter()
+            .map(|p| roll_pitch_rmse_deg(p, tilt))
+            .collect::<Vec<_>>(),
+    )
+}
+
+/// Held-out score of unit `imu` on flight `f`, its mounting fitted on the other flights that
+/// have the same unit; `pick(g, k)` is flight g's run of its k-th unit. `None` when no other flight
+/// has the unit.
+fn unit_score<'a>(
+    flights: &[Flight],
+    f: usize,
+    imu: usize,
+    pick: impl Fn(usize, usize) -> &'a Paired,
+) -> Option<f64> {
+    let mut runs = Vec::new();
+    let mut target = None;
+    for (g, other) in flights.iter().enumerate() {
+        if let Some(k) = other.imus.iter().position(|&u| u == imu) {
+            if g == f {
+                target = Some(runs.len());
+            }
+            runs.push(pick(g, k));
+        }
+    }
+    target
+        .filter(|_| runs.len() > 1)
+        .map(|t| held_out_score(&runs, t))
+}
+
+/// Every flight under `dir`; `progress(done, total)` as the runs go.
+pub fn evaluate(
+    dir: &Path,
+    base: &AidedConfig,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<AhrsReport> {
+    if !dir.is_dir() {
+        return Err(anyhow!(
+            "eval quadrotor: data set directory {} does not exist or is not a directory",
+            dir.display()
+        ));
+    }
+    let entries = list_trials(dir).map_err(|e| {
+        anyhow!(
+            "eval quadrotor: cannot list trials in {}: {e}",
+            dir.display()
+        )
+    })?;
+    if entries.is_empty() {
+        return Err(anyhow!(
+            "eval quadrotor: no trials (<group>/path_<N>/IMU_k.csv) in {}",
+            dir.display()
+        ));
+    }
+    let grid = candidates::grid(&base.tilt);
+    let total = entries.len() * (grid.len() + MAX_IMUS + 1);
+    let mut done = 0;
+    progress(done, total);
+    let mut flights = Vec::new();
+    let mut failures = Vec::new();
+    for entry in &entries {
+        match load_trial(&entry.path)
+            .map_err(anyhow::Error::from)
+            .and_then(prepare)
+        {
+            Ok(f) => flights.push(f),
+            Err(e) => failures.push(FlightFailure {
+                name: entry.name.clone(),
+                reason: format!("{e:#}"),
+            }),
+        }
+        done += 1;
+        progress(done, total);
+    }
+    // Every candidate's fused run of every flight.
+    let mut fused: Vec<Vec<Paired>> = Vec::with_capacity(grid.len());
+    for candidate in &grid {
+        let config = with_candidate(base, candidate);
+        fused.push(
+            flights
+                .iter()
+                .map(|f| pair(&navigate_ahrs(&f.fused, &f.start, &config), &f.rows))
+                .collect(),
+        );
+        done += entries.len();
+        progress(done, total);
+    }
+    let n = flights.len();
+    // The candidate chosen without each flight.
+    let chosen: Vec<usize> = (0..n)
+        .map(|f| {
+            let scores: Vec<f64> = fused
+                .iter()
+                .map(|runs| {
+                    let others: Vec<&Paired> =
+                        (0..n).filter(|&g| g != f).map(|g| &runs[g]).collect();
+                    in_sample_score(&others)
+                })
+                .collect();
+            (0..scores.len())
+                .min_by(|&a, &b| scores[a].total_cmp(&scores[b]))
+                .unwrap_or(0)
+        })
+        .collect();
+    // Single units of every flight for each candidate that was chosen.
+    let mut singles: Vec<Option<Vec<Vec<Paired>>>> = vec![None; grid.len()];
+    for &c in &chosen {
+        if singles[c].is_none() {
+            let config = with_candidate(base, &grid[c]);
+            singles[c] = Some(
+                flights
+                    .iter()
+                    .map(|f| {
+                        f.singles
+                            .iter()
+                            .map(|m| pair(&navigate_ahrs(m, &f.start, &config), &f.rows))
+                            .collect()
+                    })
+                    .collect(),
+            );
+        }
+    }
+    let mut results = Vec::with_capacity(n);
+    for (f, flight) in flights.iter().enumerate() {
+        let c = chosen[f];
+        let fused_runs: Vec<&Paired> = fused[c].iter().collect();
+        let mut single = [None; MAX_IMUS];
+        let mut peer = [None; MAX_IMUS];
+        for &imu in &flight.imus {
+            let single_runs = singles[c].as_ref();
+            single[imu - 1] =
+                single_runs.and_then(|s| unit_score(&flights, f, imu, |g, k| &s[g][k]));
+            peer[imu - 1] = unit_score(&flights, f, imu, |g, k| &flights[g].peers[k]);
+        }
+        results.push(FlightResult {
+            name: flight.name.clone(),
+            imus: flight.imus.clone(),
+            rows: flight.rows.len(),
+            candidate: grid[c].name.clone(),
+            fused_roll_pitch_rmse_deg: held_out_score(&fused_runs, f),
+            single_roll_pitch_rmse_deg: single,
+            peer_roll_pitch_rmse_deg: peer,
+            truth_offset_s: flight.truth_offset_s,
+            unit_lag_s: flight.unit_lag_s.clone(),
+            notes: flight.notes.clone(),
+        });
+    }
+    progress(total, total);
+    let candidate_figures = grid
+        .iter()
+        .enumerate()
+        .map(|(c, candidate)| CandidateFigure {
+            name: candidate.name.clone(),
+            in_sample_roll_pitch_rmse_deg: in_sample_score(&fused[c].iter().collect::<Vec<_>>()),
+            chosen: chosen.iter().filter(|&&x| x == c).count(),
+        })
+        .collect();
+    Ok(report::summarise(
+        dir,
+        entries.len(),
+        failures,
+        results,
+        candidate_figures,
+    ))
+}

@@ -1,0 +1,181 @@
+//! The `--mode ahrs` summary and its table.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::{
+    AhrsReport, CandidateFigure, FlightFailure, FlightResult, MAX_IMUS, ROLL_PITCH_TARGET_DEG,
+};
+use crate::quadrotor_nav::metrics::mean;
+
+/// Mean per unit over the flights that have it.
+fn per_unit(
+    flights: &[FlightResult],
+    pick: impl Fn(&FlightResult) -> [Option<f64>; MAX_IMUS],
+) -> [Option<f64>; MAX_IMUS] {
+    std::array::from_fn(|k| {
+        let values: Vec<f64> = flights.iter().filter_map(|f| pick(f)[k]).collect();
+        (!values.is_empty()).then(|| mean(&values))
+    })
+}
+
+/// Counts the loader's notes by kind (the text before the first number or colon).
+fn count_repairs(flights: &[FlightResult]) -> Vec<(String, usize)> {
+    let mut counts: Vec<(String, usize)> = Vec::new();
+    for note in flights.iter().flat_map(|f| &f.notes) {
+        let kind = if note.contains("timestamp") {
+            "timestamp steps not one period"
+        } else if note.contains("missing") {
+            "unit files missing"
+        } else if note.contains("residual lag") {
+            "units resampled to the reference clock"
+        } else if note.contains("lags") {
+            "units shifted to the reference clock"
+        } else if note.contains("trimmed") {
+            "rows trimmed to the common span"
+        } else {
+            "other"
+        };
+        match counts.iter_mut().find(|(k, _)| k == kind) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((kind.to_string(), 1)),
+        }
+    }
+    counts
+}
+
+/// The report from the per-flight results.
+pub fn summarise(
+    dir: &Path,
+    flights_total: usize,
+    failures: Vec<FlightFailure>,
+    flights: Vec<FlightResult>,
+    candidates: Vec<CandidateFigure>,
+) -> AhrsReport {
+    let fused = mean(
+        &flights
+            .iter()
+            .map(|f| f.fused_roll_pitch_rmse_deg)
+            .collect::<Vec<_>>(),
+    );
+    let single = per_unit(&flights, |f| f.single_roll_pitch_rmse_deg);
+    let peer = per_unit(&flights, |f| f.peer_roll_pitch_rmse_deg);
+    let below_all = |values: &[Option<f64>; MAX_IMUS]| {
+        values.iter().flatten().all(|&v| fused < v) && values.iter().any(Option::is_some)
+    };
+    AhrsReport {
+        dir: dir.to_path_buf(),
+        flights_total,
+        flights_evaluated: flights.len(),
+        repairs: count_repairs(&flights),
+        failures,
+        roll_pitch_rmse_deg: fused,
+        fused_better_than_every_peer: below_all(&peer),
+        fused_better_than_every_single: below_all(&single),
+        single_roll_pitch_rmse_deg: single,
+        peer_roll_pitch_rmse_deg: peer,
+        roll_pitch_target_deg: ROLL_PITCH_TARGET_DEG,
+        roll_pitch_target_met: fused <= ROLL_PITCH_TARGET_DEG,
+        candidates,
+        flights,
+    }
+}
+
+fn cell(v: Option<f64>) -> String {
+    v.map_or_else(|| "    -".to_string(), |x| format!("{x:5.2}"))
+}
+
+/// The human-readable table.
+pub fn to_table(r: &AhrsReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "AHRS roll/pitch RMSE, degrees, leave-one-flight-out ({} of {} flights evaluated)",
+        r.flights_evaluated, r.flights_total
+    );
+    let _ = writeln!(
+        s,
+        "{:22} {:>6} | {:>5} {:>5} {:>5} {:>5} | {:>5} {:>5} {:>5} {:>5} | {:>7}  candidate",
+        "flight",
+        "fused",
+        "rins1",
+        "rins2",
+        "rins3",
+        "rins4",
+        "peer1",
+        "peer2",
+        "peer3",
+        "peer4",
+        "gt off"
+    );
+    for f in &r.flights {
+        let single: Vec<String> = f
+            .single_roll_pitch_rmse_deg
+            .iter()
+            .map(|v| cell(*v))
+            .collect();
+        let peer: Vec<String> = f
+            .peer_roll_pitch_rmse_deg
+            .iter()
+            .map(|v| cell(*v))
+            .collect();
+        let _ = writeln!(
+            s,
+            "{:22} {:6.2} | {} | {} | {:+7.3}  {}",
+            f.name,
+            f.fused_roll_pitch_rmse_deg,
+            single.join(" "),
+            peer.join(" "),
+            f.truth_offset_s,
+            f.candidate
+        );
+    }
+    let single: Vec<String> = r
+        .single_roll_pitch_rmse_deg
+        .iter()
+        .map(|v| cell(*v))
+        .collect();
+    let peer: Vec<String> = r
+        .peer_roll_pitch_rmse_deg
+        .iter()
+        .map(|v| cell(*v))
+        .collect();
+    let _ = writeln!(
+        s,
+        "{:22} {:6.2} | {} | {} |",
+        "mean",
+        r.roll_pitch_rmse_deg,
+        single.join(" "),
+        peer.join(" ")
+    );
+    let _ = writeln!(
+        s,
+        "fused better than every unit's own filter: {}; than every unit alone: {}; target {:.2}°: {}",
+        r.fused_better_than_every_peer,
+        r.fused_better_than_every_single,
+        r.roll_pitch_target_deg,
+        if r.roll_pitch_target_met {
+            "met"
+        } else {
+            "not met"
+        }
+    );
+    let _ = writeln!(s, "candidates (in-sample mean, times chosen):");
+    for c in &r.candidates {
+        let _ = writeln!(
+            s,
+            "  {:32} {:6.2}  {}",
+            c.name, c.in_sample_roll_pitch_rmse_deg, c.chosen
+        );
+    }
+    if !r.repairs.is_empty() {
+        let _ = writeln!(s, "loader repairs and notes:");
+        for (kind, n) in &r.repairs {
+            let _ = writeln!(s, "  {kind}: {n}");
+        }
+    }
+    for f in &r.failures {
+        let _ = writeln!(s, "left out: {}: {}", f.name, f.reason);
+    }
+    s
+}
