@@ -9,18 +9,21 @@
 //! ground speed by the wind) with an unknown gyro bias (σ 0.5 °/s: the units ran long before the
 //! recording starts), and is never told the reference again ([`run`]).
 //!
-//! Cross-validation, for each flight F in turn:
-//! 1. for every candidate setting of `[navigator.tilt]` ([`candidates`]), the mounting tilt of the
-//!    fused solution is fitted on the other flights and the candidate is scored on them;
-//! 2. the candidate with the lowest mean roll/pitch RMSE on the other flights is run on F, and F
-//!    is scored with the mounting fitted on the other flights;
+//! Cross-validation ([`cross_validation`]), for each flight F in turn:
+//! 1. every candidate setting of `[navigator.tilt]` ([`candidates`]) has run every flight, started
+//!    from the airframe's attitude; on the flights other than F, the fused solution's mounting tilt
+//!    is fitted (rows after the first [`SETTLE_S`]) and the candidate scored;
+//! 2. the candidate with the lowest mean roll/pitch RMSE on the other flights runs F again, now
+//!    started from the airframe's attitude turned by that mounting (the unit's attitude), and F is
+//!    scored with that mounting;
 //! 3. each unit alone (same candidate) and each unit's on-board filter are scored the same way,
-//!    each with its own mounting fitted on the other flights.
+//!    each with its own mounting fitted on the other flights that have the unit.
 //!
 //! Nothing learnt from F is used to score F. A flight that cannot be loaded or prepared is
 //! reported with its reason and left out; the evaluation goes on.
 
 pub mod candidates;
+pub mod cross_validation;
 pub mod mounting;
 pub mod report;
 pub mod run;
@@ -36,22 +39,24 @@ use serde::Serialize;
 use crate::datasets::quadrotor::projection::estimate_installation;
 use crate::datasets::quadrotor::{IMU_RATE_HZ, MAX_IMUS, Trial, list_trials, load_trial};
 use crate::quadrotor_nav::frames::{self, Motion};
-use crate::quadrotor_nav::metrics::mean;
 use crate::quadrotor_nav::run::{Start, start_from_truth};
 use crate::quadrotor_nav::vehicle_from_reference;
 use candidates::Candidate;
-use mounting::{Paired, fit_mounting, roll_pitch_rmse_deg};
-use run::{AttitudeTrace, navigate_ahrs};
+use mounting::Paired;
+use run::AttitudeTrace;
 
 /// Initial velocity σ of every run, m/s (see the module docs).
 pub const INITIAL_VELOCITY_SIGMA_MPS: f64 = 5.0;
 /// Initial gyro bias σ of every run, °/s (see the module docs).
 pub const INITIAL_GYRO_BIAS_SIGMA_DPS: f64 = 0.5;
+/// Rows of the first seconds of a run are left out of mounting fits and of the choice of the
+/// candidate: a run started from the airframe's attitude needs them to find the unit's, s.
+pub const SETTLE_S: f64 = 5.0;
 /// The fused roll/pitch RMSE the mode is held to, degrees.
 pub const ROLL_PITCH_TARGET_DEG: f64 = 0.6;
 
 /// A flight ready to run.
-struct Flight {
+pub(crate) struct Flight {
     name: String,
     imus: Vec<usize>,
     fused: Motion,
@@ -146,11 +151,11 @@ pub struct AhrsReport {
 }
 
 /// The reference's attitude pairs for `trace` at the flight's rows.
-fn pair(trace: &AttitudeTrace, rows: &[(f64, f64, f64)]) -> Paired {
+pub(crate) fn pair(trace: &AttitudeTrace, start_s: f64, rows: &[(f64, f64, f64)]) -> Paired {
     let mut p = Paired::default();
     for &(t, roll, pitch) in rows {
         if let Some(q) = trace.at(t) {
-            p.push(q, roll, pitch);
+            p.push(t - start_s, q, roll, pitch);
         }
     }
     p
@@ -189,7 +194,7 @@ fn prepare(trial: Trial) -> Result<Flight> {
                     .map(|s| quaternion_from_euler(s.euler_rad[0], s.euler_rad[1], s.euler_rad[2]))
                     .collect::<Vec<UnitQuaternion<f64>>>(),
             };
-            pair(&trace, &rows)
+            pair(&trace, start.t_s, &rows)
         })
         .collect();
     Ok(Flight {
@@ -214,7 +219,7 @@ fn prepare(trial: Trial) -> Result<Flight> {
 }
 
 /// The profile's settings with the candidate's tilt updates and the eval's start rules.
-fn with_candidate(base: &AidedConfig, candidate: &Candidate) -> AidedConfig {
+pub(crate) fn with_candidate(base: &AidedConfig, candidate: &Candidate) -> AidedConfig {
     let mut config = *base;
     config.tilt = candidate.tilt;
     config.baro.enabled = false;
@@ -223,50 +228,6 @@ fn with_candidate(base: &AidedConfig, candidate: &Candidate) -> AidedConfig {
     config.noise.initial_velocity_sigma = INITIAL_VELOCITY_SIGMA_MPS;
     config.noise.initial_gyro_bias_sigma = INITIAL_GYRO_BIAS_SIGMA_DPS.to_radians();
     config
-}
-
-/// Score of `runs[f]` with the mounting fitted on every other run.
-fn held_out_score(runs: &[&Paired], f: usize) -> f64 {
-    let others: Vec<&Paired> = (0..runs.len())
-        .filter(|&g| g != f)
-        .map(|g| runs[g])
-        .collect();
-    roll_pitch_rmse_deg(runs[f], fit_mounting(&others))
-}
-
-/// Mean score over `runs` of the mounting fitted on all of them (the training figure).
-fn in_sample_score(runs: &[&Paired]) -> f64 {
-    let tilt = fit_mounting(runs);
-    mean(
-        &runs
-            .iter()
-            .map(|p| roll_pitch_rmse_deg(p, tilt))
-            .collect::<Vec<_>>(),
-    )
-}
-
-/// Held-out score of unit `imu` on flight `f`, its mounting fitted on the other flights that
-/// have the same unit; `pick(g, k)` is flight g's run of its k-th unit. `None` when no other flight
-/// has the unit.
-fn unit_score<'a>(
-    flights: &[Flight],
-    f: usize,
-    imu: usize,
-    pick: impl Fn(usize, usize) -> &'a Paired,
-) -> Option<f64> {
-    let mut runs = Vec::new();
-    let mut target = None;
-    for (g, other) in flights.iter().enumerate() {
-        if let Some(k) = other.imus.iter().position(|&u| u == imu) {
-            if g == f {
-                target = Some(runs.len());
-            }
-            runs.push(pick(g, k));
-        }
-    }
-    target
-        .filter(|_| runs.len() > 1)
-        .map(|t| held_out_score(&runs, t))
 }
 
 /// Every flight under `dir`; `progress(done, total)` as the runs go.
@@ -294,7 +255,7 @@ pub fn evaluate(
         ));
     }
     let grid = candidates::grid(&base.tilt);
-    let total = entries.len() * (grid.len() + MAX_IMUS + 1);
+    let total = entries.len() * (grid.len() + 2 * MAX_IMUS + 2);
     let mut done = 0;
     progress(done, total);
     let mut flights = Vec::new();
@@ -313,94 +274,16 @@ pub fn evaluate(
         done += 1;
         progress(done, total);
     }
-    // Every candidate's fused run of every flight.
-    let mut fused: Vec<Vec<Paired>> = Vec::with_capacity(grid.len());
-    for candidate in &grid {
-        let config = with_candidate(base, candidate);
-        fused.push(
-            flights
-                .iter()
-                .map(|f| pair(&navigate_ahrs(&f.fused, &f.start, &config), &f.rows))
-                .collect(),
-        );
-        done += entries.len();
-        progress(done, total);
-    }
-    let n = flights.len();
-    // The candidate chosen without each flight.
-    let chosen: Vec<usize> = (0..n)
-        .map(|f| {
-            let scores: Vec<f64> = fused
-                .iter()
-                .map(|runs| {
-                    let others: Vec<&Paired> =
-                        (0..n).filter(|&g| g != f).map(|g| &runs[g]).collect();
-                    in_sample_score(&others)
-                })
-                .collect();
-            (0..scores.len())
-                .min_by(|&a, &b| scores[a].total_cmp(&scores[b]))
-                .unwrap_or(0)
-        })
-        .collect();
-    // Single units of every flight for each candidate that was chosen.
-    let mut singles: Vec<Option<Vec<Vec<Paired>>>> = vec![None; grid.len()];
-    for &c in &chosen {
-        if singles[c].is_none() {
-            let config = with_candidate(base, &grid[c]);
-            singles[c] = Some(
-                flights
-                    .iter()
-                    .map(|f| {
-                        f.singles
-                            .iter()
-                            .map(|m| pair(&navigate_ahrs(m, &f.start, &config), &f.rows))
-                            .collect()
-                    })
-                    .collect(),
-            );
-        }
-    }
-    let mut results = Vec::with_capacity(n);
-    for (f, flight) in flights.iter().enumerate() {
-        let c = chosen[f];
-        let fused_runs: Vec<&Paired> = fused[c].iter().collect();
-        let mut single = [None; MAX_IMUS];
-        let mut peer = [None; MAX_IMUS];
-        for &imu in &flight.imus {
-            let single_runs = singles[c].as_ref();
-            single[imu - 1] =
-                single_runs.and_then(|s| unit_score(&flights, f, imu, |g, k| &s[g][k]));
-            peer[imu - 1] = unit_score(&flights, f, imu, |g, k| &flights[g].peers[k]);
-        }
-        results.push(FlightResult {
-            name: flight.name.clone(),
-            imus: flight.imus.clone(),
-            rows: flight.rows.len(),
-            candidate: grid[c].name.clone(),
-            fused_roll_pitch_rmse_deg: held_out_score(&fused_runs, f),
-            single_roll_pitch_rmse_deg: single,
-            peer_roll_pitch_rmse_deg: peer,
-            truth_offset_s: flight.truth_offset_s,
-            unit_lag_s: flight.unit_lag_s.clone(),
-            notes: flight.notes.clone(),
-        });
-    }
+    let outcome = cross_validation::run(&flights, &grid, base, &mut |runs| {
+        done += runs;
+        progress(done.min(total), total);
+    });
     progress(total, total);
-    let candidate_figures = grid
-        .iter()
-        .enumerate()
-        .map(|(c, candidate)| CandidateFigure {
-            name: candidate.name.clone(),
-            in_sample_roll_pitch_rmse_deg: in_sample_score(&fused[c].iter().collect::<Vec<_>>()),
-            chosen: chosen.iter().filter(|&&x| x == c).count(),
-        })
-        .collect();
     Ok(report::summarise(
         dir,
         entries.len(),
         failures,
-        results,
-        candidate_figures,
+        outcome.flights,
+        outcome.candidates,
     ))
 }

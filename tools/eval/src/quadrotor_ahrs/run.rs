@@ -74,12 +74,18 @@ fn initial_variances(config: &AidedConfig) -> [f64; STATES] {
 }
 
 /// Runs `motion` from `start` through the navigator's inertial core with `config` (its tilt
-/// updates included when enabled).
-pub fn navigate_ahrs(motion: &Motion, start: &Start, config: &AidedConfig) -> AttitudeTrace {
+/// updates included when enabled). The unit's attitude at t0 is the airframe's turned by the
+/// inverse of the unit's `mounting` (`C_nav←vehicle = C_nav←unit · mounting`).
+pub fn navigate_ahrs(
+    motion: &Motion,
+    start: &Start,
+    config: &AidedConfig,
+    mounting: &UnitQuaternion<f64>,
+) -> AttitudeTrace {
     let [lat, lon, altitude_zero_m] = config.origin;
     let mut state = NominalState::at_rest(lat, lon, altitude_zero_m + start.height_m);
     let [roll, pitch, heading] = start.euler_rad;
-    state.attitude = quaternion_from_euler(roll, pitch, heading);
+    state.attitude = quaternion_from_euler(roll, pitch, heading) * mounting.inverse();
     state.velocity_ned = Vector3::from(start.velocity_ned);
     let mut navigator = AidedNavigator::new(*config);
     navigator.take_over(
