@@ -1,4 +1,5 @@
-//! Quadrotor loader on small files written by the test: missing files, malformed lines, lags.
+//! Quadrotor loader on small files written by the test: missing files, malformed lines, lags,
+//! repairs; and the evaluations listing the trials they cannot use.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -276,4 +277,74 @@ fn load_each_keeps_the_trials_that_load() {
     };
     assert!(e.to_string().contains("path_2/GT.csv: missing"), "{e}");
     assert_eq!(total_repairs(&outcomes).trials_failed, 1);
+}
+
+/// A data set of three trials: one without truth, one with a single unit and one whose only
+/// unit file is unreadable.
+fn broken_data_set(root: &Path) {
+    for n in 1..=3 {
+        let dir = root.join("Horizontal").join(format!("path_{n}"));
+        std::fs::create_dir_all(&dir).unwrap();
+        write_imu(&dir, 1, 300, 0);
+        if n != 1 {
+            write_truth(&dir, 30);
+        }
+        if n == 3 {
+            std::fs::write(dir.join("IMU_1.csv"), "time\n").unwrap();
+        }
+    }
+}
+
+#[test]
+fn eval_fdi_lists_the_trials_it_cannot_use_instead_of_failing() {
+    let root = TempDir::new("fdi-skip");
+    broken_data_set(&root.0);
+    let request = rins_eval::fdi::FdiRequest {
+        dir: root.0.clone(),
+        trials: Vec::new(),
+        fdi: rins_fusion::FdiConfig::default(),
+        lsb: [2.5e-3, 3.8e-2],
+    };
+    let mut last = (0, 0);
+    let report = rins_eval::fdi::evaluate(&request, &mut |d, t| last = (d, t)).unwrap();
+    assert_eq!(report.trials, 0);
+    assert_eq!(last.0, last.1, "the progress ends at its total");
+    let reasons: Vec<(&str, &str)> = report
+        .skipped
+        .iter()
+        .map(|s| (s.trial.as_str(), s.reason.as_str()))
+        .collect();
+    assert_eq!(reasons.len(), 3, "{reasons:?}");
+    assert!(reasons[0].1.contains("GT.csv: missing"), "{reasons:?}");
+    assert_eq!(
+        reasons[1],
+        (
+            "Horizontal/path_2",
+            "1 IMUs usable, the configurations need 4"
+        )
+    );
+    assert!(reasons[2].1.contains("IMU_1.csv:1: header"), "{reasons:?}");
+    let text = rins_eval::fdi::to_table(&report);
+    assert!(
+        text.contains("3 trials skipped:\n  Horizontal/path_1: "),
+        "{text}"
+    );
+    let json = serde_json::to_value(&report).unwrap();
+    assert_eq!(json["skipped"][1]["trial"], "Horizontal/path_2");
+}
+
+#[test]
+fn eval_quadrotor_lists_the_trials_it_cannot_use_instead_of_failing() {
+    let root = TempDir::new("nav-skip");
+    broken_data_set(&root.0);
+    let config = rins_navigator::NavigatorConfig::default().aided_config();
+    let report = rins_eval::quadrotor_nav::evaluate(&root.0, &config, &mut |_, _| ()).unwrap();
+    // A single unit is enough to navigate: path_2 is evaluated, the other two are listed.
+    let evaluated: Vec<&str> = report.trials.iter().map(|t| t.name.as_str()).collect();
+    assert_eq!(evaluated, ["Horizontal/path_2"]);
+    let skipped: Vec<&str> = report.skipped.iter().map(|s| s.trial.as_str()).collect();
+    assert_eq!(skipped, ["Horizontal/path_1", "Horizontal/path_3"]);
+    let text = rins_eval::quadrotor_nav::report::to_table(&report);
+    assert!(text.contains("trials skipped:"), "{text}");
+    assert!(text.contains("Horizontal/path_1: "), "{text}");
 }

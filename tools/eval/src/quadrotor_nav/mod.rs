@@ -26,7 +26,7 @@ use rins_navigator::inertial_core::AidedConfig;
 use serde::Serialize;
 
 use crate::datasets::quadrotor::projection::estimate_installation;
-use crate::datasets::quadrotor::{Trial, list_trials, load_trial};
+use crate::datasets::quadrotor::{SkippedTrial, Trial, list_trials, load_trial};
 use metrics::{Scores, max, mean, median, score};
 use run::{navigate, start_from_truth};
 
@@ -91,6 +91,8 @@ pub struct QuadrotorReport {
     pub gravity_latitude_deg: f64,
     /// How gyro biases were handled.
     pub gyro_bias: &'static str,
+    /// Trials listed but not evaluated, with the reason.
+    pub skipped: Vec<SkippedTrial>,
 }
 
 /// What the report says about gyro biases.
@@ -171,24 +173,38 @@ pub fn evaluate(
     let mut done = 0;
     progress(done, total);
     let mut trials = Vec::with_capacity(entries.len());
+    let mut skipped = Vec::new();
     for entry in &entries {
-        let trial = load_trial(&entry.path)
-            .with_context(|| format!("eval quadrotor: trial {}", entry.name))?;
-        // The runs of a trial that fails are still counted, so the bar ends at its total.
+        // The runs of a trial that fails are still counted, so the bar ends at its total; the
+        // trial is listed in the report with the reason.
         let before = done;
-        let result = evaluate_trial(&trial, config, &mut || {
-            done += 1;
-            progress(done, total);
-        })
-        .with_context(|| format!("eval quadrotor: trial {}", entry.name))?;
+        let result = load_trial(&entry.path)
+            .map_err(anyhow::Error::from)
+            .and_then(|trial| {
+                evaluate_trial(&trial, config, &mut || {
+                    done += 1;
+                    progress(done, total);
+                })
+            });
         done = before + entry.imus.len() + 1;
         progress(done, total);
-        trials.push(result);
+        match result {
+            Ok(result) => trials.push(result),
+            Err(e) => skipped.push(SkippedTrial {
+                trial: entry.name.clone(),
+                reason: format!("{e:#}"),
+            }),
+        }
     }
-    Ok(summarise(dir, trials, config))
+    Ok(summarise(dir, trials, skipped, config))
 }
 
-fn summarise(dir: &Path, trials: Vec<TrialResult>, config: &AidedConfig) -> QuadrotorReport {
+fn summarise(
+    dir: &Path,
+    trials: Vec<TrialResult>,
+    skipped: Vec<SkippedTrial>,
+    config: &AidedConfig,
+) -> QuadrotorReport {
     let collect = |f: &dyn Fn(&TrialResult) -> f64| trials.iter().map(f).collect::<Vec<_>>();
     let fused = mean(&collect(&|t| t.fused.roll_pitch_rmse_deg));
     let median_single = mean(&collect(&|t| t.median_single_roll_pitch_rmse_deg));
@@ -217,6 +233,7 @@ fn summarise(dir: &Path, trials: Vec<TrialResult>, config: &AidedConfig) -> Quad
         gravity_latitude_deg: config.origin[0].to_degrees(),
         gyro_bias: GYRO_BIAS_NOTE,
         trials,
+        skipped,
     }
 }
 

@@ -4,6 +4,7 @@ use std::fmt::Write;
 
 use super::QuadrotorReport;
 use super::metrics::Scores;
+use crate::datasets::quadrotor::skipped_lines;
 
 fn label(s: &Scores) -> String {
     s.imu.map_or_else(|| "fused".into(), |k| format!("IMU_{k}"))
@@ -91,5 +92,6 @@ pub fn to_table(r: &QuadrotorReport) -> String {
         "gravity at latitude {:.3}° (profile origin); gyro bias {}",
         r.gravity_latitude_deg, r.gyro_bias
     );
+    s.push_str(&skipped_lines(&r.skipped));
     s
 }
