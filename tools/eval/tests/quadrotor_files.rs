@@ -344,7 +344,14 @@ fn eval_quadrotor_lists_the_trials_it_cannot_use_instead_of_failing() {
     assert_eq!(evaluated, ["Horizontal/path_2"]);
     let skipped: Vec<&str> = report.skipped.iter().map(|s| s.trial.as_str()).collect();
     assert_eq!(skipped, ["Horizontal/path_1", "Horizontal/path_3"]);
+    assert_eq!(report.repairs.trials_failed, 2);
+    // Constant truth angles give no timing information: the clock is kept, as the file's.
+    assert_eq!(report.trials[0].unit_truth_offsets_s, [0.0]);
     let text = rins_eval::quadrotor_nav::report::to_table(&report);
     assert!(text.contains("trials skipped:"), "{text}");
     assert!(text.contains("Horizontal/path_1: "), "{text}");
+    assert!(
+        text.contains("truth clock +0.000 s (files: +0.000 s)"),
+        "{text}"
+    );
 }

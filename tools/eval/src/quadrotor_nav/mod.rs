@@ -26,7 +26,7 @@ use rins_navigator::inertial_core::AidedConfig;
 use serde::Serialize;
 
 use crate::datasets::quadrotor::projection::estimate_installation;
-use crate::datasets::quadrotor::{SkippedTrial, Trial, list_trials, load_trial};
+use crate::datasets::quadrotor::{Repairs, SkippedTrial, Trial, list_trials, load_trial};
 use metrics::{Scores, max, mean, median, score};
 use run::{navigate, start_from_truth};
 
@@ -60,6 +60,12 @@ pub struct TrialResult {
     pub median_single_roll_pitch_rmse_deg: f64,
     /// The fused roll/pitch RMSE is below the median single unit's.
     pub fused_better_than_median_single: bool,
+    /// Added to the truth file's times to put them on the reference unit's, s.
+    pub truth_offset_s: f64,
+    /// The same for each unit's own file (its lag included), in file order, s.
+    pub unit_truth_offsets_s: Vec<f64>,
+    /// What the loader repaired in the trial's files.
+    pub repairs: Repairs,
 }
 
 /// The whole data set's figures.
@@ -93,6 +99,8 @@ pub struct QuadrotorReport {
     pub gyro_bias: &'static str,
     /// Trials listed but not evaluated, with the reason.
     pub skipped: Vec<SkippedTrial>,
+    /// What the loader repaired over the evaluated trials; the skipped ones count as failed.
+    pub repairs: Repairs,
 }
 
 /// What the report says about gyro biases.
@@ -146,6 +154,9 @@ pub fn evaluate_trial(
         median_single_roll_pitch_rmse_deg: median_single,
         single,
         fused,
+        truth_offset_s: trial.truth_offset_s,
+        unit_truth_offsets_s: trial.imus.iter().map(|s| s.truth_offset_s).collect(),
+        repairs: trial.repairs,
     })
 }
 
@@ -232,6 +243,13 @@ fn summarise(
         fused_height_error_max_m: max(&collect(&|t| t.fused.height_error_max_m)),
         gravity_latitude_deg: config.origin[0].to_degrees(),
         gyro_bias: GYRO_BIAS_NOTE,
+        repairs: trials.iter().fold(
+            Repairs {
+                trials_failed: skipped.len(),
+                ..Repairs::default()
+            },
+            |total, t| total + t.repairs,
+        ),
         trials,
         skipped,
     }

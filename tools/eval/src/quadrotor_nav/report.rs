@@ -53,6 +53,24 @@ pub fn to_table(r: &QuadrotorReport) -> String {
                 "not better"
             }
         );
+        let files: Vec<String> = t
+            .unit_truth_offsets_s
+            .iter()
+            .map(|o| format!("{o:+.3}"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "{:<20} {:>6} truth clock {:+.3} s (files: {} s){}",
+            "",
+            "",
+            t.truth_offset_s,
+            files.join(", "),
+            if t.repairs.is_clean() {
+                String::new()
+            } else {
+                format!("; repaired: {}", t.repairs.phrases().join(", "))
+            }
+        );
     }
     let _ = writeln!(
         s,
