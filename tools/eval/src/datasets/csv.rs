@@ -10,11 +10,37 @@ pub(crate) fn read_numeric<const N: usize>(
     path: &Path,
     header: &[&str; N],
 ) -> Result<Vec<[f64; N]>, DatasetError> {
+    read_with(path, header, Values::Finite)
+}
+
+/// [`read_numeric`], except that an empty field or a non-finite number (`NaN`, `inf`) is read as
+/// NaN instead of refused: for files whose loader repairs such rows.
+pub(crate) fn read_numeric_allowing_gaps<const N: usize>(
+    path: &Path,
+    header: &[&str; N],
+) -> Result<Vec<[f64; N]>, DatasetError> {
+    read_with(path, header, Values::GapsAsNan)
+}
+
+/// What a field may hold.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Values {
+    /// Finite numbers only.
+    Finite,
+    /// Numbers, with empty and non-finite fields read as NaN.
+    GapsAsNan,
+}
+
+fn read_with<const N: usize>(
+    path: &Path,
+    header: &[&str; N],
+    values: Values,
+) -> Result<Vec<[f64; N]>, DatasetError> {
     let text = std::fs::read_to_string(path).map_err(|source| DatasetError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    parse_numeric(path, &text, header)
+    parse_with(path, &text, header, values)
 }
 
 /// [`read_numeric`] on text already read; `path` only names the source in errors.
@@ -22,6 +48,15 @@ pub(crate) fn parse_numeric<const N: usize>(
     path: &Path,
     text: &str,
     header: &[&str; N],
+) -> Result<Vec<[f64; N]>, DatasetError> {
+    parse_with(path, text, header, Values::Finite)
+}
+
+fn parse_with<const N: usize>(
+    path: &Path,
+    text: &str,
+    header: &[&str; N],
+    values: Values,
 ) -> Result<Vec<[f64; N]>, DatasetError> {
     let mut lines = text.lines().map(|l| l.trim_end_matches('\r'));
     let first = lines.next().unwrap_or("");
@@ -50,11 +85,16 @@ pub(crate) fn parse_numeric<const N: usize>(
             let field = fields.next().ok_or_else(|| {
                 malformed(format!("{column} fields, expected {N} (missing {name})"))
             })?;
-            let value: f64 = field
-                .trim()
-                .parse()
-                .map_err(|_| malformed(format!("{name} = {:?}: not a number", field.trim())))?;
-            if !value.is_finite() {
+            let gaps = values == Values::GapsAsNan;
+            let value: f64 = if gaps && field.trim().is_empty() {
+                f64::NAN
+            } else {
+                field
+                    .trim()
+                    .parse()
+                    .map_err(|_| malformed(format!("{name} = {:?}: not a number", field.trim())))?
+            };
+            if !value.is_finite() && !gaps {
                 return Err(malformed(format!("{name} = {value}: not finite")));
             }
             *slot = value;
@@ -103,5 +143,21 @@ mod tests {
         assert!(e.to_string().starts_with("x/IMU_1.csv:1: header"), "{e}");
         let e = parse("").unwrap_err();
         assert!(matches!(e, DatasetError::Header { .. }));
+    }
+
+    #[test]
+    fn gaps_are_read_as_nan_when_allowed() {
+        let rows = parse_with(
+            Path::new("x"),
+            "time,a,b\n0,,inf\n1,NaN,2\n",
+            &H,
+            Values::GapsAsNan,
+        )
+        .unwrap();
+        assert_eq!(rows[0][0], 0.0);
+        assert!(rows[0][1].is_nan() && rows[0][2].is_infinite() && rows[1][1].is_nan());
+        assert_eq!(rows[1][2], 2.0);
+        let e = parse_with(Path::new("x"), "time,a,b\n0,x,1\n", &H, Values::GapsAsNan);
+        assert!(e.is_err());
     }
 }

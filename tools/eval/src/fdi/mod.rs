@@ -35,7 +35,7 @@ use rins_fusion::{
 use serde::Serialize;
 
 use crate::datasets::quadrotor::projection::stacked_axes;
-use crate::datasets::quadrotor::{IMU_RATE_HZ, list_trials, load_trial};
+use crate::datasets::quadrotor::{IMU_RATE_HZ, MAX_IMUS, SkippedTrial, list_trials, load_trial};
 
 mod episodes;
 mod prepare;
@@ -272,9 +272,30 @@ pub fn evaluate(request: &FdiRequest, progress: &mut dyn FnMut(usize, usize)) ->
             }
         }
     }
+    let mut skipped = Vec::new();
     for entry in &entries {
-        let trial =
-            load_trial(&entry.path).with_context(|| format!("eval fdi: trial {}", entry.name))?;
+        // A trial that cannot be loaded, or has fewer units than the configurations are built
+        // from, is listed in the report; its runs still count, so the bar ends at its total.
+        let reason = match load_trial(&entry.path) {
+            Ok(trial) if trial.imus.len() == MAX_IMUS => Ok(trial),
+            Ok(trial) => Err(format!(
+                "{} IMUs usable, the configurations need {MAX_IMUS}",
+                trial.imus.len()
+            )),
+            Err(e) => Err(e.to_string()),
+        };
+        let trial = match reason {
+            Ok(trial) => trial,
+            Err(reason) => {
+                skipped.push(SkippedTrial {
+                    trial: entry.name.clone(),
+                    reason,
+                });
+                done += runs_per_trial;
+                progress(done, total_runs);
+                continue;
+            }
+        };
         for (ci, (layout, fusion, geometry)) in configs.iter().enumerate() {
             let p = prepare(&trial, *layout, geometry, lsb)
                 .with_context(|| format!("eval fdi: trial {}", entry.name))?;
@@ -368,7 +389,8 @@ pub fn evaluate(request: &FdiRequest, progress: &mut dyn FnMut(usize, usize)) ->
     breakdown.iter_mut().for_each(|b| b.tally.finish());
     Ok(FdiReport {
         dir: dir.clone(),
-        trials: entries.len(),
+        trials: entries.len() - skipped.len(),
+        skipped,
         imu_rate_hz: IMU_RATE_HZ,
         gyro_lsb_rps: lsb[0],
         accel_lsb_mps2: lsb[1],

@@ -6,7 +6,7 @@ use serde::Serialize;
 
 use super::NoiseFit;
 use super::runs::Outcome;
-use crate::datasets::quadrotor::IMU_RATE_HZ;
+use crate::datasets::quadrotor::{IMU_RATE_HZ, SkippedTrial, skipped_lines};
 
 /// Detection and isolation of injected faults, counted. Delays are in faulty samples processed
 /// until the fuser flagged (1 = on the first faulty sample); the median and maximum are filled in
@@ -170,6 +170,8 @@ pub struct FdiReport {
     pub dir: PathBuf,
     /// Trials evaluated.
     pub trials: usize,
+    /// Trials listed but not evaluated, with the reason.
+    pub skipped: Vec<SkippedTrial>,
     /// The data set's IMU rate, Hz.
     pub imu_rate_hz: f64,
     /// Gyro count resolution the data were quantised to, rad/s.
@@ -232,6 +234,7 @@ pub fn to_table(r: &FdiReport) -> String {
         r.motion_noise_fraction,
         r.timing_skew_s * 1e3
     );
+    s.push_str(&skipped_lines(&r.skipped));
     let _ = writeln!(
         s,
         "{:22} {:9} {:>6} {:>10} {:>10} {:>11} {:>11} {:>11} {:>11} {:>7}",

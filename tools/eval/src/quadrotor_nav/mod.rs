@@ -26,7 +26,7 @@ use rins_navigator::inertial_core::AidedConfig;
 use serde::Serialize;
 
 use crate::datasets::quadrotor::projection::estimate_installation;
-use crate::datasets::quadrotor::{Trial, list_trials, load_trial};
+use crate::datasets::quadrotor::{Repairs, SkippedTrial, Trial, list_trials, load_trial};
 use metrics::{Scores, max, mean, median, score};
 use run::{navigate, start_from_truth};
 
@@ -60,6 +60,12 @@ pub struct TrialResult {
     pub median_single_roll_pitch_rmse_deg: f64,
     /// The fused roll/pitch RMSE is below the median single unit's.
     pub fused_better_than_median_single: bool,
+    /// Added to the truth file's times to put them on the reference unit's, s.
+    pub truth_offset_s: f64,
+    /// The same for each unit's own file (its lag included), in file order, s.
+    pub unit_truth_offsets_s: Vec<f64>,
+    /// What the loader repaired in the trial's files.
+    pub repairs: Repairs,
 }
 
 /// The whole data set's figures.
@@ -91,6 +97,10 @@ pub struct QuadrotorReport {
     pub gravity_latitude_deg: f64,
     /// How gyro biases were handled.
     pub gyro_bias: &'static str,
+    /// Trials listed but not evaluated, with the reason.
+    pub skipped: Vec<SkippedTrial>,
+    /// What the loader repaired over the evaluated trials; the skipped ones count as failed.
+    pub repairs: Repairs,
 }
 
 /// What the report says about gyro biases.
@@ -144,6 +154,9 @@ pub fn evaluate_trial(
         median_single_roll_pitch_rmse_deg: median_single,
         single,
         fused,
+        truth_offset_s: trial.truth_offset_s,
+        unit_truth_offsets_s: trial.imus.iter().map(|s| s.truth_offset_s).collect(),
+        repairs: trial.repairs,
     })
 }
 
@@ -171,24 +184,38 @@ pub fn evaluate(
     let mut done = 0;
     progress(done, total);
     let mut trials = Vec::with_capacity(entries.len());
+    let mut skipped = Vec::new();
     for entry in &entries {
-        let trial = load_trial(&entry.path)
-            .with_context(|| format!("eval quadrotor: trial {}", entry.name))?;
-        // The runs of a trial that fails are still counted, so the bar ends at its total.
+        // The runs of a trial that fails are still counted, so the bar ends at its total; the
+        // trial is listed in the report with the reason.
         let before = done;
-        let result = evaluate_trial(&trial, config, &mut || {
-            done += 1;
-            progress(done, total);
-        })
-        .with_context(|| format!("eval quadrotor: trial {}", entry.name))?;
+        let result = load_trial(&entry.path)
+            .map_err(anyhow::Error::from)
+            .and_then(|trial| {
+                evaluate_trial(&trial, config, &mut || {
+                    done += 1;
+                    progress(done, total);
+                })
+            });
         done = before + entry.imus.len() + 1;
         progress(done, total);
-        trials.push(result);
+        match result {
+            Ok(result) => trials.push(result),
+            Err(e) => skipped.push(SkippedTrial {
+                trial: entry.name.clone(),
+                reason: format!("{e:#}"),
+            }),
+        }
     }
-    Ok(summarise(dir, trials, config))
+    Ok(summarise(dir, trials, skipped, config))
 }
 
-fn summarise(dir: &Path, trials: Vec<TrialResult>, config: &AidedConfig) -> QuadrotorReport {
+fn summarise(
+    dir: &Path,
+    trials: Vec<TrialResult>,
+    skipped: Vec<SkippedTrial>,
+    config: &AidedConfig,
+) -> QuadrotorReport {
     let collect = |f: &dyn Fn(&TrialResult) -> f64| trials.iter().map(f).collect::<Vec<_>>();
     let fused = mean(&collect(&|t| t.fused.roll_pitch_rmse_deg));
     let median_single = mean(&collect(&|t| t.median_single_roll_pitch_rmse_deg));
@@ -216,7 +243,15 @@ fn summarise(dir: &Path, trials: Vec<TrialResult>, config: &AidedConfig) -> Quad
         fused_height_error_max_m: max(&collect(&|t| t.fused.height_error_max_m)),
         gravity_latitude_deg: config.origin[0].to_degrees(),
         gyro_bias: GYRO_BIAS_NOTE,
+        repairs: trials.iter().fold(
+            Repairs {
+                trials_failed: skipped.len(),
+                ..Repairs::default()
+            },
+            |total, t| total + t.repairs,
+        ),
         trials,
+        skipped,
     }
 }
 
@@ -271,7 +306,8 @@ mod tests {
                 imu: k + 1,
                 lag_rows: 0,
                 residual_lag_rows: [0.0; 2],
-                timestamp_glitches: 0,
+                repairs: Default::default(),
+                truth_offset_s: 0.0,
                 samples: (0..rows)
                     .map(|j| {
                         let t = j as f64 * dt;
@@ -314,6 +350,7 @@ mod tests {
             imus,
             truth,
             truth_offset_s: 0.0,
+            repairs: Default::default(),
             notes: Vec::new(),
         }
     }

@@ -4,6 +4,7 @@ use std::fmt::Write;
 
 use super::QuadrotorReport;
 use super::metrics::Scores;
+use crate::datasets::quadrotor::skipped_lines;
 
 fn label(s: &Scores) -> String {
     s.imu.map_or_else(|| "fused".into(), |k| format!("IMU_{k}"))
@@ -52,6 +53,24 @@ pub fn to_table(r: &QuadrotorReport) -> String {
                 "not better"
             }
         );
+        let files: Vec<String> = t
+            .unit_truth_offsets_s
+            .iter()
+            .map(|o| format!("{o:+.3}"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "{:<20} {:>6} truth clock {:+.3} s (files: {} s){}",
+            "",
+            "",
+            t.truth_offset_s,
+            files.join(", "),
+            if t.repairs.is_clean() {
+                String::new()
+            } else {
+                format!("; repaired: {}", t.repairs.phrases().join(", "))
+            }
+        );
     }
     let _ = writeln!(
         s,
@@ -91,5 +110,6 @@ pub fn to_table(r: &QuadrotorReport) -> String {
         "gravity at latitude {:.3}° (profile origin); gyro bias {}",
         r.gravity_latitude_deg, r.gyro_bias
     );
+    s.push_str(&skipped_lines(&r.skipped));
     s
 }

@@ -164,7 +164,8 @@ mod tests {
                 imu: k + 1,
                 lag_rows: 0,
                 residual_lag_rows: [0.0; 2],
-                timestamp_glitches: 0,
+                repairs: Default::default(),
+                truth_offset_s: 0.0,
                 samples: (0..n)
                     .map(|j| {
                         let t = j as f64 / rate;
@@ -204,6 +205,7 @@ mod tests {
             imus,
             truth: Vec::new(),
             truth_offset_s: 0.0,
+            repairs: Default::default(),
             notes: Vec::new(),
         };
         (trial, installation)

@@ -3,24 +3,31 @@
 //!
 //! Layout: `<group>/path_<N>/{IMU_1..4.csv, GT.csv}` with groups `Horizontal` and `StraightLine`
 //! (the copy at hand has 8 + 4 trials, all with four IMUs; the published set also has vertical
-//! trials, some with a single IMU: a missing IMU file is skipped with a note, a trial without any
-//! IMU or without truth is an error). IMU files: time s, Euler_X/Y/Z °, Acc_X/Y/Z m/s²,
+//! trials, some with a single IMU: a missing or unusable IMU file is skipped with a note, a trial
+//! without any usable IMU or without truth is an error). Defects of the time column are repaired
+//! and counted (see [`repair`]). IMU files: time s, Euler_X/Y/Z °, Acc_X/Y/Z m/s²,
 //! Gyr_X/Y/Z °/s at 120 Hz. GT.csv at 10 Hz: time, distance, speed, compass heading °, pitch °,
 //! roll °, height above take-off m, North, East, Down m.
 //!
 //! Loaded trials are in SI units and FRD axes (see [`frame`]), the IMUs aligned on one time base
-//! and the truth moved onto it (see [`align`]).
+//! (see [`align`]) and the truth moved onto it (see [`clock`]).
 
 pub mod align;
+pub mod clock;
 pub mod frame;
 pub mod lever_arm;
+mod load;
 pub mod projection;
+pub mod repair;
 pub mod subrow;
 
 use std::path::{Path, PathBuf};
 
-use super::csv::read_numeric;
+use serde::Serialize;
+
 use super::error::DatasetError;
+pub use load::load_trial;
+pub use repair::Repairs;
 
 /// IMU output rate, Hz.
 pub const IMU_RATE_HZ: f64 = 120.0;
@@ -33,10 +40,10 @@ pub const MIN_IMU_ROWS: usize = 120;
 /// Fewest rows the truth file must have (1 s).
 pub const MIN_TRUTH_ROWS: usize = 10;
 
-const IMU_HEADER: [&str; 10] = [
+pub(crate) const IMU_HEADER: [&str; 10] = [
     "time", "Euler_X", "Euler_Y", "Euler_Z", "Acc_X", "Acc_Y", "Acc_Z", "Gyr_X", "Gyr_Y", "Gyr_Z",
 ];
-const TRUTH_HEADER: [&str; 10] = [
+pub(crate) const TRUTH_HEADER: [&str; 10] = [
     "time",
     "distance(meters)",
     "speed(m/s)",
@@ -74,8 +81,11 @@ pub struct ImuSeries {
     /// Smallest and largest residual lag (rows, fractional) removed by resampling after the
     /// whole-row alignment (see [`subrow`]); zero for the reference.
     pub residual_lag_rows: [f64; 2],
-    /// Rows of the file whose timestamp step is not one period (repeated or skipped timestamps).
-    pub timestamp_glitches: usize,
+    /// What was repaired in the file's rows ([`repair`]).
+    pub repairs: Repairs,
+    /// Added to the truth file's times to put them on this unit file's own time column, s: the
+    /// trial's [`Trial::truth_offset_s`] plus this unit's whole-row and mean residual lag.
+    pub truth_offset_s: f64,
     /// The aligned samples; every series of a trial has the same length and times.
     pub samples: Vec<ImuSample>,
 }
@@ -118,7 +128,9 @@ pub struct Trial {
     pub truth: Vec<TruthRow>,
     /// Added to the truth file's times to put them on the IMU time base, s.
     pub truth_offset_s: f64,
-    /// What the loader noticed: missing IMU files, lags, timestamp glitches, trimmed rows.
+    /// What was repaired over the trial's units, and the unit files skipped.
+    pub repairs: Repairs,
+    /// What the loader noticed: missing or skipped IMU files, lags, repairs, trimmed rows.
     pub notes: Vec<String>,
 }
 
@@ -206,262 +218,75 @@ fn trial_name(path: &Path) -> String {
     parts.join("/")
 }
 
-/// One IMU file as read: times, and samples converted to SI/FRD.
-struct RawImu {
-    imu: usize,
-    times: Vec<f64>,
-    samples: Vec<ImuSample>,
-    glitches: usize,
+/// A trial that could not be used, and why: listed in the evaluations' reports.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct SkippedTrial {
+    /// `<group>/path_<N>`.
+    pub trial: String,
+    /// Why it was skipped.
+    pub reason: String,
 }
 
-fn read_imu(path: &Path, imu: usize) -> Result<RawImu, DatasetError> {
-    let rows = read_numeric(path, &IMU_HEADER)?;
-    if rows.len() < MIN_IMU_ROWS {
-        return Err(DatasetError::TooShort {
-            path: path.to_path_buf(),
-            rows: rows.len(),
-            min: MIN_IMU_ROWS,
-        });
+/// The lines of a report listing skipped trials (none when nothing was skipped).
+pub fn skipped_lines(skipped: &[SkippedTrial]) -> String {
+    if skipped.is_empty() {
+        return String::new();
     }
-    let period = 1.0 / IMU_RATE_HZ;
-    let mut glitches = 0;
-    for (k, pair) in rows.windows(2).enumerate() {
-        let step = pair[1][0] - pair[0][0];
-        if step < -0.5 * period {
-            return Err(DatasetError::Malformed {
-                path: path.to_path_buf(),
-                line: k + 3,
-                reason: format!("time {} goes back from {}", pair[1][0], pair[0][0]),
-            });
-        }
-        if (step - period).abs() > 0.25 * period {
-            glitches += 1;
-        }
+    let mut s = format!("{} trials skipped:\n", skipped.len());
+    for t in skipped {
+        s.push_str(&format!("  {}: {}\n", t.trial, t.reason));
     }
-    let samples = rows
-        .iter()
-        .map(|r| ImuSample {
-            t_s: r[0],
-            gyro_rps: frame::xsens_to_frd([r[7], r[8], r[9]].map(f64::to_radians)),
-            accel_mps2: frame::xsens_to_frd([r[4], r[5], r[6]]),
-            euler_rad: frame::xsens_euler_to_frd([r[1], r[2], r[3]]),
-        })
-        .collect();
-    Ok(RawImu {
-        imu,
-        times: rows.iter().map(|r| r[0]).collect(),
-        samples,
-        glitches,
-    })
+    s
 }
 
-fn read_truth(path: &Path) -> Result<Vec<TruthRow>, DatasetError> {
-    let rows = read_numeric(path, &TRUTH_HEADER)?;
-    if rows.len() < MIN_TRUTH_ROWS {
-        return Err(DatasetError::TooShort {
-            path: path.to_path_buf(),
-            rows: rows.len(),
-            min: MIN_TRUTH_ROWS,
-        });
-    }
-    Ok(rows
-        .iter()
-        .map(|r| TruthRow {
-            t_s: r[0],
-            distance_m: r[1],
-            speed_mps: r[2],
-            heading_rad: r[3].to_radians(),
-            pitch_rad: r[4].to_radians(),
-            roll_rad: r[5].to_radians(),
-            height_m: r[6],
-            north_m: r[7],
-            east_m: r[8],
-            down_m: r[9],
-        })
-        .collect())
-}
+/// One listed trial and what loading it gave.
+pub type Outcome = (TrialEntry, Result<Trial, DatasetError>);
 
-fn rate_magnitude(samples: &[ImuSample]) -> Vec<f64> {
-    samples
-        .iter()
-        .map(|s| s.gyro_rps.iter().map(|x| x * x).sum::<f64>().sqrt())
-        .collect()
-}
-
-/// Loads one trial directory: every `IMU_k.csv` present (k = 1..=4), aligned on the first one's
-/// time base, and `GT.csv` moved onto it. Missing IMU files are noted, not fatal.
-pub fn load_trial(path: &Path) -> Result<Trial, DatasetError> {
-    let name = trial_name(path);
-    let mut notes = Vec::new();
-    let mut raw = Vec::new();
-    for imu in 1..=MAX_IMUS {
-        let file = path.join(format!("IMU_{imu}.csv"));
-        if file.is_file() {
-            raw.push(read_imu(&file, imu)?);
-        } else {
-            notes.push(format!("IMU_{imu}.csv missing: skipped"));
-        }
-    }
-    let Some(reference) = raw.first() else {
-        return Err(DatasetError::MissingFile {
-            path: path.join("IMU_1.csv"),
-            what: "no IMU_1..4.csv in the trial",
-        });
-    };
-    let truth_path = path.join("GT.csv");
-    if !truth_path.is_file() {
-        return Err(DatasetError::MissingFile {
-            path: truth_path,
-            what: "ground truth",
-        });
-    }
-    let mut truth = read_truth(&truth_path)?;
-
-    // Lag of each IMU against the reference, on the rate magnitude (mounting-independent).
-    let reference_rate = rate_magnitude(&reference.samples);
-    let mut lags: Vec<i64> = Vec::with_capacity(raw.len());
-    for series in &raw {
-        if series.imu == reference.imu {
-            lags.push(0);
-            continue;
-        }
-        let lag = align::estimate_lag(
-            &reference_rate,
-            &rate_magnitude(&series.samples),
-            align::MAX_LAG_ROWS,
-        )
-        .ok_or_else(|| DatasetError::Mismatch {
-            trial: name.clone(),
-            reason: format!(
-                "IMU_{} ({} rows) does not overlap IMU_{} ({} rows)",
-                series.imu,
-                series.samples.len(),
-                reference.imu,
-                reference.samples.len()
-            ),
-        })?;
-        lags.push(lag);
-    }
-    // Common rows j of the reference such that j + lag is inside every series.
-    let start = lags.iter().map(|&l| (-l).max(0)).max().unwrap_or(0) as usize;
-    let end = raw
-        .iter()
-        .zip(&lags)
-        .map(|(s, &l)| (s.samples.len() as i64 - l).max(0) as usize)
-        .min()
-        .unwrap_or(0)
-        .min(reference.samples.len());
-    if end <= start + MIN_IMU_ROWS {
-        return Err(DatasetError::Mismatch {
-            trial: name,
-            reason: format!(
-                "aligned IMUs overlap on {} rows only",
-                end.saturating_sub(start)
-            ),
-        });
-    }
-    let times: Vec<f64> = reference.times[start..end].to_vec();
-    let imus: Vec<ImuSeries> = raw
-        .iter()
-        .zip(&lags)
-        .map(|(series, &lag)| {
-            let from = (start as i64 + lag) as usize;
-            let samples = series.samples[from..from + times.len()]
-                .iter()
-                .zip(&times)
-                .map(|(s, &t_s)| ImuSample { t_s, ..*s })
-                .collect();
-            if lag != 0 {
-                notes.push(format!(
-                    "IMU_{} lags IMU_{} by {lag} rows",
-                    series.imu, reference.imu
-                ));
-            }
-            if series.glitches > 0 {
-                notes.push(format!(
-                    "IMU_{}: {} timestamp steps are not one period (data kept on the row grid)",
-                    series.imu, series.glitches
-                ));
-            }
-            ImuSeries {
-                imu: series.imu,
-                lag_rows: lag,
-                residual_lag_rows: [0.0; 2],
-                timestamp_glitches: series.glitches,
-                samples,
-            }
-        })
-        .collect();
-    let mut imus = imus;
-    let reference_rate = rate_magnitude(&imus[0].samples);
-    for series in imus.iter_mut().skip(1) {
-        let lag = subrow::residual_lag(&reference_rate, &rate_magnitude(&series.samples));
-        let lo = lag.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = lag.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        series.samples = subrow::resample(&series.samples, &lag);
-        series.residual_lag_rows = [lo, hi];
-        notes.push(format!(
-            "IMU_{}: residual lag {lo:+.2}..{hi:+.2} rows removed by resampling",
-            series.imu
-        ));
-    }
-    let trimmed = reference.samples.len() - times.len();
-    if trimmed > 0 {
-        notes.push(format!(
-            "{trimmed} reference rows trimmed to the common span"
-        ));
-    }
-
-    // Truth clock against the reference IMU's roll and pitch.
-    let (roll, pitch): (Vec<f64>, Vec<f64>) = imus[0]
-        .samples
-        .iter()
-        .map(|s| (s.euler_rad[0], s.euler_rad[1]))
-        .unzip();
-    let truth_angles: Vec<(f64, f64, f64)> = truth
-        .iter()
-        .map(|r| (r.t_s, r.roll_rad, r.pitch_rad))
-        .collect();
-    let truth_offset_s = align::estimate_truth_offset(
-        &truth_angles,
-        &roll,
-        &pitch,
-        times[0],
-        1.0 / IMU_RATE_HZ,
-        align::MAX_TRUTH_OFFSET_S,
-        1.0 / IMU_RATE_HZ,
-    )
-    .unwrap_or_else(|| {
-        notes.push("truth clock offset not estimable: kept at 0".into());
-        0.0
-    });
-    truth.iter_mut().for_each(|r| r.t_s += truth_offset_s);
-
-    Ok(Trial {
-        name,
-        path: path.to_path_buf(),
-        imus,
-        truth,
-        truth_offset_s,
-        notes,
-    })
-}
-
-/// Loads every trial under `dir`; `progress(done, total)` after each. A trial that cannot be
-/// loaded is an error naming its file.
-pub fn load_all(
+/// Loads every trial under `dir`, each on its own: every listed trial with either the loaded
+/// trial or the error that names why it could not be. `progress(done, total)` after each. Only
+/// a directory that cannot be listed is an error.
+pub fn load_each(
     dir: &Path,
     mut progress: impl FnMut(usize, usize),
-) -> Result<Vec<Trial>, DatasetError> {
+) -> Result<Vec<Outcome>, DatasetError> {
     let entries = list_trials(dir)?;
     let total = entries.len();
     progress(0, total);
-    let mut trials = Vec::with_capacity(total);
-    for (k, entry) in entries.iter().enumerate() {
-        trials.push(load_trial(&entry.path)?);
+    let mut out = Vec::with_capacity(total);
+    for (k, entry) in entries.into_iter().enumerate() {
+        let trial = load_trial(&entry.path);
+        out.push((entry, trial));
         progress(k + 1, total);
     }
-    Ok(trials)
+    Ok(out)
+}
+
+/// The repairs over every outcome of [`load_each`], counting the trials that failed.
+pub fn total_repairs(outcomes: &[Outcome]) -> Repairs {
+    outcomes
+        .iter()
+        .fold(Repairs::default(), |total, (_, outcome)| match outcome {
+            Ok(trial) => total + trial.repairs,
+            Err(_) => {
+                total
+                    + Repairs {
+                        trials_failed: 1,
+                        ..Repairs::default()
+                    }
+            }
+        })
+}
+
+/// Loads every trial under `dir`; `progress(done, total)` after each. The first trial that
+/// cannot be loaded is an error naming its file (see [`load_each`] to keep the others).
+pub fn load_all(
+    dir: &Path,
+    progress: impl FnMut(usize, usize),
+) -> Result<Vec<Trial>, DatasetError> {
+    load_each(dir, progress)?
+        .into_iter()
+        .map(|(_, trial)| trial)
+        .collect()
 }
 
 #[cfg(test)]

@@ -269,7 +269,8 @@ mod tests {
                 imu: k + 1,
                 lag_rows: 0,
                 residual_lag_rows: [0.0; 2],
-                timestamp_glitches: 0,
+                repairs: Default::default(),
+                truth_offset_s: 0.0,
                 samples: reference
                     .iter()
                     .enumerate()
@@ -293,6 +294,7 @@ mod tests {
             imus,
             truth: Vec::new(),
             truth_offset_s: 0.0,
+            repairs: Default::default(),
             notes: Vec::new(),
         }
     }
