@@ -155,7 +155,8 @@ pub(crate) fn run(
                 single_roll_pitch_rmse_deg: single,
                 peer_roll_pitch_rmse_deg: peer,
                 truth_offset_s: flight.truth_offset_s,
-                unit_lag_s: flight.unit_lag_s.clone(),
+                file_offsets_s: flight.file_offsets_s.clone(),
+                repairs: flight.repairs,
                 notes: flight.notes.clone(),
             }
         })

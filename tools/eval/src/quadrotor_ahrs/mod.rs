@@ -37,7 +37,7 @@ use rins_navigator::inertial_core::AidedConfig;
 use serde::Serialize;
 
 use crate::datasets::quadrotor::projection::estimate_installation;
-use crate::datasets::quadrotor::{IMU_RATE_HZ, MAX_IMUS, Trial, list_trials, load_trial};
+use crate::datasets::quadrotor::{MAX_IMUS, Repairs, Trial, load_each, total_repairs};
 use crate::quadrotor_nav::frames::{self, Motion};
 use crate::quadrotor_nav::run::{Start, start_from_truth};
 use crate::quadrotor_nav::vehicle_from_reference;
@@ -67,7 +67,8 @@ pub(crate) struct Flight {
     /// Each unit's on-board attitude paired with the reference rows.
     peers: Vec<Paired>,
     truth_offset_s: f64,
-    unit_lag_s: Vec<f64>,
+    file_offsets_s: Vec<f64>,
+    repairs: Repairs,
     notes: Vec<String>,
 }
 
@@ -97,10 +98,13 @@ pub struct FlightResult {
     pub single_roll_pitch_rmse_deg: [Option<f64>; MAX_IMUS],
     /// Each unit's own on-board filter, by unit number (null when absent).
     pub peer_roll_pitch_rmse_deg: [Option<f64>; MAX_IMUS],
-    /// Added to the reference's file times to put them on the reference unit's clock, s.
+    /// Added to the reference's file times to put them on the reference unit's clock (estimated
+    /// from the gyro against the reference's body rates), s.
     pub truth_offset_s: f64,
-    /// Each present unit's lag behind the reference unit, s.
-    pub unit_lag_s: Vec<f64>,
+    /// Each present unit file's own offset to the reference's clock, s.
+    pub file_offsets_s: Vec<f64>,
+    /// What the loader repaired in this flight's files.
+    pub repairs: Repairs,
     /// What the loader repaired or noticed.
     pub notes: Vec<String>,
 }
@@ -128,8 +132,8 @@ pub struct AhrsReport {
     pub flights_evaluated: usize,
     /// Flights left out, with reasons.
     pub failures: Vec<FlightFailure>,
-    /// Counts of what the loader repaired, by kind.
-    pub repairs: Vec<(String, usize)>,
+    /// What the loader repaired, by kind, over every flight (failed flights counted).
+    pub repairs: Repairs,
     /// Mean over flights of the fused roll/pitch RMSE, degrees (cross-validated).
     pub roll_pitch_rmse_deg: f64,
     /// Per unit (1..=4): mean over the flights that have it of its roll/pitch RMSE through rins.
@@ -200,15 +204,9 @@ fn prepare(trial: Trial) -> Result<Flight> {
     Ok(Flight {
         name: trial.name.clone(),
         imus: trial.imus.iter().map(|s| s.imu).collect(),
-        unit_lag_s: trial
-            .imus
-            .iter()
-            .map(|s| {
-                (s.lag_rows as f64 + 0.5 * (s.residual_lag_rows[0] + s.residual_lag_rows[1]))
-                    / IMU_RATE_HZ
-            })
-            .collect(),
+        file_offsets_s: trial.imus.iter().map(|s| s.truth_offset_s).collect(),
         truth_offset_s: trial.truth_offset_s,
+        repairs: trial.repairs,
         notes: trial.notes,
         fused,
         singles,
@@ -242,29 +240,31 @@ pub fn evaluate(
             dir.display()
         ));
     }
-    let entries = list_trials(dir).map_err(|e| {
+    let loaded = load_each(dir, |_, _| ()).map_err(|e| {
         anyhow!(
             "eval quadrotor: cannot list trials in {}: {e}",
             dir.display()
         )
     })?;
-    if entries.is_empty() {
+    if loaded.is_empty() {
         return Err(anyhow!(
             "eval quadrotor: no trials (<group>/path_<N>/IMU_k.csv) in {}",
             dir.display()
         ));
     }
+    let mut repairs = total_repairs(&loaded);
+    let flights_total = loaded.len();
     let grid = candidates::grid(&base.tilt);
-    let total = entries.len() * (grid.len() + 2 * MAX_IMUS + 2);
+    let total = flights_total * (grid.len() + MAX_IMUS + 2);
     let mut done = 0;
     progress(done, total);
     let mut flights = Vec::new();
     let mut failures = Vec::new();
-    for entry in &entries {
-        match load_trial(&entry.path)
+    for (entry, trial) in loaded {
+        let prepared = trial
             .map_err(anyhow::Error::from)
-            .and_then(prepare)
-        {
+            .and_then(|t| prepare(t).inspect_err(|_| repairs.trials_failed += 1));
+        match prepared {
             Ok(f) => flights.push(f),
             Err(e) => failures.push(FlightFailure {
                 name: entry.name.clone(),
@@ -281,7 +281,8 @@ pub fn evaluate(
     progress(total, total);
     Ok(report::summarise(
         dir,
-        entries.len(),
+        flights_total,
+        repairs,
         failures,
         outcome.flights,
         outcome.candidates,

@@ -6,6 +6,7 @@ use std::path::Path;
 use super::{
     AhrsReport, CandidateFigure, FlightFailure, FlightResult, MAX_IMUS, ROLL_PITCH_TARGET_DEG,
 };
+use crate::datasets::quadrotor::Repairs;
 use crate::quadrotor_nav::metrics::mean;
 
 /// Mean per unit over the flights that have it.
@@ -19,35 +20,11 @@ fn per_unit(
     })
 }
 
-/// Counts the loader's notes by kind (the text before the first number or colon).
-fn count_repairs(flights: &[FlightResult]) -> Vec<(String, usize)> {
-    let mut counts: Vec<(String, usize)> = Vec::new();
-    for note in flights.iter().flat_map(|f| &f.notes) {
-        let kind = if note.contains("timestamp") {
-            "timestamp steps not one period"
-        } else if note.contains("missing") {
-            "unit files missing"
-        } else if note.contains("residual lag") {
-            "units resampled to the reference clock"
-        } else if note.contains("lags") {
-            "units shifted to the reference clock"
-        } else if note.contains("trimmed") {
-            "rows trimmed to the common span"
-        } else {
-            "other"
-        };
-        match counts.iter_mut().find(|(k, _)| k == kind) {
-            Some((_, n)) => *n += 1,
-            None => counts.push((kind.to_string(), 1)),
-        }
-    }
-    counts
-}
-
 /// The report from the per-flight results.
 pub fn summarise(
     dir: &Path,
     flights_total: usize,
+    repairs: Repairs,
     failures: Vec<FlightFailure>,
     flights: Vec<FlightResult>,
     candidates: Vec<CandidateFigure>,
@@ -67,7 +44,7 @@ pub fn summarise(
         dir: dir.to_path_buf(),
         flights_total,
         flights_evaluated: flights.len(),
-        repairs: count_repairs(&flights),
+        repairs,
         failures,
         roll_pitch_rmse_deg: fused,
         fused_better_than_every_peer: below_all(&peer),
@@ -168,12 +145,18 @@ pub fn to_table(r: &AhrsReport) -> String {
             c.name, c.in_sample_roll_pitch_rmse_deg, c.chosen
         );
     }
-    if !r.repairs.is_empty() {
-        let _ = writeln!(s, "loader repairs and notes:");
-        for (kind, n) in &r.repairs {
-            let _ = writeln!(s, "  {kind}: {n}");
-        }
-    }
+    let p = &r.repairs;
+    let _ = writeln!(
+        s,
+        "repairs: counter wraps {}, repeated timestamps {}, samples filled {}, non-finite rows {}, rows dropped {}, unit files skipped {}, flights failed {}",
+        p.counter_wraps,
+        p.repeated_timestamps,
+        p.missing_samples_filled,
+        p.non_finite_rows,
+        p.rows_dropped,
+        p.imu_files_skipped,
+        p.trials_failed
+    );
     for f in &r.failures {
         let _ = writeln!(s, "left out: {}: {}", f.name, f.reason);
     }
