@@ -6,7 +6,7 @@ use rins_navigator::inertial_core::AidedConfig;
 
 use super::candidates::Candidate;
 use super::mounting::{Paired, fit_mounting, mounting_rotation, roll_pitch_rmse_deg};
-use super::run::navigate_ahrs;
+use super::run::{GyroPrior, navigate_ahrs};
 use super::{CandidateFigure, Flight, FlightResult, SETTLE_S, pair, with_candidate};
 use crate::datasets::quadrotor::MAX_IMUS;
 use crate::quadrotor_nav::frames::Motion;
@@ -50,15 +50,61 @@ fn others_with_unit(flights: &[Flight], f: usize, imu: usize) -> Vec<(usize, usi
         .collect()
 }
 
-/// One run's attitude at the flight's reference rows.
+/// Smallest σ of a gyro bias prior, rad/s (0.05 °/s): a unit's bias moves between flights.
+const MIN_PRIOR_SIGMA_RPS: f64 = 0.05 * std::f64::consts::PI / 180.0;
+
+/// One run's attitude at the flight's reference rows, and the gyro bias it ended with.
+struct Scored {
+    paired: Paired,
+    final_gyro_bias_rps: [f64; 3],
+}
+
 fn run_paired(
     flight: &Flight,
     motion: &Motion,
     config: &AidedConfig,
     mounting: &UnitQuaternion<f64>,
-) -> Paired {
-    let trace = navigate_ahrs(motion, &flight.start, config, mounting);
-    pair(&trace, flight.start.t_s, &flight.rows)
+    prior: Option<&GyroPrior>,
+) -> Scored {
+    let run = navigate_ahrs(motion, &flight.start, config, mounting, prior);
+    Scored {
+        paired: pair(&run.trace, flight.start.t_s, &flight.rows),
+        final_gyro_bias_rps: run.final_gyro_bias_rps,
+    }
+}
+
+/// The gyro bias the same series ended the other flights with: their mean, σ their spread (at
+/// least [`MIN_PRIOR_SIGMA_RPS`]). A unit's bias changes little between flights of one session;
+/// the live navigator has the same knowledge from its static alignment before take-off.
+fn prior_from(others: &[&Scored]) -> Option<GyroPrior> {
+    if others.is_empty() {
+        return None;
+    }
+    let n = others.len() as f64;
+    let mut bias = [0.0; 3];
+    for s in others {
+        for (b, x) in bias.iter_mut().zip(s.final_gyro_bias_rps) {
+            *b += x / n;
+        }
+    }
+    let spread = (0..3)
+        .map(|axis| {
+            let var = others
+                .iter()
+                .map(|s| (s.final_gyro_bias_rps[axis] - bias[axis]).powi(2))
+                .sum::<f64>()
+                / n;
+            var.sqrt()
+        })
+        .fold(MIN_PRIOR_SIGMA_RPS, f64::max);
+    Some(GyroPrior {
+        bias_rps: bias,
+        sigma_rps: spread,
+    })
+}
+
+fn paired<'a>(runs: &[&'a Scored]) -> Vec<&'a Paired> {
+    runs.iter().map(|s| &s.paired).collect()
 }
 
 /// Runs the cross-validation; `progress(runs)` after each batch of navigator runs.
@@ -72,12 +118,12 @@ pub(crate) fn run(
     let identity = UnitQuaternion::identity();
     let configs: Vec<AidedConfig> = grid.iter().map(|c| with_candidate(base, c)).collect();
     // First pass: every candidate on every flight, started from the airframe's attitude.
-    let first: Vec<Vec<Paired>> = configs
+    let first: Vec<Vec<Scored>> = configs
         .iter()
         .map(|config| {
             let runs = flights
                 .iter()
-                .map(|f| run_paired(f, &f.fused, config, &identity))
+                .map(|f| run_paired(f, &f.fused, config, &identity, None))
                 .collect();
             progress(n);
             runs
@@ -87,7 +133,7 @@ pub(crate) fn run(
         .map(|f| {
             let scores: Vec<f64> = first
                 .iter()
-                .map(|runs| training_score(&without(runs, f)))
+                .map(|runs| training_score(&paired(&without(runs, f))))
                 .collect();
             (0..scores.len())
                 .min_by(|&a, &b| scores[a].total_cmp(&scores[b]))
@@ -95,7 +141,7 @@ pub(crate) fn run(
         })
         .collect();
     // First-pass single units for each candidate that was chosen somewhere.
-    let mut singles: Vec<Option<Vec<Vec<Paired>>>> = vec![None; grid.len()];
+    let mut singles: Vec<Option<Vec<Vec<Scored>>>> = (0..grid.len()).map(|_| None).collect();
     for &c in &chosen {
         if singles[c].is_none() {
             singles[c] = Some(
@@ -104,7 +150,7 @@ pub(crate) fn run(
                     .map(|f| {
                         f.singles
                             .iter()
-                            .map(|m| run_paired(f, m, &configs[c], &identity))
+                            .map(|m| run_paired(f, m, &configs[c], &identity, None))
                             .collect()
                     })
                     .collect(),
@@ -118,8 +164,16 @@ pub(crate) fn run(
         .map(|(f, flight)| {
             let c = chosen[f];
             let config = &configs[c];
-            let tilt = fit_mounting(&without(&first[c], f), SETTLE_S);
-            let fused = run_paired(flight, &flight.fused, config, &mounting_rotation(tilt));
+            let others = without(&first[c], f);
+            let tilt = fit_mounting(&paired(&others), SETTLE_S);
+            let fused = run_paired(
+                flight,
+                &flight.fused,
+                config,
+                &mounting_rotation(tilt),
+                prior_from(&others).as_ref(),
+            )
+            .paired;
             let mut single = [None; MAX_IMUS];
             let mut peer = [None; MAX_IMUS];
             for (k, &imu) in flight.imus.iter().enumerate() {
@@ -128,13 +182,16 @@ pub(crate) fn run(
                     continue;
                 }
                 if let Some(runs) = &singles[c] {
-                    let tilt = fit_mounting(
-                        &others.iter().map(|&(g, j)| &runs[g][j]).collect::<Vec<_>>(),
-                        SETTLE_S,
+                    let same: Vec<&Scored> = others.iter().map(|&(g, j)| &runs[g][j]).collect();
+                    let tilt = fit_mounting(&paired(&same), SETTLE_S);
+                    let own = run_paired(
+                        flight,
+                        &flight.singles[k],
+                        config,
+                        &mounting_rotation(tilt),
+                        prior_from(&same).as_ref(),
                     );
-                    let own =
-                        run_paired(flight, &flight.singles[k], config, &mounting_rotation(tilt));
-                    single[imu - 1] = Some(roll_pitch_rmse_deg(&own, tilt, 0.0));
+                    single[imu - 1] = Some(roll_pitch_rmse_deg(&own.paired, tilt, 0.0));
                 }
                 let tilt = fit_mounting(
                     &others
@@ -166,7 +223,9 @@ pub(crate) fn run(
         .enumerate()
         .map(|(c, candidate)| CandidateFigure {
             name: candidate.name.clone(),
-            in_sample_roll_pitch_rmse_deg: training_score(&first[c].iter().collect::<Vec<_>>()),
+            in_sample_roll_pitch_rmse_deg: training_score(
+                &first[c].iter().map(|s| &s.paired).collect::<Vec<_>>(),
+            ),
             chosen: chosen.iter().filter(|&&x| x == c).count(),
         })
         .collect();

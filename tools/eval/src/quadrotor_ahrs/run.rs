@@ -49,6 +49,24 @@ impl AttitudeTrace {
     }
 }
 
+/// What is known of the gyro bias at t0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GyroPrior {
+    /// Bias estimate, body FRD, rad/s.
+    pub bias_rps: [f64; 3],
+    /// σ of each axis, rad/s.
+    pub sigma_rps: f64,
+}
+
+/// One run: the attitude trace and the gyro bias the filter ended with.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct AhrsRun {
+    /// Attitude over the run.
+    pub trace: AttitudeTrace,
+    /// The filter's gyro bias estimate at the end, body FRD, rad/s.
+    pub final_gyro_bias_rps: [f64; 3],
+}
+
 /// Device time of trial time `t_s`, µs: the trial's times start near 0 and may be slightly
 /// negative after alignment, so they are moved by a fixed second.
 fn device_us(t_s: f64) -> u64 {
@@ -75,25 +93,28 @@ fn initial_variances(config: &AidedConfig) -> [f64; STATES] {
 
 /// Runs `motion` from `start` through the navigator's inertial core with `config` (its tilt
 /// updates included when enabled). The unit's attitude at t0 is the airframe's turned by the
-/// inverse of the unit's `mounting` (`C_nav←vehicle = C_nav←unit · mounting`).
+/// inverse of the unit's `mounting` (`C_nav←vehicle = C_nav←unit · mounting`); the gyro bias
+/// starts from `prior` when given, else from zero with the configured σ.
 pub fn navigate_ahrs(
     motion: &Motion,
     start: &Start,
     config: &AidedConfig,
     mounting: &UnitQuaternion<f64>,
-) -> AttitudeTrace {
+    prior: Option<&GyroPrior>,
+) -> AhrsRun {
     let [lat, lon, altitude_zero_m] = config.origin;
     let mut state = NominalState::at_rest(lat, lon, altitude_zero_m + start.height_m);
     let [roll, pitch, heading] = start.euler_rad;
     state.attitude = quaternion_from_euler(roll, pitch, heading) * mounting.inverse();
     state.velocity_ned = Vector3::from(start.velocity_ned);
+    let mut bias = ImuBias::default();
+    let mut variances = initial_variances(config);
+    if let Some(p) = prior {
+        bias.gyro_rps = Vector3::from(p.bias_rps);
+        variances[BG..BG + 3].fill(p.sigma_rps * p.sigma_rps);
+    }
     let mut navigator = AidedNavigator::new(*config);
-    navigator.take_over(
-        device_us(start.t_s),
-        state,
-        ImuBias::default(),
-        &initial_variances(config),
-    );
+    navigator.take_over(device_us(start.t_s), state, bias, &variances);
     let mut trace = AttitudeTrace::default();
     trace.t_s.push(start.t_s);
     trace.attitude.push(state.attitude);
@@ -111,5 +132,10 @@ pub fn navigate_ahrs(
             trace.attitude.push(ekf.state().attitude);
         }
     }
-    trace
+    AhrsRun {
+        trace,
+        final_gyro_bias_rps: navigator
+            .ekf()
+            .map_or([0.0; 3], |ekf| ekf.bias().gyro_rps.into()),
+    }
 }
