@@ -2,7 +2,7 @@
 //!
 //! Both models of `[navigator.tilt]` over a small grid: the gravity model with a fixed σ or with
 //! σ inflated by the departure of |f| from g and by the rotation rate, and the rotor-drag model
-//! over the plausible drag coefficients of a small multirotor (0.4–0.8 /s forwards, 0.4–0.6 /s
+//! over the plausible drag coefficients of a small multirotor (0.3–0.6 /s forwards, 0.4–0.6 /s
 //! sideways) and two σs. Every other setting is the profile's.
 
 use rins_navigator::tilt_aiding::{TiltAidingConfig, TiltModel};
@@ -42,9 +42,9 @@ pub fn grid(base: &TiltAidingConfig) -> Vec<Candidate> {
             });
         }
     }
-    for forward in [0.4, 0.6, 0.8] {
+    for forward in [0.3, 0.4, 0.6] {
         for lateral in [0.4, 0.6] {
-            for sigma in [0.5, 1.0] {
+            for sigma in [1.0, 1.5] {
                 out.push(Candidate {
                     name: format!("drag mu {forward}/{lateral} sigma {sigma}"),
                     tilt: TiltAidingConfig {

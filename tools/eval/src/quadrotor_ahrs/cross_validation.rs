@@ -73,10 +73,13 @@ fn run_paired(
     }
 }
 
-/// The gyro bias the same series ended the other flights with: their mean, σ their spread (at
-/// least [`MIN_PRIOR_SIGMA_RPS`]). A unit's bias changes little between flights of one session;
-/// the live navigator has the same knowledge from its static alignment before take-off.
-fn prior_from(others: &[&Scored]) -> Option<GyroPrior> {
+/// The multiples of the spread tried as the prior's σ (chosen on the other flights).
+const PRIOR_SIGMA_SCALES: [f64; 4] = [0.1, 0.25, 0.5, 1.0];
+
+/// The gyro bias the same series ended the other flights with: their mean, σ `scale` times their
+/// spread (at least [`MIN_PRIOR_SIGMA_RPS`]). A unit's bias changes little between flights of one
+/// session; the live navigator has the same knowledge from its static alignment before take-off.
+fn prior_from(others: &[&Scored], scale: f64) -> Option<GyroPrior> {
     if others.is_empty() {
         return None;
     }
@@ -96,15 +99,59 @@ fn prior_from(others: &[&Scored]) -> Option<GyroPrior> {
                 / n;
             var.sqrt()
         })
-        .fold(MIN_PRIOR_SIGMA_RPS, f64::max);
+        .fold(0.0, f64::max);
     Some(GyroPrior {
         bias_rps: bias,
-        sigma_rps: spread,
+        sigma_rps: (scale * spread).max(MIN_PRIOR_SIGMA_RPS),
     })
 }
 
 fn paired<'a>(runs: &[&'a Scored]) -> Vec<&'a Paired> {
     runs.iter().map(|s| &s.paired).collect()
+}
+
+/// Flight `g` of the training set without `f`, scored as a held-out flight of that set: mounting
+/// and gyro prior from the first-pass runs of the flights other than `g` and `f`.
+fn training_run(
+    flights: &[Flight],
+    first: &[Scored],
+    config: &AidedConfig,
+    g: usize,
+    f: usize,
+    scale: f64,
+) -> f64 {
+    let others: Vec<&Scored> = first
+        .iter()
+        .enumerate()
+        .filter(|&(h, _)| h != g && h != f)
+        .map(|(_, s)| s)
+        .collect();
+    let tilt = fit_mounting(&paired(&others), SETTLE_S);
+    let run = run_paired(
+        &flights[g],
+        &flights[g].fused,
+        config,
+        &mounting_rotation(tilt),
+        prior_from(&others, scale).as_ref(),
+    );
+    roll_pitch_rmse_deg(&run.paired, tilt, 0.0)
+}
+
+/// The prior σ scale with the best mean score over the flights other than `f`.
+fn choose_prior_scale(flights: &[Flight], first: &[Scored], config: &AidedConfig, f: usize) -> f64 {
+    let score = |scale: f64| {
+        mean(
+            &(0..flights.len())
+                .filter(|&g| g != f)
+                .map(|g| training_run(flights, first, config, g, f, scale))
+                .collect::<Vec<_>>(),
+        )
+    };
+    PRIOR_SIGMA_SCALES
+        .into_iter()
+        .map(|scale| (score(scale), scale))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map_or(1.0, |(_, scale)| scale)
 }
 
 /// Runs the cross-validation; `progress(runs)` after each batch of navigator runs.
@@ -164,6 +211,7 @@ pub(crate) fn run(
         .map(|(f, flight)| {
             let c = chosen[f];
             let config = &configs[c];
+            let scale = choose_prior_scale(flights, &first[c], config, f);
             let others = without(&first[c], f);
             let tilt = fit_mounting(&paired(&others), SETTLE_S);
             let fused = run_paired(
@@ -171,7 +219,7 @@ pub(crate) fn run(
                 &flight.fused,
                 config,
                 &mounting_rotation(tilt),
-                prior_from(&others).as_ref(),
+                prior_from(&others, scale).as_ref(),
             )
             .paired;
             let mut single = [None; MAX_IMUS];
@@ -189,7 +237,7 @@ pub(crate) fn run(
                         &flight.singles[k],
                         config,
                         &mounting_rotation(tilt),
-                        prior_from(&same).as_ref(),
+                        prior_from(&same, scale).as_ref(),
                     );
                     single[imu - 1] = Some(roll_pitch_rmse_deg(&own.paired, tilt, 0.0));
                 }
@@ -207,7 +255,7 @@ pub(crate) fn run(
                 name: flight.name.clone(),
                 imus: flight.imus.clone(),
                 rows: flight.rows.len(),
-                candidate: grid[c].name.clone(),
+                candidate: format!("{}, bias prior {scale}×spread", grid[c].name),
                 fused_roll_pitch_rmse_deg: roll_pitch_rmse_deg(&fused, tilt, 0.0),
                 single_roll_pitch_rmse_deg: single,
                 peer_roll_pitch_rmse_deg: peer,
