@@ -7,7 +7,8 @@
 //!   vehicle's own acceleration, so its σ grows with what betrays acceleration: the departure of
 //!   |f̄| from g (`force_error_gain`) and the rotation rate (`rate_gain_mps`: a turn at rate ω and
 //!   speed v accelerates the vehicle by v ω), and windows with | |f̄| − g | above
-//!   `max_force_error_mps2` are not used at all.
+//!   `max_force_error_mps2` are not used at all. With `centripetal_correction` the acceleration
+//!   of a turn, `ω × v` from the filter's own rate and velocity, is taken out first.
 //! * `drag` — a multirotor's body x/y force is rotor drag, `−μ v_b` (`ErrorStateEkf::rotor_drag`):
 //!   right during accelerations, which a multirotor makes by tilting, where the gravity model
 //!   reads the tilt as level.
@@ -66,6 +67,10 @@ pub struct TiltAidingConfig {
     pub lateral_drag_per_s: f64,
     /// Innovation gate: largest accepted Mahalanobis distance.
     pub gate: f64,
+    /// `gravity` model: the vehicle's acceleration is taken as the centripetal `ω × v` of its
+    /// rotation (navigation frame) and the filter's velocity — a coordinated turn, where the
+    /// specific force of a fixed wing stays along its z axis — instead of zero.
+    pub centripetal_correction: bool,
 }
 
 impl Default for TiltAidingConfig {
@@ -81,6 +86,7 @@ impl Default for TiltAidingConfig {
             drag_per_s: 0.6,
             lateral_drag_per_s: 0.6,
             gate: 5.0,
+            centripetal_correction: false,
         }
     }
 }
@@ -145,7 +151,17 @@ impl TiltAiding {
             + config.force_error_gain * force_error
             + config.rate_gain_mps * mean.rate.norm();
         Some(match config.model {
-            TiltModel::Gravity => ekf.gravity_tilt(mean.force.into(), sigma, config.gate),
+            TiltModel::Gravity => {
+                let acceleration = if config.centripetal_correction {
+                    let state = ekf.state();
+                    (state.attitude * mean.rate)
+                        .cross(&state.velocity_ned)
+                        .into()
+                } else {
+                    [0.0; 3]
+                };
+                ekf.gravity_tilt_accelerating(mean.force.into(), acceleration, sigma, config.gate)
+            }
             TiltModel::Drag => ekf.rotor_drag(
                 mean.force.into(),
                 [config.drag_per_s, config.lateral_drag_per_s],
@@ -265,6 +281,78 @@ mod tests {
         let [roll, pitch, _] = ekf.state().euler();
         assert!(roll.abs().max(pitch.abs()) < 0.01_f64.to_radians());
         assert!(ekf.sigma(ATT) < 0.05_f64.to_radians());
+    }
+
+    /// A coordinated right turn (yaw rate ω, speed v, bank φ with tan φ = ω v / g): the specific
+    /// force stays on the body z axis. The filter's state is exact; with the centripetal
+    /// correction the window is a measurement of zero error and the roll stays, without it the
+    /// model reads the force as "level" and pulls the roll towards zero.
+    #[test]
+    fn the_centripetal_correction_keeps_a_coordinated_turn_banked() {
+        let (omega, speed) = (0.2, 15.0);
+        let roll_after = |centripetal_correction: bool| {
+            let mut ekf = filter(0.0, 1e-12);
+            let g = ekf.strapdown().gravity();
+            let bank = (omega * speed / g).atan();
+            let attitude = quaternion_from_euler(bank, 0.0, 0.0);
+            ekf.state_mut().attitude = attitude;
+            ekf.state_mut().velocity_ned = Vector3::new(speed, 0.0, 0.0);
+            let acceleration = Vector3::new(0.0, omega * speed, 0.0);
+            let force = attitude.inverse() * (acceleration - Vector3::new(0.0, 0.0, g));
+            let rate = attitude.inverse() * Vector3::new(0.0, 0.0, omega);
+            let config = TiltAidingConfig {
+                centripetal_correction,
+                max_force_error_mps2: 5.0,
+                ..gravity_config(0.2)
+            };
+            let mut aiding = TiltAiding::default();
+            for k in 0..=10u64 {
+                let _ = aiding.push(&mut ekf, &config, k * 10_000, force.into(), &rate);
+            }
+            (ekf.state().euler()[0], bank)
+        };
+        let (held, bank) = roll_after(true);
+        assert!((held - bank).abs() < 1e-6, "{held} against {bank}");
+        let (pulled, bank) = roll_after(false);
+        assert!(
+            bank - pulled > 0.5_f64.to_radians(),
+            "{pulled} against {bank}"
+        );
+    }
+
+    /// Steady flight north at 5 m/s through still air: the airframe pitches nose-down until the
+    /// rotor drag balances, tan θ = −μ v / g, and the specific force is exactly gravity's. The
+    /// filter starts 2° off in pitch with the velocity known only to 1 m/s; the drag model sees
+    /// the velocity the tilt error makes it integrate and levels the filter on the true pitch.
+    #[test]
+    fn the_drag_model_finds_the_pitch_of_steady_flight() {
+        let (mu, speed) = (0.4, 5.0);
+        let mut ekf = filter(0.0, 1e-12);
+        let g = ekf.strapdown().gravity();
+        let pitch = (-mu * speed / g).atan();
+        let truth = quaternion_from_euler(0.0, pitch, 0.0);
+        ekf.state_mut().attitude = quaternion_from_euler(0.0, pitch + 2_f64.to_radians(), 0.0);
+        ekf.state_mut().velocity_ned = Vector3::new(speed + 0.5, 0.0, 0.0);
+        let force: [f64; 3] = (truth.inverse() * Vector3::new(0.0, 0.0, -g)).into();
+        let config = TiltAidingConfig {
+            model: TiltModel::Drag,
+            drag_per_s: mu,
+            lateral_drag_per_s: mu,
+            ..gravity_config(0.05)
+        };
+        let mut aiding = TiltAiding::default();
+        for k in 1..=(30.0 * RATE_HZ) as u64 {
+            assert!(ekf.predict([0.0; 3], force, 1.0 / RATE_HZ).is_applied());
+            let _ = aiding.push(&mut ekf, &config, k * 10_000, force, &Vector3::zeros());
+        }
+        let [_, estimated, _] = ekf.state().euler();
+        assert!(
+            (estimated - pitch).abs() < 0.05_f64.to_radians(),
+            "pitch {} against {}",
+            estimated.to_degrees(),
+            pitch.to_degrees()
+        );
+        assert!((ekf.state().velocity_ned.x - speed).abs() < 0.05);
     }
 
     #[test]

@@ -54,6 +54,20 @@ impl ErrorStateEkf {
         sigma_mps2: f64,
         gate: f64,
     ) -> UpdateOutcome {
+        self.gravity_tilt_accelerating(force_body, [0.0; 3], sigma_mps2, gate)
+    }
+
+    /// [`Self::gravity_tilt`] for a vehicle whose acceleration `acceleration_ned` (m/s², NED) is
+    /// known, e.g. the centripetal acceleration of a turn: the specific force is then `a − g`, and
+    /// its horizontal part less `a` is the measurement of zero. `a` is taken as exact (its error
+    /// belongs in σ).
+    pub fn gravity_tilt_accelerating(
+        &mut self,
+        force_body: [f64; 3],
+        acceleration_ned: [f64; 3],
+        sigma_mps2: f64,
+        gate: f64,
+    ) -> UpdateOutcome {
         let c = self.state().attitude.to_rotation_matrix().into_inner();
         let corrected = nalgebra::Vector3::from(force_body) - self.bias().accel_mps2;
         let f_n = c * corrected;
@@ -67,7 +81,8 @@ impl ErrorStateEkf {
             h[(0, BA + k)] = -c[(0, k)];
             h[(1, BA + k)] = -c[(1, k)];
         }
-        let innovation = SVector::<f64, 2>::new(-f_n.x, -f_n.y);
+        let innovation =
+            SVector::<f64, 2>::new(acceleration_ned[0] - f_n.x, acceleration_ned[1] - f_n.y);
         let r = SMatrix::<f64, 2, 2>::identity() * (sigma_mps2 * sigma_mps2);
         self.update(AidingSource::Gravity, &h, &innovation, &r, gate)
     }
