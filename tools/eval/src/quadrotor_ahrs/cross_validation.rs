@@ -40,6 +40,23 @@ fn without<T>(runs: &[T], f: usize) -> Vec<&T> {
         .collect()
 }
 
+/// The runs of the flights other than `f` that carry the same units as `f` (the fused solution of
+/// four units and of one are different instruments, with different biases and mountings); all the
+/// other flights when none does.
+fn same_units<'a, T>(flights: &[Flight], runs: &'a [T], f: usize) -> Vec<&'a T> {
+    let same: Vec<&T> = runs
+        .iter()
+        .enumerate()
+        .filter(|&(g, _)| g != f && flights[g].imus == flights[f].imus)
+        .map(|(_, r)| r)
+        .collect();
+    if same.is_empty() {
+        without(runs, f)
+    } else {
+        same
+    }
+}
+
 /// Where unit `imu` sits in each flight other than `f` that has it: `(flight, position)`.
 fn others_with_unit(flights: &[Flight], f: usize, imu: usize) -> Vec<(usize, usize)> {
     flights
@@ -120,11 +137,9 @@ fn training_run(
     f: usize,
     scale: f64,
 ) -> f64 {
-    let others: Vec<&Scored> = first
-        .iter()
-        .enumerate()
-        .filter(|&(h, _)| h != g && h != f)
-        .map(|(_, s)| s)
+    let others: Vec<&Scored> = same_units(flights, first, g)
+        .into_iter()
+        .filter(|s| !std::ptr::eq(*s, &first[f]))
         .collect();
     let tilt = fit_mounting(&paired(&others), SETTLE_S);
     let run = run_paired(
@@ -212,7 +227,7 @@ pub(crate) fn run(
             let c = chosen[f];
             let config = &configs[c];
             let scale = choose_prior_scale(flights, &first[c], config, f);
-            let others = without(&first[c], f);
+            let others = same_units(flights, &first[c], f);
             let tilt = fit_mounting(&paired(&others), SETTLE_S);
             let fused = run_paired(
                 flight,
