@@ -162,3 +162,128 @@ fn eval_quadrotor_names_a_bad_profile() {
         "/nonexistent/uav.toml",
     );
 }
+
+fn ahrs_report(dir: &std::path::Path) -> Value {
+    let out = rins(&[
+        "eval",
+        "quadrotor",
+        dir.to_str().unwrap(),
+        "--mode",
+        "ahrs",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn per_unit(report: &Value, key: &str) -> Vec<f64> {
+    report[key].as_array().unwrap().iter().map(number).collect()
+}
+
+/// The AHRS mode on the twelve flights: every flight evaluated, the data's three repeated
+/// timestamps and one missing sample repaired, each unit alone and each unit's own filter scored,
+/// and the fused solution below every one of the units' own filters (the claim the README makes).
+#[test]
+fn eval_quadrotor_ahrs_scores_every_flight_beside_each_units_own_filter() {
+    let Some(dir) = common::quadrotor_data_dir() else {
+        return;
+    };
+    let r = ahrs_report(&dir);
+    assert_eq!(r["flights_total"], 12, "{r}");
+    assert_eq!(r["flights_evaluated"], 12, "{r}");
+    assert_eq!(r["repairs"]["repeated_timestamps"], 3, "{r}");
+    assert_eq!(r["repairs"]["missing_samples_filled"], 1, "{r}");
+    assert_eq!(r["repairs"]["trials_failed"], 0, "{r}");
+    let fused = number(&r["roll_pitch_rmse_deg"]);
+    let peer = per_unit(&r, "peer_roll_pitch_rmse_deg");
+    let single = per_unit(&r, "single_roll_pitch_rmse_deg");
+    assert_eq!((peer.len(), single.len()), (4, 4), "{r}");
+    // The units' own filters are good to 0.5–1.5° against the reference on these flights.
+    for p in &peer {
+        assert!((0.3..1.5).contains(p), "{peer:?}");
+    }
+    assert!(fused > 0.2 && fused < peer.iter().copied().fold(f64::INFINITY, f64::min));
+    assert_eq!(r["fused_better_than_every_peer"], true);
+    for f in r["flights"].as_array().unwrap() {
+        assert!(f["rows"].as_u64().unwrap() > 100, "{f}");
+        assert!(
+            f["candidate"].as_str().unwrap().contains("bias prior"),
+            "{f}"
+        );
+        assert_eq!(f["file_offsets_s"].as_array().unwrap().len(), 4, "{f}");
+    }
+}
+
+/// Failed units, a counter wrap, an unreadable unit file and an empty reference file: the flights
+/// are evaluated with what they have, the broken one is left out with its reason, and the repairs
+/// are counted; nothing aborts.
+#[test]
+fn eval_quadrotor_ahrs_goes_on_past_failed_units_and_broken_files() {
+    let Some(dir) = common::quadrotor_data_dir() else {
+        return;
+    };
+    let scratch = Scratch::new("quadrotor-broken", "data");
+    let root = scratch.path();
+    for group in ["Horizontal", "StraightLine"] {
+        for entry in std::fs::read_dir(dir.join(group)).unwrap() {
+            let from = entry.unwrap().path();
+            let to = root.join(group).join(from.file_name().unwrap());
+            std::fs::create_dir_all(&to).unwrap();
+            for file in std::fs::read_dir(&from).unwrap() {
+                let file = file.unwrap().path();
+                std::fs::copy(&file, to.join(file.file_name().unwrap())).unwrap();
+            }
+        }
+    }
+    for k in 2..=4 {
+        std::fs::remove_file(root.join(format!("Horizontal/path_2/IMU_{k}.csv"))).unwrap();
+    }
+    // The unit's 32-bit microsecond counter wraps after row 2000.
+    let wrapped = root.join("Horizontal/path_3/IMU_1.csv");
+    let text = std::fs::read_to_string(&wrapped).unwrap();
+    let lines: Vec<String> = text
+        .lines()
+        .enumerate()
+        .map(|(i, line)| {
+            if i <= 2001 {
+                return line.to_string();
+            }
+            let (t, rest) = line.split_once(',').unwrap();
+            format!("{},{rest}", t.parse::<f64>().unwrap() - 4294.967296)
+        })
+        .collect();
+    std::fs::write(&wrapped, lines.join("\n") + "\n").unwrap();
+    std::fs::write(root.join("Horizontal/path_7/IMU_3.csv"), "garbage\n1,2,3\n").unwrap();
+    std::fs::write(root.join("StraightLine/path_2/GT.csv"), "").unwrap();
+
+    let r = ahrs_report(root);
+    assert_eq!(r["flights_total"], 12, "{r}");
+    assert_eq!(r["flights_evaluated"], 11, "{r}");
+    assert_eq!(r["repairs"]["counter_wraps"], 1, "{r}");
+    assert_eq!(r["repairs"]["imu_files_skipped"], 1, "{r}");
+    assert_eq!(r["repairs"]["trials_failed"], 1, "{r}");
+    let failures = r["failures"].as_array().unwrap();
+    assert_eq!(failures.len(), 1, "{r}");
+    assert_eq!(failures[0]["name"], "StraightLine/path_2");
+    assert!(failures[0]["reason"].as_str().unwrap().contains("GT.csv"));
+    let flights = r["flights"].as_array().unwrap();
+    let one_unit = flights
+        .iter()
+        .find(|f| f["name"] == "Horizontal/path_2")
+        .unwrap();
+    assert_eq!(one_unit["imus"], serde_json::json!([1]));
+    assert!(
+        number(&one_unit["fused_roll_pitch_rmse_deg"]) < 2.0,
+        "{one_unit}"
+    );
+    assert!(one_unit["peer_roll_pitch_rmse_deg"][1].is_null());
+    let three_units = flights
+        .iter()
+        .find(|f| f["name"] == "Horizontal/path_7")
+        .unwrap();
+    assert_eq!(three_units["imus"], serde_json::json!([1, 2, 4]));
+}

@@ -40,7 +40,7 @@ use crate::datasets::quadrotor::projection::estimate_installation;
 use crate::datasets::quadrotor::{MAX_IMUS, Repairs, Trial, load_each, total_repairs};
 use crate::quadrotor_nav::frames::{self, Motion};
 use crate::quadrotor_nav::run::{Start, start_from_truth};
-use crate::quadrotor_nav::vehicle_from_reference;
+use crate::quadrotor_nav::{require_data_dir, vehicle_from_reference};
 use candidates::Candidate;
 use mounting::Paired;
 use run::AttitudeTrace;
@@ -109,8 +109,8 @@ pub struct FlightResult {
     pub notes: Vec<String>,
 }
 
-/// One candidate's in-sample figure (every flight, mounting fitted on all of them): shown for
-/// transparency, not used to choose.
+/// One candidate's in-sample figure (first pass, gyro bias learnt from zero, every flight after
+/// [`SETTLE_S`], mounting fitted on all of them): shown for transparency, not used to choose.
 #[derive(Debug, Clone, Serialize)]
 pub struct CandidateFigure {
     /// The candidate.
@@ -234,12 +234,7 @@ pub fn evaluate(
     base: &AidedConfig,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<AhrsReport> {
-    if !dir.is_dir() {
-        return Err(anyhow!(
-            "eval quadrotor: data set directory {} does not exist or is not a directory",
-            dir.display()
-        ));
-    }
+    require_data_dir(dir)?;
     let loaded = load_each(dir, |_, _| ()).map_err(|e| {
         anyhow!(
             "eval quadrotor: cannot list trials in {}: {e}",

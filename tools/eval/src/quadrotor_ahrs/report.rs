@@ -8,6 +8,7 @@ use super::{
 };
 use crate::datasets::quadrotor::Repairs;
 use crate::quadrotor_nav::metrics::mean;
+use crate::quadrotor_nav::report::met;
 
 /// Mean per unit over the flights that have it.
 fn per_unit(
@@ -131,13 +132,13 @@ pub fn to_table(r: &AhrsReport) -> String {
         r.fused_better_than_every_peer,
         r.fused_better_than_every_single,
         r.roll_pitch_target_deg,
-        if r.roll_pitch_target_met {
-            "met"
-        } else {
-            "not met"
-        }
+        met(r.roll_pitch_target_met)
     );
-    let _ = writeln!(s, "candidates (in-sample mean, times chosen):");
+    let _ = writeln!(
+        s,
+        "tilt settings: first pass (gyro bias learnt from zero), mean over every flight after the first {} s with the mounting fitted on all (shown, not used to choose); flights it was chosen for:",
+        super::SETTLE_S
+    );
     for c in &r.candidates {
         let _ = writeln!(
             s,

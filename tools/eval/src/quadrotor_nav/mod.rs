@@ -160,18 +160,25 @@ pub fn evaluate_trial(
     })
 }
 
+/// The data set directory must exist: the error names it.
+pub fn require_data_dir(dir: &Path) -> Result<()> {
+    if dir.is_dir() {
+        Ok(())
+    } else {
+        Err(anyhow!(
+            "eval quadrotor: data set directory {} does not exist or is not a directory",
+            dir.display()
+        ))
+    }
+}
+
 /// Every trial under `dir`; `progress(done, total)` after each navigator run.
 pub fn evaluate(
     dir: &Path,
     config: &AidedConfig,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<QuadrotorReport> {
-    if !dir.is_dir() {
-        return Err(anyhow!(
-            "eval quadrotor: data set directory {} does not exist or is not a directory",
-            dir.display()
-        ));
-    }
+    require_data_dir(dir)?;
     let entries = list_trials(dir)
         .with_context(|| format!("eval quadrotor: cannot list trials in {}", dir.display()))?;
     if entries.is_empty() {

@@ -91,11 +91,7 @@ pub fn to_table(r: &QuadrotorReport) -> String {
         s,
         "target ≤ {:.1}°: {}",
         r.roll_pitch_target_deg,
-        if r.roll_pitch_target_met {
-            "met"
-        } else {
-            "not met"
-        }
+        met(r.roll_pitch_target_met)
     );
     let _ = writeln!(
         s,
@@ -112,4 +108,9 @@ pub fn to_table(r: &QuadrotorReport) -> String {
     );
     s.push_str(&skipped_lines(&r.skipped));
     s
+}
+
+/// How a target reads in a table.
+pub fn met(met: bool) -> &'static str {
+    if met { "met" } else { "not met" }
 }
