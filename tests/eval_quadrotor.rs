@@ -125,6 +125,17 @@ fn eval_quadrotor_names_a_bad_file() {
         &["eval", "quadrotor", data.path().to_str().unwrap()],
         file.to_str().unwrap(),
     );
+    // The AHRS mode, with no flight it can use, fails the same way.
+    assert_fails_naming(
+        &[
+            "eval",
+            "quadrotor",
+            data.path().to_str().unwrap(),
+            "--mode",
+            "ahrs",
+        ],
+        file.to_str().unwrap(),
+    );
 }
 
 #[test]
@@ -268,7 +279,7 @@ fn eval_quadrotor_ahrs_goes_on_past_failed_units_and_broken_files() {
     assert_eq!(r["repairs"]["trials_failed"], 1, "{r}");
     let failures = r["failures"].as_array().unwrap();
     assert_eq!(failures.len(), 1, "{r}");
-    assert_eq!(failures[0]["name"], "StraightLine/path_2");
+    assert_eq!(failures[0]["trial"], "StraightLine/path_2");
     assert!(failures[0]["reason"].as_str().unwrap().contains("GT.csv"));
     let flights = r["flights"].as_array().unwrap();
     let one_unit = flights

@@ -37,7 +37,9 @@ use rins_navigator::inertial_core::AidedConfig;
 use serde::Serialize;
 
 use crate::datasets::quadrotor::projection::estimate_installation;
-use crate::datasets::quadrotor::{MAX_IMUS, Repairs, Trial, load_each, total_repairs};
+use crate::datasets::quadrotor::{
+    MAX_IMUS, Repairs, SkippedTrial, Trial, load_each, nothing_evaluated, total_repairs,
+};
 use crate::quadrotor_nav::frames::{self, Motion};
 use crate::quadrotor_nav::run::{Start, start_from_truth};
 use crate::quadrotor_nav::{require_data_dir, vehicle_from_reference};
@@ -70,15 +72,6 @@ pub(crate) struct Flight {
     file_offsets_s: Vec<f64>,
     repairs: Repairs,
     notes: Vec<String>,
-}
-
-/// A flight left out, and why.
-#[derive(Debug, Clone, Serialize)]
-pub struct FlightFailure {
-    /// `<group>/path_<N>`.
-    pub name: String,
-    /// What went wrong.
-    pub reason: String,
 }
 
 /// One flight's cross-validated figures.
@@ -131,7 +124,7 @@ pub struct AhrsReport {
     /// Flights evaluated.
     pub flights_evaluated: usize,
     /// Flights left out, with reasons.
-    pub failures: Vec<FlightFailure>,
+    pub failures: Vec<SkippedTrial>,
     /// What the loader repaired, by kind, over every flight (failed flights counted).
     pub repairs: Repairs,
     /// Mean over flights of the fused roll/pitch RMSE, degrees (cross-validated).
@@ -261,13 +254,16 @@ pub fn evaluate(
             .and_then(|t| prepare(t).inspect_err(|_| repairs.trials_failed += 1));
         match prepared {
             Ok(f) => flights.push(f),
-            Err(e) => failures.push(FlightFailure {
-                name: entry.name.clone(),
+            Err(e) => failures.push(SkippedTrial {
+                trial: entry.name.clone(),
                 reason: format!("{e:#}"),
             }),
         }
         done += 1;
         progress(done, total);
+    }
+    if flights.is_empty() {
+        return Err(anyhow!("eval quadrotor: {}", nothing_evaluated(&failures)));
     }
     let outcome = cross_validation::run(&flights, &grid, base, &mut |runs| {
         done += runs;

@@ -3,10 +3,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::{
-    AhrsReport, CandidateFigure, FlightFailure, FlightResult, MAX_IMUS, ROLL_PITCH_TARGET_DEG,
-};
-use crate::datasets::quadrotor::Repairs;
+use super::{AhrsReport, CandidateFigure, FlightResult, MAX_IMUS, ROLL_PITCH_TARGET_DEG};
+use crate::datasets::quadrotor::{Repairs, SkippedTrial, skipped_lines};
 use crate::quadrotor_nav::metrics::mean;
 use crate::quadrotor_nav::report::met;
 
@@ -26,7 +24,7 @@ pub fn summarise(
     dir: &Path,
     flights_total: usize,
     repairs: Repairs,
-    failures: Vec<FlightFailure>,
+    failures: Vec<SkippedTrial>,
     flights: Vec<FlightResult>,
     candidates: Vec<CandidateFigure>,
 ) -> AhrsReport {
@@ -158,8 +156,6 @@ pub fn to_table(r: &AhrsReport) -> String {
         p.imu_files_skipped,
         p.trials_failed
     );
-    for f in &r.failures {
-        let _ = writeln!(s, "left out: {}: {}", f.name, f.reason);
-    }
+    s.push_str(&skipped_lines(&r.failures));
     s
 }

@@ -26,7 +26,9 @@ use rins_navigator::inertial_core::AidedConfig;
 use serde::Serialize;
 
 use crate::datasets::quadrotor::projection::estimate_installation;
-use crate::datasets::quadrotor::{Repairs, SkippedTrial, Trial, list_trials, load_trial};
+use crate::datasets::quadrotor::{
+    Repairs, SkippedTrial, Trial, list_trials, load_trial, nothing_evaluated,
+};
 use metrics::{Scores, max, mean, median, score};
 use run::{navigate, start_from_truth};
 
@@ -213,6 +215,9 @@ pub fn evaluate(
                 reason: format!("{e:#}"),
             }),
         }
+    }
+    if trials.is_empty() {
+        return Err(anyhow!("eval quadrotor: {}", nothing_evaluated(&skipped)));
     }
     Ok(summarise(dir, trials, skipped, config))
 }

@@ -239,6 +239,16 @@ pub fn skipped_lines(skipped: &[SkippedTrial]) -> String {
     s
 }
 
+/// The error of an evaluation that could use none of the trials it found: every reason, so the
+/// operator sees which file to look at.
+pub fn nothing_evaluated(skipped: &[SkippedTrial]) -> String {
+    let reasons: Vec<String> = skipped
+        .iter()
+        .map(|t| format!("{}: {}", t.trial, t.reason))
+        .collect();
+    format!("no trial could be evaluated ({})", reasons.join("; "))
+}
+
 /// One listed trial and what loading it gave.
 pub type Outcome = (TrialEntry, Result<Trial, DatasetError>);
 
