@@ -113,20 +113,30 @@ fn killing_either_navigator_lane_loses_no_sample_and_navigation_goes_on() {
         after_first.iter().all(|s| s.mode == NAVIGATING),
         "stopped navigating"
     );
-    assert_eq!(after_first.last().map(|s| s.lane), Some(1 - delivering));
+    assert!(
+        after_first.iter().any(|s| s.lane == 1 - delivering),
+        "the other lane never delivered"
+    );
 
     // The killed lane was restarted in flight: it took over the other lane's solution (a static
-    // alignment is impossible while flying) and has settled by now. Kill the other lane.
-    let second_victim = LANES[1 - delivering as usize];
-    let other = pid_of(&ipc, second_victim);
+    // alignment is impossible while flying). Which lane delivers now is the selector's choice: it
+    // stays on the surviving lane, or — when a loaded machine kept that lane silent for longer
+    // than the dead time while the restarted one published — on the restarted one, with no
+    // preferred lane to return to. Kill whichever delivers, so the switch is exercised again.
     assert_ne!(pid_of(&ipc, first_victim), killed);
+    let now_delivering = after_first.last().map_or(0, |s| s.lane);
+    let second_victim = LANES[now_delivering as usize];
+    let other = pid_of(&ipc, second_victim);
     send_signal(other, Signal::Kill).expect("SIGKILL");
     let after_second = follow(&rx, &mut last, Duration::from_secs(4));
     assert!(
         after_second.iter().all(|s| s.mode == NAVIGATING),
-        "the restarted lane is not navigating"
+        "navigation stopped after the second kill"
     );
-    assert_eq!(after_second.last().map(|s| s.lane), Some(delivering));
+    assert!(
+        after_second.iter().any(|s| s.lane == 1 - now_delivering),
+        "the other lane never delivered after the second kill"
+    );
 
     // Our own child; already gone is fine too.
     let _ = send_signal(u64::from(echo.id()), Signal::Terminate);
