@@ -274,19 +274,29 @@ fn acquisition_rides_out_a_disconnect_under_a_running_pipeline() {
         (lost + 1) * period_us,
         "device time runs on"
     );
-    // Nothing else lost: every other step of the stream is one frame.
+    // Nothing else lost beyond the line: a frame or two may overflow the pseudo-terminal of a
+    // loaded test machine (the line is the limit, not the pipeline), up to one in a thousand, and
+    // acquisition must have counted every frame missing, the outage's and those.
     let other_gaps: Vec<(u64, u64)> = seen
         .imu
         .windows(2)
         .map(|w| (w[0].0, w[1].0))
         .filter(|&(a, b)| b != a + 1 && a != seq_before)
         .collect();
-    assert!(other_gaps.is_empty(), "other gaps: {other_gaps:?}");
+    let other_lost: u64 = other_gaps.iter().map(|&(a, b)| b - a - 1).sum();
+    assert!(
+        other_lost as f64 <= (seen.imu.len() as f64 / 1000.0).max(1.0),
+        "other gaps: {other_gaps:?}"
+    );
 
     let (pid_after, restarts, state) = acquisition(&ipc.status());
     assert_eq!((pid_after, restarts, state.as_str()), (pid, 0, "running"));
     let summary = stop_up(&ipc, up.release());
     assert_eq!(summary["restarts"], 0, "{summary}");
+    assert!(
+        num(&summary, "lost_frames") >= (lost + other_lost) as f64,
+        "frames missing from the stream but not counted as lost: {summary}"
+    );
 }
 
 /// Takes everything a child wrote to a pipe so far, without waiting for its end.
