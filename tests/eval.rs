@@ -56,6 +56,11 @@ fn eval_fdi_reports_every_trial_and_isolates_health_faults_on_the_pyramid() {
         assert!(report.get(key).is_some(), "missing {key}");
     }
     assert_eq!(report["trials"], 12);
+    assert_eq!(report["flights_total"], 12);
+    assert_eq!(report["flights_evaluated"], 12);
+    // 356 s of recording over the twelve flights (the units' common spans).
+    let hours = report["flight_hours"].as_f64().unwrap();
+    assert!((hours - 0.0989).abs() < 0.0005, "{hours}");
     // Two configurations per trial.
     assert_eq!(report["per_trial"].as_array().unwrap().len(), 24);
     // 12 trials × 2 types × (4 + 12 channels) × 5 fault kinds.

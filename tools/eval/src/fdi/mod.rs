@@ -273,6 +273,7 @@ pub fn evaluate(request: &FdiRequest, progress: &mut dyn FnMut(usize, usize)) ->
         }
     }
     let mut skipped = Vec::new();
+    let mut flight_s = 0.0;
     for entry in &entries {
         // A trial that cannot be loaded, or has fewer units than the configurations are built
         // from, is listed in the report; its runs still count, so the bar ends at its total.
@@ -296,6 +297,7 @@ pub fn evaluate(request: &FdiRequest, progress: &mut dyn FnMut(usize, usize)) ->
                 continue;
             }
         };
+        flight_s += trial.len() as f64 / IMU_RATE_HZ;
         for (ci, (layout, fusion, geometry)) in configs.iter().enumerate() {
             let p = prepare(&trial, *layout, geometry, lsb)
                 .with_context(|| format!("eval fdi: trial {}", entry.name))?;
@@ -390,6 +392,9 @@ pub fn evaluate(request: &FdiRequest, progress: &mut dyn FnMut(usize, usize)) ->
     Ok(FdiReport {
         dir: dir.clone(),
         trials: entries.len() - skipped.len(),
+        flights_total: entries.len(),
+        flights_evaluated: entries.len() - skipped.len(),
+        flight_hours: flight_s / 3600.0,
         skipped,
         imu_rate_hz: IMU_RATE_HZ,
         gyro_lsb_rps: lsb[0],

@@ -170,6 +170,12 @@ pub struct FdiReport {
     pub dir: PathBuf,
     /// Trials evaluated.
     pub trials: usize,
+    /// Flights (trials) listed in the data set.
+    pub flights_total: usize,
+    /// Flights evaluated (equal to `trials`).
+    pub flights_evaluated: usize,
+    /// Recorded time of the evaluated flights, h (each configuration runs over all of it).
+    pub flight_hours: f64,
     /// Trials listed but not evaluated, with the reason.
     pub skipped: Vec<SkippedTrial>,
     /// The data set's IMU rate, Hz.
@@ -222,9 +228,11 @@ pub fn to_table(r: &FdiReport) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "FDI on {} ({} trials, {} Hz; persistence {}-of-{} samples; learning {} samples; lsb gyro {:.3e} rad/s, accel {:.3e} m/s²; motion noise {} of |x|, timing skew {} ms)\n",
+        "FDI on {} ({} of {} flights, {:.3} flight hours, {} Hz; persistence {}-of-{} samples; learning {} samples; lsb gyro {:.3e} rad/s, accel {:.3e} m/s²; motion noise {} of |x|, timing skew {} ms)\n",
         r.dir.display(),
-        r.trials,
+        r.flights_evaluated,
+        r.flights_total,
+        r.flight_hours,
         r.imu_rate_hz,
         r.persistence[0],
         r.persistence[1],
