@@ -120,20 +120,7 @@ impl ErrorStateEkf {
         strapdown: StrapdownConfig,
         noise: EkfNoise,
     ) -> Self {
-        let mut diagonal = SVector::<f64, STATES>::zeros();
-        let blocks = [
-            (ATT, noise.initial_tilt_sigma),
-            (VEL, noise.initial_velocity_sigma),
-            (POS, noise.initial_position_sigma),
-            (BG, noise.initial_gyro_bias_sigma),
-            (BA, noise.initial_accel_bias_sigma),
-        ];
-        for (start, sigma) in blocks {
-            for i in start..start + 3 {
-                diagonal[i] = sigma * sigma;
-            }
-        }
-        diagonal[ATT + 2] = noise.initial_heading_sigma.powi(2);
+        let diagonal = SVector::<f64, STATES>::from(noise.initial_variances());
         Self {
             strapdown: Strapdown::new(state, bias, strapdown),
             p: Covariance::from_diagonal(&diagonal),

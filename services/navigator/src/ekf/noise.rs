@@ -50,6 +50,24 @@ impl Default for EkfNoise {
 }
 
 impl EkfNoise {
+    /// The error-state variances a filter starts with: the initial σs squared, per block of the
+    /// error state, the heading its own.
+    pub fn initial_variances(&self) -> [f64; super::STATES] {
+        let mut v = [0.0; super::STATES];
+        let blocks = [
+            (super::ATT, self.initial_tilt_sigma),
+            (super::VEL, self.initial_velocity_sigma),
+            (super::POS, self.initial_position_sigma),
+            (super::BG, self.initial_gyro_bias_sigma),
+            (super::BA, self.initial_accel_bias_sigma),
+        ];
+        for (start, sigma) in blocks {
+            v[start..start + 3].fill(sigma * sigma);
+        }
+        v[super::ATT + 2] = self.initial_heading_sigma.powi(2);
+        v
+    }
+
     /// Every value must be finite and positive: `(field, value)` of the first that is not.
     pub fn check(&self) -> Result<(), (&'static str, f64)> {
         let fields = [

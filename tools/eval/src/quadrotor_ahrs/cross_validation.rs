@@ -40,21 +40,25 @@ fn without<T>(runs: &[T], f: usize) -> Vec<&T> {
         .collect()
 }
 
-/// The runs of the flights other than `f` that carry the same units as `f` (the fused solution of
-/// four units and of one are different instruments, with different biases and mountings); all the
-/// other flights when none does.
-fn same_units<'a, T>(flights: &[Flight], runs: &'a [T], f: usize) -> Vec<&'a T> {
-    let same: Vec<&T> = runs
-        .iter()
-        .enumerate()
-        .filter(|&(g, _)| g != f && flights[g].imus == flights[f].imus)
-        .map(|(_, r)| r)
-        .collect();
-    if same.is_empty() {
-        without(runs, f)
-    } else {
-        same
-    }
+/// The runs of the flights other than `f` and `also_left_out` that carry the same units as `f` (the
+/// fused solution of four units and of one are different instruments, with different biases and
+/// mountings); all those flights when none does.
+fn same_units<'a, T>(
+    flights: &[Flight],
+    runs: &'a [T],
+    f: usize,
+    also_left_out: Option<usize>,
+) -> Vec<&'a T> {
+    let kept = |g: usize| g != f && Some(g) != also_left_out;
+    let pick = |same: bool| -> Vec<&T> {
+        runs.iter()
+            .enumerate()
+            .filter(|&(g, _)| kept(g) && (!same || flights[g].imus == flights[f].imus))
+            .map(|(_, r)| r)
+            .collect()
+    };
+    let same = pick(true);
+    if same.is_empty() { pick(false) } else { same }
 }
 
 /// Where unit `imu` sits in each flight other than `f` that has it: `(flight, position)`.
@@ -137,10 +141,7 @@ fn training_run(
     f: usize,
     scale: f64,
 ) -> f64 {
-    let others: Vec<&Scored> = same_units(flights, first, g)
-        .into_iter()
-        .filter(|s| !std::ptr::eq(*s, &first[f]))
-        .collect();
+    let others = same_units(flights, first, g, Some(f));
     let tilt = fit_mounting(&paired(&others), SETTLE_S);
     let run = run_paired(
         &flights[g],
@@ -227,7 +228,7 @@ pub(crate) fn run(
             let c = chosen[f];
             let config = &configs[c];
             let scale = choose_prior_scale(flights, &first[c], config, f);
-            let others = same_units(flights, &first[c], f);
+            let others = same_units(flights, &first[c], f, None);
             let tilt = fit_mounting(&paired(&others), SETTLE_S);
             let fused = run_paired(
                 flight,

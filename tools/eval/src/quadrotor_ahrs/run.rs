@@ -8,7 +8,7 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 use rins_navigator::attitude::quaternion_from_euler;
-use rins_navigator::ekf::{ATT, BA, BG, POS, STATES, VEL};
+use rins_navigator::ekf::BG;
 use rins_navigator::inertial_core::{AidedConfig, AidedNavigator};
 use rins_navigator::{ImuBias, NominalState};
 
@@ -73,24 +73,6 @@ fn device_us(t_s: f64) -> u64 {
     ((t_s + 1.0).max(0.0) * 1e6).round() as u64
 }
 
-/// The error variances the filter starts with: the configured initial σs.
-fn initial_variances(config: &AidedConfig) -> [f64; STATES] {
-    let n = &config.noise;
-    let mut v = [0.0; STATES];
-    let blocks = [
-        (ATT, n.initial_tilt_sigma),
-        (VEL, n.initial_velocity_sigma),
-        (POS, n.initial_position_sigma),
-        (BG, n.initial_gyro_bias_sigma),
-        (BA, n.initial_accel_bias_sigma),
-    ];
-    for (start, sigma) in blocks {
-        v[start..start + 3].fill(sigma * sigma);
-    }
-    v[ATT + 2] = n.initial_heading_sigma.powi(2);
-    v
-}
-
 /// Runs `motion` from `start` through the navigator's inertial core with `config` (its tilt
 /// updates included when enabled). The unit's attitude at t0 is the airframe's turned by the
 /// inverse of the unit's `mounting` (`C_nav←vehicle = C_nav←unit · mounting`); the gyro bias
@@ -108,7 +90,7 @@ pub fn navigate_ahrs(
     state.attitude = quaternion_from_euler(roll, pitch, heading) * mounting.inverse();
     state.velocity_ned = Vector3::from(start.velocity_ned);
     let mut bias = ImuBias::default();
-    let mut variances = initial_variances(config);
+    let mut variances = config.noise.initial_variances();
     if let Some(p) = prior {
         bias.gyro_rps = Vector3::from(p.bias_rps);
         variances[BG..BG + 3].fill(p.sigma_rps * p.sigma_rps);
