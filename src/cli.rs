@@ -355,9 +355,13 @@ pub struct SimArgs {
     /// Also make this path a symbolic link to the pseudo-terminal (replaced if it exists).
     #[arg(long)]
     pub link: Option<PathBuf>,
-    /// Stop after this many seconds.
+    /// Stop after this many seconds (the uav scenario then flies its circuits for that long).
     #[arg(long)]
     pub duration: Option<f64>,
+    /// Uav scenario: length of the flight, s, its circuits repeated as many times as fit
+    /// (overrides sim.uav_flight_s; default: --duration).
+    #[arg(long, value_name = "SECONDS")]
+    pub flight_s: Option<f64>,
     /// Faults for the simulator to apply.
     #[command(flatten)]
     pub faults: FaultArgs,

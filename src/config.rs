@@ -241,6 +241,28 @@ mod tests {
         assert_eq!(cfg, RinsConfig::parse(BUILT_IN, "x").unwrap());
     }
 
+    /// The endurance profile is a copy of the built-in file: only its simulated sensors and
+    /// scenario may differ, and its slow errors must be worse than the typical block's.
+    #[test]
+    fn endurance_profile_is_the_built_in_one_with_worse_slow_sensor_errors() {
+        let text = include_str!("../config/endurance.toml");
+        let endurance = RinsConfig::parse(text, "config/endurance.toml").unwrap();
+        let built_in = load(None).unwrap();
+        let typical = &built_in.sim.sensors;
+        let worst = &endurance.sim.sensors;
+        assert!(worst.gyro_bias_instability_sigma_dps > typical.gyro_bias_instability_sigma_dps);
+        assert!(worst.accel_bias_instability_sigma_mg > typical.accel_bias_instability_sigma_mg);
+        assert!(
+            worst.gyro_bias_temp_coeff_sigma_dps_per_c
+                > typical.gyro_bias_temp_coeff_sigma_dps_per_c
+        );
+        assert!(worst.temperature_warmup_c > typical.temperature_warmup_c);
+        assert_eq!(endurance.sim.scenario, rins_sim::Scenario::Uav);
+        let mut same = endurance.clone();
+        same.sim = built_in.sim.clone();
+        assert_eq!(same, built_in);
+    }
+
     #[test]
     fn unknown_keys_are_rejected_by_name() {
         let err = RinsConfig::parse("[fusion]\nspeed = 3\n", "test.toml").unwrap_err();

@@ -25,6 +25,10 @@ pub fn run(args: &SimArgs) -> Result<()> {
     {
         bail!("--duration {d}: must be a positive number of seconds");
     }
+    if let Some(flight_s) = args.flight_s.or(args.duration) {
+        // Checked with the rest of the configuration when the simulator is built.
+        cfg.sim.uav_flight_s = Some(flight_s);
+    }
     // The simulated block carries the sensors the fusion geometry describes.
     let (gyro, accel) = cfg.geometries()?;
     let faults = fault_args::schedule(&args.faults, gyro.n(), accel.n())?;

@@ -192,6 +192,11 @@ fn sim_args(cfg: &RinsConfig, config_args: &[String], link: &Path, up: &UpArgs) 
         "--link".to_string(),
         link.to_string_lossy().into_owned(),
     ]);
+    // A run of given length flies the uav circuits for all of it, unless the configuration says
+    // how long the flight is.
+    if let (Some(d), None) = (up.duration, cfg.sim.uav_flight_s) {
+        args.extend(["--flight-s".to_string(), d.to_string()]);
+    }
     // The simulator applies timed faults itself, exactly at their tick.
     for spec in &up.faults.inject {
         args.extend(["--inject".to_string(), spec.clone()]);

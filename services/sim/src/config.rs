@@ -72,6 +72,9 @@ pub struct SimConfig {
     /// UAV and walk scenarios: time at rest, level, before moving, s (the window a navigator's
     /// static alignment needs).
     pub static_s: f64,
+    /// UAV scenario: length of the whole flight, s (parking, take-off, circuits, landing); the
+    /// pair of circuits repeats as many times as fit. Unset: one pair (about 615 s), then parked.
+    pub uav_flight_s: Option<f64>,
     /// Sea-level pressure of the ISA model, Pa.
     pub qnh_pa: f64,
     /// Local Earth magnetic field.
@@ -94,6 +97,7 @@ impl Default for SimConfig {
             origin_altitude_m: 488.0,
             initial_heading_deg: 0.0,
             static_s: 3.0,
+            uav_flight_s: None,
             qnh_pa: 101_325.0,
             earth_field: EarthFieldConfig::default(),
             sensors: SensorModelConfig::default(),
@@ -158,6 +162,15 @@ impl SimConfig {
             86_400.0,
             "must be within 0..=86400",
         )?;
+        if let Some(flight_s) = self.uav_flight_s {
+            check_range(
+                "sim.uav_flight_s",
+                flight_s,
+                0.0,
+                86_400.0,
+                "must be within 0..=86400",
+            )?;
+        }
         check_range(
             "sim.qnh_pa",
             self.qnh_pa,
@@ -206,6 +219,7 @@ impl SimConfig {
             altitude_m: self.origin_altitude_m,
             heading_rad: self.initial_heading_deg.to_radians(),
             static_s: self.static_s,
+            uav_flight_s: self.uav_flight_s,
         }
     }
 

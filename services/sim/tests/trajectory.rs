@@ -260,3 +260,56 @@ fn static_prefix_shifts_the_profile() {
     assert_eq!(parked.latitude_rad, config.origin_latitude_deg.to_radians());
     assert_eq!(parked.velocity_n, Vector3::zeros());
 }
+
+/// An hour-long flight repeats the circuits: it keeps flying (banked, at cruise speed and
+/// altitude) for most of the hour, lands by the end, and its first circuits are the short
+/// profile's.
+#[test]
+fn a_long_flight_repeats_the_circuits_until_it_must_land() {
+    let (short, _) = uav();
+    let config = SimConfig {
+        scenario: Scenario::Uav,
+        initial_heading_deg: 30.0,
+        uav_flight_s: Some(3600.0),
+        ..SimConfig::default()
+    };
+    let long = Trajectory::new(Scenario::Uav, config.trajectory_start());
+    assert!(long.end_s() <= 3600.0, "ends at {} s", long.end_s());
+    // One more pair of circuits would not fit: the gap left is shorter than a pair (≈ 424 s).
+    let pair_s = (long.end_s() - short.end_s()) / ((long.end_s() - short.end_s()) / 424.0).round();
+    assert!(
+        (400.0..450.0).contains(&pair_s),
+        "pair of circuits {pair_s} s"
+    );
+    assert!(3600.0 - long.end_s() < pair_s, "ends at {} s", long.end_s());
+    // Identical up to the end of the first pair of circuits (the reversal comes later).
+    for t in [0.0, 50.0, 200.0, 400.0] {
+        let (a, b) = (short.sample(t), long.sample(t));
+        assert!(a.attitude.angle_to(&b.attitude) < 1e-12, "t={t}");
+        assert!((a.velocity_n - b.velocity_n).norm() < 1e-9, "t={t}");
+    }
+    // Airborne at cruise speed between take-off and the descent, and banked a good part of it.
+    let (mut airborne, mut banked, mut samples) = (0, 0, 0);
+    for k in 0..3500 {
+        let s = long.sample(k as f64);
+        samples += 1;
+        airborne += usize::from(s.altitude_m - config.origin_altitude_m > 50.0);
+        banked += usize::from(s.euler_rad[0].abs() > 10f64.to_radians());
+    }
+    // Parked 3 s, climb 44 s, descent 54 s, landing roll and a margin before the hour ends.
+    assert!(
+        airborne > samples * 85 / 100,
+        "airborne {airborne} of {samples} s"
+    );
+    assert!(banked > samples / 10, "banked {banked} of {samples} s");
+    let parked = long.sample(long.end_s() + 1.0);
+    assert!((parked.altitude_m - config.origin_altitude_m).abs() < 1e-6);
+    assert!(parked.velocity_n.norm() < 1e-12);
+    // The configured length is validated: a negative flight is named.
+    let bad = SimConfig {
+        uav_flight_s: Some(-1.0),
+        ..SimConfig::default()
+    };
+    let e = bad.validate().expect_err("negative flight").to_string();
+    assert!(e.contains("sim.uav_flight_s"), "{e}");
+}

@@ -54,9 +54,13 @@ impl FlightPath {
         (path, landmarks)
     }
 
-    /// The UAV profile of [`UavProfile`] after `start.static_s` seconds parked.
+    /// The UAV profile of [`UavProfile`] after `start.static_s` seconds parked; its circuits
+    /// repeated to last `start.uav_flight_s` when that is set.
     pub fn uav(start: TrajectoryStart) -> (Self, Landmarks) {
-        let profile = UavProfile::new(start.static_s);
+        let profile = match start.uav_flight_s {
+            Some(flight_s) => UavProfile::lasting(start.static_s, flight_s),
+            None => UavProfile::new(start.static_s),
+        };
         let mut path = Self {
             start,
             speed: profile.speed,

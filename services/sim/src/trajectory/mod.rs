@@ -38,7 +38,7 @@ pub enum Scenario {
     Walk,
 }
 
-/// Where and how the trajectory starts.
+/// Where and how the trajectory starts, and how long the UAV flies.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrajectoryStart {
     /// Geodetic latitude of the origin, rad.
@@ -51,6 +51,9 @@ pub struct TrajectoryStart {
     pub heading_rad: f64,
     /// Time at rest, level, before the UAV profile or the walk starts moving, s.
     pub static_s: f64,
+    /// UAV scenario: the flight (parking included) lasts up to this long, its circuits repeated
+    /// as many times as fit; `None`: one pair of circuits. Ignored by the other scenarios.
+    pub uav_flight_s: Option<f64>,
 }
 
 /// The true state at one instant.

@@ -4,6 +4,10 @@
 //! rate to cruise altitude, two rectangular circuits (right turns at 25° bank, then left turns at
 //! 20°), a 180° reversal at 30° bank, a constant-rate descent whose final smooth step is the flare,
 //! a landing roll to a stop, then parked for as long as the simulation runs.
+//!
+//! A longer flight (an endurance run) repeats the pair of circuits as many times as fit before
+//! the reversal, so that the vehicle keeps turning, accelerating and heating its sensors instead
+//! of standing parked for most of the run.
 
 use super::schedule::Schedule;
 use rins_earth::STANDARD_GRAVITY;
@@ -41,7 +45,8 @@ const fn leg(straight_s: f64, turn_deg: f64, bank_deg: f64) -> Leg {
     }
 }
 
-const CRUISE_LEGS: [Leg; 10] = [
+/// The pair of rectangular circuits: flown once, or repeated in a longer flight.
+const CIRCUIT_LEGS: [Leg; 8] = [
     leg(60.0, 90.0, 25.0),
     leg(30.0, 90.0, 25.0),
     leg(60.0, 90.0, 25.0),
@@ -50,9 +55,9 @@ const CRUISE_LEGS: [Leg; 10] = [
     leg(30.0, -90.0, 20.0),
     leg(60.0, -90.0, 20.0),
     leg(30.0, -90.0, 20.0),
-    leg(20.0, 180.0, 30.0),
-    leg(0.0, 0.0, 0.0),
 ];
+/// After the circuits: the reversal towards the landing.
+const REVERSAL: Leg = leg(20.0, 180.0, 30.0);
 const FINAL_STRAIGHT_S: f64 = 30.0;
 
 /// Schedules of the UAV profile and its landmark times.
@@ -73,8 +78,28 @@ pub struct UavProfile {
 }
 
 impl UavProfile {
-    /// Builds the profile with `static_s` seconds parked at the start.
+    /// Builds the profile with `static_s` seconds parked at the start and one pair of circuits.
     pub fn new(static_s: f64) -> Self {
+        Self::with_circuits(static_s, 1)
+    }
+
+    /// Builds the profile with as many pairs of circuits (at least one) as fit for the whole
+    /// flight, parking included, to end (stopped after the landing roll) by `flight_s`.
+    pub fn lasting(static_s: f64, flight_s: f64) -> Self {
+        let one = Self::with_circuits(static_s, 1).end_s;
+        let extra = ((flight_s - one) / circuit_duration_s()).floor();
+        // Bounded so that a huge request cannot build a schedule that exhausts memory: a day of
+        // circuits is far more than any run needs.
+        let extra = if extra.is_finite() {
+            extra.clamp(0.0, 200.0) as usize
+        } else {
+            0
+        };
+        Self::with_circuits(static_s, 1 + extra)
+    }
+
+    /// Builds the profile with `circuits` pairs of circuits (at least one).
+    fn with_circuits(static_s: f64, circuits: usize) -> Self {
         let mut speed = Schedule::new(0.0);
         let mut heading_rate = Schedule::new(0.0);
         let mut climb_rate = Schedule::new(0.0);
@@ -91,11 +116,13 @@ impl UavProfile {
         climb_rate.step_to(t, CLIMB_TRANSITION_S, 0.0);
         t += CLIMB_TRANSITION_S;
 
-        for leg in &CRUISE_LEGS {
+        let legs = CIRCUIT_LEGS
+            .iter()
+            .cycle()
+            .take(CIRCUIT_LEGS.len() * circuits.max(1));
+        for leg in legs.chain([&REVERSAL]) {
             t += leg.straight_s;
-            if leg.turn_deg != 0.0 {
-                t += coordinated_turn(&mut heading_rate, t, leg.turn_deg, leg.bank_deg);
-            }
+            t += coordinated_turn(&mut heading_rate, t, leg.turn_deg, leg.bank_deg);
         }
         t += FINAL_STRAIGHT_S;
 
@@ -121,6 +148,26 @@ impl UavProfile {
     }
 }
 
+/// Duration of one pair of circuits, s.
+fn circuit_duration_s() -> f64 {
+    CIRCUIT_LEGS
+        .iter()
+        .map(|l| l.straight_s + turn_duration_s(l.turn_deg, l.bank_deg))
+        .sum()
+}
+
+/// Heading rate of a level coordinated turn at `bank_deg` and cruise speed, rad/s.
+fn turn_rate_rps(bank_deg: f64) -> f64 {
+    STANDARD_GRAVITY * bank_deg.to_radians().tan() / CRUISE_SPEED_MPS
+}
+
+/// Duration of a turn of `turn_deg` at `bank_deg`, s (see [`coordinated_turn`]).
+fn turn_duration_s(turn_deg: f64, bank_deg: f64) -> f64 {
+    let hold_s =
+        (turn_deg.to_radians().abs() / turn_rate_rps(bank_deg) - ROLL_TRANSITION_S).max(0.0);
+    2.0 * ROLL_TRANSITION_S + hold_s
+}
+
 /// Adds a level coordinated turn of `turn_deg` (positive = right) at `bank_deg` starting at `start_s`
 /// to the heading-rate schedule; returns its duration. The heading rate rises to `g·tan(bank)/V`
 /// through a smooth step, holds, and returns to zero; the two steps together turn as much as
@@ -131,9 +178,10 @@ fn coordinated_turn(
     turn_deg: f64,
     bank_deg: f64,
 ) -> f64 {
-    let rate = STANDARD_GRAVITY * bank_deg.to_radians().tan() / CRUISE_SPEED_MPS;
-    let hold_s = (turn_deg.to_radians().abs() / rate - ROLL_TRANSITION_S).max(0.0);
+    let duration_s = turn_duration_s(turn_deg, bank_deg);
+    let hold_s = duration_s - 2.0 * ROLL_TRANSITION_S;
+    let rate = turn_rate_rps(bank_deg);
     heading_rate.step_to(start_s, ROLL_TRANSITION_S, rate * turn_deg.signum());
     heading_rate.step_to(start_s + ROLL_TRANSITION_S + hold_s, ROLL_TRANSITION_S, 0.0);
-    2.0 * ROLL_TRANSITION_S + hold_s
+    duration_s
 }
