@@ -213,6 +213,12 @@ pub struct EvalFdiArgs {
     /// Only trials whose name contains this text, e.g. `Horizontal/path_1`. Repeatable.
     #[arg(long = "trial", value_name = "NAME")]
     pub trials: Vec<String>,
+    /// Also draw the cross-validated ROC into this PNG file.
+    #[arg(long, value_name = "FILE.png")]
+    pub plot: Option<PathBuf>,
+    /// Worker threads (default: the machine's cores).
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=256))]
+    pub threads: Option<u16>,
 }
 
 /// Options of `rins mc`.

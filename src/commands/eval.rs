@@ -2,7 +2,7 @@
 //! `rins-eval` with a progress bar and prints the report.
 
 use anyhow::Result;
-use rins_eval::fdi::{FdiRequest, evaluate, to_table};
+use rins_eval::fdi::{FdiRequest, draw_roc, evaluate, to_table};
 
 use crate::cli::{
     EvalFdiArgs, EvalProfileArgs, EvalPyshoeArgs, EvalQuadrotorArgs, EvalXioArgs, QuadrotorMode,
@@ -16,10 +16,18 @@ pub fn run_fdi(args: &EvalFdiArgs) -> Result<()> {
         trials: args.trials.clone(),
         fdi: cfg.fusion.fdi.clone(),
         lsb: [cfg.device.gyro_lsb_rps(), cfg.device.accel_lsb_mps2()],
+        threads: args.threads.map_or_else(
+            || std::thread::available_parallelism().map_or(1, usize::from),
+            usize::from,
+        ),
     };
     let mut bar = super::progress::Progress::new("eval fdi");
     let report = evaluate(&request, &mut |done, total| bar.set(done, total))?;
     bar.finish();
+    if let Some(path) = &args.plot {
+        draw_roc(path, &report.roc, &report.operating_points)?;
+        eprintln!("eval fdi: ROC drawn in {}", path.display());
+    }
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
     } else {

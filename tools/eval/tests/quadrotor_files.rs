@@ -304,6 +304,7 @@ fn eval_fdi_lists_the_trials_it_cannot_use_instead_of_failing() {
         trials: Vec::new(),
         fdi: rins_fusion::FdiConfig::default(),
         lsb: [2.5e-3, 3.8e-2],
+        threads: 1,
     };
     let mut last = (0, 0);
     let report = rins_eval::fdi::evaluate(&request, &mut |d, t| last = (d, t)).unwrap();
@@ -314,23 +315,25 @@ fn eval_fdi_lists_the_trials_it_cannot_use_instead_of_failing() {
         .iter()
         .map(|s| (s.trial.as_str(), s.reason.as_str()))
         .collect();
-    assert_eq!(reasons.len(), 3, "{reasons:?}");
+    assert_eq!(reasons.len(), 2, "{reasons:?}");
     assert!(reasons[0].1.contains("GT.csv: missing"), "{reasons:?}");
-    assert_eq!(
-        reasons[1],
-        (
-            "Horizontal/path_2",
-            "1 IMUs usable, the configurations need 4"
-        )
+    assert!(reasons[1].1.contains("IMU_1.csv:1: header"), "{reasons:?}");
+    assert_eq!(report.repairs.trials_failed, 2);
+    // A single unit is not an error: it has no redundancy to monitor, and is listed as such.
+    assert_eq!(report.single_unit.len(), 1);
+    assert_eq!(report.single_unit[0].trial, "Horizontal/path_2");
+    assert!(
+        report.single_unit[0].reason.contains("no redundancy"),
+        "{:?}",
+        report.single_unit
     );
-    assert!(reasons[2].1.contains("IMU_1.csv:1: header"), "{reasons:?}");
     let text = rins_eval::fdi::to_table(&report);
     assert!(
-        text.contains("3 trials skipped:\n  Horizontal/path_1: "),
+        text.contains("2 trials skipped:\n  Horizontal/path_1: "),
         "{text}"
     );
     let json = serde_json::to_value(&report).unwrap();
-    assert_eq!(json["skipped"][1]["trial"], "Horizontal/path_2");
+    assert_eq!(json["single_unit"][0]["trial"], "Horizontal/path_2");
 }
 
 #[test]

@@ -8,8 +8,8 @@ use rins_fusion::Geometry;
 use crate::datasets::quadrotor::projection::MAX_CHANNELS;
 use serde::Serialize;
 
+use super::layout::Sensor;
 use super::prepare::Prepared;
-use super::{Layout, Sensor};
 
 /// Half-width of the window the channels' noise is compared over, s.
 pub const EVIDENCE_HALF_WINDOW_S: f64 = 1.0;
@@ -31,16 +31,6 @@ pub struct AlarmEpisode {
     pub loudest_imu: usize,
     /// That channel's first-difference RMS over the median of its peers'.
     pub noise_ratio: f64,
-}
-
-impl Layout {
-    /// The recorded IMU (0-based) a channel comes from.
-    pub(crate) fn unit_of(self, channel: usize) -> usize {
-        match self {
-            Layout::Pyramid4 => channel,
-            Layout::Stacked12 => channel / 3,
-        }
-    }
 }
 
 /// First-difference RMS of channel `ch` over `rows`.
@@ -102,10 +92,11 @@ pub(crate) fn loudest_channel(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fdi::layout::Layout;
 
     #[test]
     fn the_channel_vibrating_three_times_harder_than_its_like_axis_peers_is_named() {
-        let layout = Layout::Stacked12;
+        let layout = Layout::Stacked { units: 4 };
         let geometry = layout.geometry().build().expect("stacked geometry");
         // Alternating ±a per row: first-difference RMS 2a. Unit 2's y row (channel 7) at 3×.
         let rows: Vec<[i16; MAX_CHANNELS]> = (0..240)

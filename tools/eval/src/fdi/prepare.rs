@@ -4,10 +4,12 @@ use anyhow::{Result, anyhow};
 use rins_fusion::fdi::channel_health::COUNT_MAX;
 use rins_fusion::{Geometry, WlsSolver};
 
-use super::{BIAS_WINDOW_S, Layout, PREFILTER_ROWS, Sensor};
-use crate::datasets::quadrotor::lever_arm::{estimate_lever_arms, remove_lever_arms};
+use super::layout::{Layout, Sensor};
+use super::learned_geometry::LearnedGeometry;
+use super::{BIAS_WINDOW_S, PREFILTER_ROWS};
+use crate::datasets::quadrotor::lever_arm::remove_lever_arms;
 use crate::datasets::quadrotor::projection::{
-    ChannelRow, MAX_CHANNELS, estimate_installation, project_to_pyramid, stack_triads,
+    ChannelRow, MAX_CHANNELS, project_to_pyramid, stack_triads,
 };
 use crate::datasets::quadrotor::{IMU_RATE_HZ, Trial};
 
@@ -79,20 +81,22 @@ fn remove_relative_bias(geometry: &Geometry, rows: &mut [[f64; MAX_CHANNELS]]) -
     Ok(largest)
 }
 
+/// The trial's channels in `layout`, with the installation and lever arms of `learned` (from
+/// the other flights).
 pub(crate) fn prepare(
     trial: &Trial,
     layout: Layout,
     geometry: &Geometry,
     lsb: [f64; 2],
+    learned: &LearnedGeometry,
 ) -> Result<Prepared> {
-    let installation = estimate_installation(trial)?;
-    let arms = estimate_lever_arms(trial, &installation, IMU_RATE_HZ);
+    let installation = &learned.installation;
     let mut trial = trial.clone();
-    remove_lever_arms(&mut trial, &installation, &arms, IMU_RATE_HZ);
+    remove_lever_arms(&mut trial, installation, &learned.arms, IMU_RATE_HZ);
     let trial = &trial;
     let rows: Vec<ChannelRow> = match layout {
-        Layout::Pyramid4 => project_to_pyramid(trial, &installation, geometry)?,
-        Layout::Stacked12 => stack_triads(trial, &installation)?,
+        Layout::Pyramid4 => project_to_pyramid(trial, installation, geometry)?,
+        Layout::Stacked { .. } => stack_triads(trial, installation)?,
     };
     let n = geometry.n();
     let mut out = Prepared {

@@ -4,9 +4,11 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
-use super::NoiseFit;
+use super::candidates::DetectorSetting;
+use super::layout::NoiseFit;
+use super::roc::RocPoint;
 use super::runs::Outcome;
-use crate::datasets::quadrotor::{IMU_RATE_HZ, SkippedTrial, skipped_lines};
+use crate::datasets::quadrotor::{IMU_RATE_HZ, Repairs, SkippedTrial, skipped_lines};
 
 /// Detection and isolation of injected faults, counted. Delays are in faulty samples processed
 /// until the fuser flagged (1 = on the first faulty sample); the median and maximum are filled in
@@ -144,6 +146,23 @@ pub struct TrialReport {
     pub clipped_samples: usize,
     /// Row at which the faults are injected in the fault runs (the middle of the trial).
     pub fault_row: usize,
+    /// The detector setting this flight was scored with, chosen on the other flights.
+    pub setting: DetectorSetting,
+    /// Other flights whose installation rotations and lever arms were used for this one (0: its
+    /// own, no other flight had the same units).
+    pub geometry_flights_pooled: usize,
+}
+
+/// The setting a configuration would be deployed with: chosen on every flight, its false-alarm
+/// probability read off the cross-validated ROC.
+#[derive(Debug, Clone, Serialize)]
+pub struct OperatingPoint {
+    /// The configuration.
+    pub configuration: &'static str,
+    /// The chosen setting.
+    pub setting: DetectorSetting,
+    /// The cross-validated false alarms per flight hour at its false-alarm probability.
+    pub cv_false_alarms_per_hour: f64,
 }
 
 /// One configuration's figures over every trial.
@@ -154,10 +173,19 @@ pub struct ConfigurationSummary {
     pub configuration: &'static str,
     /// Channels per sensor type.
     pub channels: usize,
-    /// The channel noise σ fitted for it and used in every trial.
+    /// Flights evaluated in it.
+    pub flights: usize,
+    /// Their recorded time, h.
+    pub flight_hours: f64,
+    /// The reference σ (unit of the injected fault sizes, centre of the detector σ grid).
     pub noise: NoiseFit,
-    /// False alarm episodes over every trial, both types.
+    /// False alarm episodes over every flight, both types, each flight with the setting chosen
+    /// on the others.
     pub false_alarms: usize,
+    /// The same (the cross-validated figure, named as such).
+    pub cv_false_alarms: usize,
+    /// Those per flight hour.
+    pub cv_false_alarms_per_hour: f64,
     /// Detection and isolation of every fault run.
     #[serde(flatten)]
     pub tally: Tally,
@@ -176,8 +204,14 @@ pub struct FdiReport {
     pub flights_evaluated: usize,
     /// Recorded time of the evaluated flights, h (each configuration runs over all of it).
     pub flight_hours: f64,
-    /// Trials listed but not evaluated, with the reason.
+    /// Trials (or trial configurations) listed but not evaluated, with the reason.
     pub skipped: Vec<SkippedTrial>,
+    /// Flights with a single usable unit: no redundancy to monitor, listed, not evaluated.
+    pub single_unit: Vec<SkippedTrial>,
+    /// What the loader repaired in the recordings (and trials it could not load).
+    pub repairs: Repairs,
+    /// Detector settings in the grid the cross-validation chooses from.
+    pub settings_grid: usize,
     /// The data set's IMU rate, Hz.
     pub imu_rate_hz: f64,
     /// Gyro count resolution the data were quantised to, rad/s.
@@ -188,17 +222,25 @@ pub struct FdiReport {
     pub persistence: [u32; 2],
     /// Samples of the learning phase at the start of each run (no declarations).
     pub learning_samples: u32,
-    /// False alarm episodes over every trial, configuration and type.
+    /// False alarm episodes over every trial, configuration and type, each flight scored with the
+    /// setting chosen on the other flights.
     pub false_alarms: usize,
+    /// The same (the cross-validated figure, named as such).
+    pub cv_false_alarms: usize,
     /// Samples in an alarmed state without any fault, over every trial, configuration and type.
     pub false_alarm_samples: usize,
     /// Episodes of genuine over-range (not false alarms).
     pub over_range: usize,
     /// Scale-factor and misalignment disagreement allowed between channels, fraction of the
-    /// measured quantity ([`super::MOTION_NOISE_FRACTION`]).
+    /// measured quantity: the first configuration's operating point.
     pub motion_noise_fraction: f64,
-    /// Uncertainty of the sampling instants between units, s ([`super::TIMING_SKEW_S`]).
+    /// Uncertainty of the sampling instants between units, s: the first configuration's
+    /// operating point.
     pub timing_skew_s: f64,
+    /// The cross-validated ROC of every configuration.
+    pub roc: Vec<RocPoint>,
+    /// The setting each configuration would be deployed with.
+    pub operating_points: Vec<OperatingPoint>,
     /// Detection and isolation over every fault run.
     #[serde(flatten)]
     pub total: Tally,
@@ -228,7 +270,7 @@ pub fn to_table(r: &FdiReport) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "FDI on {} ({} of {} flights, {:.3} flight hours, {} Hz; persistence {}-of-{} samples; learning {} samples; lsb gyro {:.3e} rad/s, accel {:.3e} m/s²; motion noise {} of |x|, timing skew {} ms)\n",
+        "FDI on {} ({} of {} flights, {:.3} flight hours, {} Hz; persistence {}-of-{} samples; learning {} samples; lsb gyro {:.3e} rad/s, accel {:.3e} m/s²)\nEvery figure is leave-one-flight-out: each flight is scored with the detector setting chosen on the other flights from {} settings (false-alarm probability, detector σ, motion noise, timing skew), with the installation and lever arms of the other flights.\n",
         r.dir.display(),
         r.flights_evaluated,
         r.flights_total,
@@ -239,13 +281,24 @@ pub fn to_table(r: &FdiReport) -> String {
         r.learning_samples,
         r.gyro_lsb_rps,
         r.accel_lsb_mps2,
-        r.motion_noise_fraction,
-        r.timing_skew_s * 1e3
+        r.settings_grid,
     );
     s.push_str(&skipped_lines(&r.skipped));
+    s.push_str(&skipped_lines(&r.single_unit));
     let _ = writeln!(
         s,
-        "{:22} {:9} {:>6} {:>10} {:>10} {:>11} {:>11} {:>11} {:>11} {:>7}",
+        "repaired in the recordings: {} counter wraps, {} repeated timestamps, {} missing samples filled, {} non-finite rows, {} rows dropped, {} unit files skipped, {} trials not loadable\n",
+        r.repairs.counter_wraps,
+        r.repairs.repeated_timestamps,
+        r.repairs.missing_samples_filled,
+        r.repairs.non_finite_rows,
+        r.repairs.rows_dropped,
+        r.repairs.imu_files_skipped,
+        r.repairs.trials_failed
+    );
+    let _ = writeln!(
+        s,
+        "{:22} {:9} {:>6} {:>10} {:>10} {:>11} {:>11} {:>11} {:>11} {:>7} {:>28}",
         "trial",
         "config",
         "s",
@@ -255,12 +308,13 @@ pub fn to_table(r: &FdiReport) -> String {
         "T/thr acc",
         "σ̂ gyro °/s",
         "σ̂ acc m/s²",
-        "clipped"
+        "clipped",
+        "setting: Pfa σ× motion skew"
     );
     for t in &r.per_trial {
         let _ = writeln!(
             s,
-            "{:22} {:9} {:>6.1} {:>10} {:>10} {:>11.2} {:>11.2} {:>11.3} {:>11.3} {:>7}",
+            "{:22} {:9} {:>6.1} {:>10} {:>10} {:>11.2} {:>11.2} {:>11.3} {:>11.3} {:>7} {:>28}",
             t.trial,
             t.configuration,
             t.seconds,
@@ -270,7 +324,8 @@ pub fn to_table(r: &FdiReport) -> String {
             t.max_t_over_threshold[1],
             t.sigma_hat[0].to_degrees(),
             t.sigma_hat[1],
-            t.clipped_samples
+            t.clipped_samples,
+            setting_text(&t.setting)
         );
         for e in &t.alarm_episodes {
             let _ = writeln!(
@@ -282,9 +337,24 @@ pub fn to_table(r: &FdiReport) -> String {
     }
     let _ = writeln!(
         s,
-        "\nfalse alarms (episodes without a fault): {} ({} samples); genuine over-range episodes (Suspect, not alarms): {}\n",
-        r.false_alarms, r.false_alarm_samples, r.over_range
+        "\ncross-validated false alarms (episodes without a fault): {} ({} samples, {:.2} per flight hour); genuine over-range episodes (Suspect, not alarms): {}",
+        r.cv_false_alarms,
+        r.false_alarm_samples,
+        r.cv_false_alarms as f64 / r.flight_hours.max(f64::MIN_POSITIVE),
+        r.over_range
     );
+    for c in &r.configurations {
+        let _ = writeln!(
+            s,
+            "  {:9}: {} episodes in {} flights ({:.3} h): {:.2} per flight hour",
+            c.configuration,
+            c.cv_false_alarms,
+            c.flights,
+            c.flight_hours,
+            c.cv_false_alarms_per_hour
+        );
+    }
+    let _ = writeln!(s);
     let _ = writeln!(
         s,
         "{:9} {:5} {:10} {:>15} {:>15} {:>15} {:>17} {:>17}",
@@ -338,6 +408,56 @@ pub fn to_table(r: &FdiReport) -> String {
             opt(t.detection_delay_ms_max),
             opt(t.isolation_delay_ms_p50),
             opt(t.isolation_delay_ms_max),
+        );
+    }
+    s.push_str(&roc_table(r));
+    s
+}
+
+fn setting_text(t: &DetectorSetting) -> String {
+    format!(
+        "{:.0e} {:.1} {:.3} {:.0}ms",
+        t.false_alarm_probability,
+        t.noise_scale,
+        t.motion_noise_fraction,
+        t.timing_skew_s * 1e3
+    )
+}
+
+/// The cross-validated ROC and the operating points as text.
+fn roc_table(r: &FdiReport) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::from(
+        "\ncross-validated ROC (each flight with the other settings chosen on the other flights):\n",
+    );
+    let kinds: Vec<&str> = r
+        .roc
+        .first()
+        .map(|p| p.detection.iter().map(|d| d.fault.as_str()).collect())
+        .unwrap_or_default();
+    let _ = write!(s, "{:9} {:>7} {:>5} {:>7}", "config", "Pfa", "FA", "FA/h");
+    for k in &kinds {
+        let _ = write!(s, " {k:>11}");
+    }
+    let _ = writeln!(s);
+    for p in &r.roc {
+        let _ = write!(
+            s,
+            "{:9} {:>7.0e} {:>5} {:>7.2}",
+            p.configuration, p.false_alarm_probability, p.false_alarms, p.false_alarms_per_hour
+        );
+        for d in &p.detection {
+            let _ = write!(s, " {:>10.1}%", 100.0 * d.rate);
+        }
+        let _ = writeln!(s);
+    }
+    for o in &r.operating_points {
+        let _ = writeln!(
+            s,
+            "operating point {:9}: {} (Pfa, σ×, motion, skew; {:.2} false alarms per flight hour cross-validated)",
+            o.configuration,
+            setting_text(&o.setting),
+            o.cv_false_alarms_per_hour
         );
     }
     s

@@ -2,11 +2,12 @@
 
 use anyhow::{Result, anyhow};
 use ipc_types::ChannelState;
-use rins_fusion::fdi::channel_health::COUNT_MAX;
 use rins_fusion::{FusionConfig, ImuFuser, SensorStatus};
 
+use super::faults::{FaultKind, Injector};
+use super::layout::Sensor;
 use super::prepare::Prepared;
-use super::{FaultKind, Sensor};
+use crate::datasets::quadrotor::IMU_RATE_HZ;
 
 /// Anything but all-Ok on one side.
 fn alarmed(s: &SensorStatus) -> bool {
@@ -40,15 +41,24 @@ fn full_valid(n: usize) -> u32 {
     m | m << rins_fusion::fuser::ACCEL_MASK_SHIFT
 }
 
-pub(crate) fn run_fault(
-    snapshot: &ImuFuser,
-    p: &Prepared,
-    t0: usize,
-    sensor: Sensor,
-    ch: usize,
-    kind: FaultKind,
-    bias_counts: f64,
-) -> Outcome {
+/// One injected fault: its kind, the faulty channel and type, and the reference σ in counts.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FaultRun {
+    pub sensor: Sensor,
+    pub channel: usize,
+    pub kind: FaultKind,
+    pub sigma_counts: f64,
+}
+
+/// Runs the fuser from the fault-free `snapshot` at row `t0` with `fault` injected from there on,
+/// until the fuser excludes a channel or the flight ends.
+pub(crate) fn run_fault(snapshot: &ImuFuser, p: &Prepared, t0: usize, fault: FaultRun) -> Outcome {
+    let FaultRun {
+        sensor,
+        channel: ch,
+        kind,
+        sigma_counts,
+    } = fault;
     let mut fuser = snapshot.clone();
     // Exclusions the fault-free run had already latched do not count for this fault.
     let before = match sensor {
@@ -68,23 +78,22 @@ pub(crate) fn run_fault(
         Sensor::Gyro => p.gyro[t0.saturating_sub(1)][ch],
         Sensor::Accel => p.accel[t0.saturating_sub(1)][ch],
     };
+    // The noise differs from channel to channel and type to type, and is the same in every run.
+    let seed = (t0 as u64) << 16 | (ch as u64) << 1 | sensor as u64;
+    let mut injector = Injector::new(kind, sigma_counts, IMU_RATE_HZ, frozen, seed);
+    let valid = if injector.valid() {
+        valid_all
+    } else {
+        valid_all & !(1 << (ch as u32 + shift))
+    };
     for k in t0..p.gyro.len() {
         let mut g = p.gyro[k];
         let mut a = p.accel[k];
-        let mut valid = valid_all;
         let target = match sensor {
             Sensor::Gyro => &mut g,
             Sensor::Accel => &mut a,
         };
-        match kind {
-            FaultKind::Dead => valid &= !(1 << (ch as u32 + shift)),
-            FaultKind::Stuck => target[ch] = frozen,
-            FaultKind::Bias(_) => {
-                let c = (f64::from(target[ch]) + bias_counts).round();
-                target[ch] = c.clamp(-2048.0, f64::from(COUNT_MAX)) as i16;
-            }
-            FaultKind::Saturated => target[ch] = COUNT_MAX,
-        }
+        target[ch] = injector.apply(k - t0, target[ch]);
         let fused = fuser.fuse(&g[..p.n], &a[..p.n], valid);
         let status = match sensor {
             Sensor::Gyro => &fused.gyro_status,

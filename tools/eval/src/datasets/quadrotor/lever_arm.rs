@@ -185,18 +185,12 @@ mod tests {
         let installation = Installation {
             reference_imu: 1,
             imus: (0..arms.len())
-                .map(
-                    |k| crate::datasets::quadrotor::projection::ImuInstallation {
-                        imu: k + 1,
-                        rotation: Rotation3::identity(),
-                        angle_deg: 0.0,
-                        residual_unrotated_dps: 0.0,
-                        residual_dps: 0.0,
-                        residual_centred_dps: 0.0,
-                        residual_low_pass_dps: 0.0,
-                        bias_difference_dps: [0.0; 3],
-                    },
-                )
+                .map(|k| {
+                    crate::datasets::quadrotor::projection::ImuInstallation::fixture(
+                        k + 1,
+                        Rotation3::identity(),
+                    )
+                })
                 .collect(),
         };
         let trial = Trial {

@@ -45,6 +45,23 @@ pub struct ImuInstallation {
     pub bias_difference_dps: [f64; 3],
 }
 
+impl ImuInstallation {
+    /// A unit turned by `rotation` with no residuals: a test fixture.
+    #[cfg(test)]
+    pub(crate) fn fixture(imu: usize, rotation: Rotation3<f64>) -> Self {
+        Self {
+            imu,
+            rotation,
+            angle_deg: 0.0,
+            residual_unrotated_dps: 0.0,
+            residual_dps: 0.0,
+            residual_centred_dps: 0.0,
+            residual_low_pass_dps: 0.0,
+            bias_difference_dps: [0.0; 3],
+        }
+    }
+}
+
 /// Every IMU of a trial against the reference (the first IMU, whose entry is the identity).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Installation {
