@@ -56,7 +56,7 @@ pub struct HealthSettings {
 }
 
 /// What the checks found on one sample (bit i = channel i).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct HealthFindings {
     /// At a rail now.
     pub at_rail: u32,
@@ -68,6 +68,9 @@ pub struct HealthFindings {
     pub noisy: u32,
     /// A noise block ended on this sample (`noisy` is a fresh verdict).
     pub noise_verdict: bool,
+    /// With a verdict: the largest channel noise level over `noise_ratio` times its peers'
+    /// median (above 1 = a noise outlier), the margin of the check; 0 without a verdict.
+    pub noise_peak: f64,
 }
 
 /// Channels whose axes are at most this far apart (either sense) are compared with each other in
@@ -193,7 +196,7 @@ impl ChannelHealth {
         self.block_samples += 1;
         if self.block_samples >= s.noise_window {
             found.noise_verdict = true;
-            found.noisy = self.noise_outliers(usable);
+            (found.noisy, found.noise_peak) = self.noise_outliers(usable);
             self.block_samples = 0;
             self.diff_sum = [0.0; MAX_CHANNELS];
             self.diff_count = [0; MAX_CHANNELS];
@@ -203,8 +206,9 @@ impl ChannelHealth {
 
     /// Channels whose mean normalised squared difference over the block exceeds `noise_ratio`
     /// times the median of the other eligible channels' (at least two others needed): its peers
-    /// along the same axis when two or more are eligible, otherwise all.
-    fn noise_outliers(&self, usable: u32) -> u32 {
+    /// along the same axis when two or more are eligible, otherwise all. Also the largest ratio
+    /// of a level to its bound (see [`HealthFindings::noise_peak`]).
+    fn noise_outliers(&self, usable: u32) -> (u32, f64) {
         let min_count = (self.settings.noise_window / 2).max(1);
         let mut level = [0.0; MAX_CHANNELS];
         let mut eligible = 0u32;
@@ -215,6 +219,7 @@ impl ChannelHealth {
             }
         }
         let mut noisy = 0;
+        let mut peak: f64 = 0.0;
         for (i, &li) in level.iter().enumerate().take(self.n) {
             if eligible & (1 << i) == 0 {
                 continue;
@@ -241,11 +246,15 @@ impl ChannelHealth {
             } else {
                 0.5 * (others[k / 2 - 1] + others[k / 2])
             };
-            if li > self.settings.noise_ratio * median {
+            let bound = self.settings.noise_ratio * median;
+            if li > bound {
                 noisy |= 1 << i;
             }
+            if bound > 0.0 {
+                peak = peak.max(li / bound);
+            }
         }
-        noisy
+        (noisy, peak)
     }
 
     /// Restarts the histories of `channel` (after it is returned to service).
@@ -276,6 +285,10 @@ mod tests {
 
     /// Noise verdict after one window of white noise with per-channel σ `sigma` (configured σ 1).
     fn noisy_after_a_window(axes: &[[f64; 3]], sigma: &[f64]) -> u32 {
+        verdict_after_a_window(axes, sigma).noisy
+    }
+
+    fn verdict_after_a_window(axes: &[[f64; 3]], sigma: &[f64]) -> HealthFindings {
         let mut health = ChannelHealth::new(axes, &[1.0; MAX_CHANNELS], SETTINGS);
         let mut rng = ChaCha8Rng::seed_from_u64(11);
         let usable = (1u32 << axes.len()) - 1;
@@ -289,8 +302,9 @@ mod tests {
             }
             let found = health.check(&counts[..axes.len()], &z, usable);
             if found.noise_verdict {
-                return found.noisy;
+                return found;
             }
+            assert_eq!(found.noise_peak, 0.0, "a margin only with a verdict");
         }
         panic!("no verdict within one window");
     }
@@ -314,6 +328,30 @@ mod tests {
         let mut sigma = [1.0, 1.0, 6.0, 1.0, 1.0, 6.0, 1.0, 1.0, 6.0];
         sigma[5] = 60.0;
         assert_eq!(noisy_after_a_window(&three_triads(), &sigma), 1 << 5);
+    }
+
+    #[test]
+    fn the_margin_is_the_loudest_channel_over_its_bound() {
+        // Channel 5 at 3× its z peers' σ: variance ratio 9 against the bound 25, margin ≈ 0.36
+        // (the block's 200 samples estimate each variance within about ±10 % each).
+        let mut sigma = [1.0, 1.0, 6.0, 1.0, 1.0, 6.0, 1.0, 1.0, 6.0];
+        sigma[5] = 18.0;
+        let found = verdict_after_a_window(&three_triads(), &sigma);
+        assert_eq!(found.noisy, 0);
+        assert!(
+            (found.noise_peak - 9.0 / 25.0).abs() < 0.1,
+            "{}",
+            found.noise_peak
+        );
+        // At 6× its peers: ratio 36 > 25, flagged, margin above 1.
+        sigma[5] = 36.0;
+        let found = verdict_after_a_window(&three_triads(), &sigma);
+        assert_eq!(found.noisy, 1 << 5);
+        assert!(
+            (found.noise_peak - 36.0 / 25.0).abs() < 0.3,
+            "{}",
+            found.noise_peak
+        );
     }
 
     #[test]

@@ -31,6 +31,10 @@ pub struct SensorStatus {
     pub block_saturated: bool,
     /// Channels re-admitted by the recovery re-test on this sample (see [`super::recovery`]).
     pub auto_readmitted: u32,
+    /// When a noise-outlier block ended on this sample: the largest channel noise over its bound
+    /// (above 1 = an outlier); 0 otherwise. The margin of that check, as T / threshold is the
+    /// parity test's.
+    pub noise_peak: f64,
 }
 
 impl SensorStatus {
@@ -47,6 +51,7 @@ impl SensorStatus {
         learning: false,
         block_saturated: false,
         auto_readmitted: 0,
+        noise_peak: 0.0,
     };
 
     /// Channels in state `state` (bit i = channel i).

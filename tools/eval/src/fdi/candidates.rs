@@ -1,10 +1,11 @@
 //! The detector settings the evaluation chooses from, and the fuser configuration of each.
 //!
-//! Four settings are tuned from data, each over a small grid: the false-alarm probability (the
+//! Five settings are tuned from data, each over a small grid: the false-alarm probability (the
 //! parity threshold), the channel noise σ given to the detector (a multiple of the
 //! configuration's reference σ, which seeds the adaptive parity noise), the motion noise fraction
-//! (scale-factor and misalignment disagreement between units) and the timing skew (uncertainty of
-//! the sampling instants between units). No setting is ever chosen on the flight it is scored on
+//! (scale-factor and misalignment disagreement between units), the timing skew (uncertainty of
+//! the sampling instants between units) and the noise-outlier ratio (the channel-health check's
+//! threshold). No setting is ever chosen on the flight it is scored on
 //! (see [`super::cross_validation`]).
 
 use rins_fusion::{ChannelNoise, FdiConfig, FusionConfig, NoiseConfig, ParityNoise, PerSensor};
@@ -19,10 +20,14 @@ pub const FALSE_ALARM_PROBABILITIES: [f64; 5] = [1e-6, 1e-8, 1e-10, 1e-12, 1e-14
 pub const NOISE_SCALES: [f64; 3] = [0.7, 1.0, 1.4];
 /// Scale-factor and misalignment disagreement between units, fraction of |x|: consumer MEMS
 /// units are specified at 1–2 % each, plus the error of the estimated installation.
-pub const MOTION_NOISE_FRACTIONS: [f64; 3] = [0.015, 0.03, 0.06];
+pub const MOTION_NOISE_FRACTIONS: [f64; 2] = [0.02, 0.05];
 /// Uncertainty of the sampling instants between units, s: each unit samples somewhere in its
 /// own 8.3 ms period, and the sub-row lag estimate wanders.
-pub const TIMING_SKEWS_S: [f64; 3] = [0.003, 0.006, 0.012];
+pub const TIMING_SKEWS_S: [f64; 2] = [0.004, 0.010];
+/// Noise-outlier thresholds: a channel's first-difference variance over the median of its
+/// peers' (25: the product's default; the separate units of the recordings vibrate unlike each
+/// other far more than the channels of one block).
+pub const NOISE_RATIOS: [f64; 2] = [25.0, 60.0];
 /// Learning phase of the parity offset and adaptive noise, s (declarations suspended).
 pub const LEARNING_S: f64 = 2.0;
 /// Averaging length of the adaptive parity noise, s.
@@ -39,6 +44,8 @@ pub struct DetectorSetting {
     pub motion_noise_fraction: f64,
     /// Sampling-instant uncertainty between units, s.
     pub timing_skew_s: f64,
+    /// Noise-outlier threshold (variance ratio).
+    pub noise_ratio: f64,
 }
 
 /// Every setting of the grid, grouped by false-alarm probability in the order of
@@ -49,12 +56,15 @@ pub fn grid() -> Vec<DetectorSetting> {
         for noise_scale in NOISE_SCALES {
             for motion_noise_fraction in MOTION_NOISE_FRACTIONS {
                 for timing_skew_s in TIMING_SKEWS_S {
-                    v.push(DetectorSetting {
-                        false_alarm_probability,
-                        noise_scale,
-                        motion_noise_fraction,
-                        timing_skew_s,
-                    });
+                    for noise_ratio in NOISE_RATIOS {
+                        v.push(DetectorSetting {
+                            false_alarm_probability,
+                            noise_scale,
+                            motion_noise_fraction,
+                            timing_skew_s,
+                            noise_ratio,
+                        });
+                    }
                 }
             }
         }
@@ -79,6 +89,7 @@ pub(crate) fn fusion_config(
     fdi.adaptive_window = (ADAPTIVE_WINDOW_S * IMU_RATE_HZ) as u32;
     fdi.motion_noise_fraction = setting.motion_noise_fraction;
     fdi.timing_skew_s = setting.timing_skew_s;
+    fdi.noise_ratio = setting.noise_ratio;
     FusionConfig {
         geometry: PerSensor {
             gyro: layout.geometry(),
@@ -105,7 +116,7 @@ mod tests {
     #[test]
     fn the_grid_holds_every_combination_once_grouped_by_probability() {
         let g = grid();
-        assert_eq!(g.len(), 5 * 3 * 3 * 3);
+        assert_eq!(g.len(), 5 * 3 * 2 * 2 * 2);
         let per = g.len() / FALSE_ALARM_PROBABILITIES.len();
         for (i, p) in FALSE_ALARM_PROBABILITIES.iter().enumerate() {
             assert!(

@@ -6,12 +6,12 @@
 //!    [`HEALTH_TARGET`] of the channel-health faults (dead, stuck, saturated) and
 //!    [`BIAS_TARGET`] of the largest bias steps detected;
 //! 2. then the fewest false-alarm episodes on the training flights;
-//! 3. then the largest margin: the lowest peak of the parity statistic over its threshold on any
-//!    training flight (a setting that only just stayed quiet on the training flights is the one
-//!    that alarms on the next flight: choosing on the subtle faults' detection instead tripled
-//!    the held-out false alarms);
-//! 4. then the most detections of the subtle faults (the smaller steps, the ramp, the noise
-//!    increase);
+//! 3. then a safety factor: the fault-free checks (parity statistic, noise-outlier level) must
+//!    have stayed below [`MARGIN`] of their thresholds on every training flight. A setting that
+//!    only just stayed quiet on the training flights is the one that alarms on the next flight:
+//!    choosing on detection alone tripled the held-out false alarms;
+//! 4. among settings with that margin, the most detections of the subtle faults (the smaller
+//!    steps, the ramp, the noise increase); among settings without it, the largest margin;
 //! 5. then the first in grid order.
 //!
 //! A configuration seen on one flight only has nothing to learn from: that flight is scored with
@@ -24,6 +24,10 @@ use super::table::FlightOutcome;
 pub const HEALTH_TARGET: f64 = 0.99;
 /// Fraction of the largest bias steps a setting must detect on the training flights.
 pub const BIAS_TARGET: f64 = 0.95;
+/// Largest fraction of its threshold a fault-free check may reach on the training flights for
+/// the setting to count as having margin: a factor two of headroom, the usual engineering
+/// factor between the largest fault-free statistic seen and the threshold.
+pub const MARGIN: f64 = 0.5;
 
 /// How good a setting was on a set of flights (the rule's keys).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,12 +49,14 @@ impl Score {
             Less => return false,
             _ => {}
         }
-        match other.peak_ratio.total_cmp(&self.peak_ratio) {
-            Greater => return true,
-            Less => return false,
-            _ => {}
+        let (mine, theirs) = (self.peak_ratio <= MARGIN, other.peak_ratio <= MARGIN);
+        if mine != theirs {
+            return mine;
         }
-        self.subtle_detected > other.subtle_detected
+        if mine && self.subtle_detected != other.subtle_detected {
+            return self.subtle_detected > other.subtle_detected;
+        }
+        self.peak_ratio < other.peak_ratio
     }
 }
 
@@ -67,7 +73,7 @@ fn score(
     for &f in flights {
         let o = &table[f][setting];
         false_alarms += o.false_alarm_episodes();
-        peak_ratio = o.max_t_ratio.iter().fold(peak_ratio, |m, r| m.max(*r));
+        peak_ratio = peak_ratio.max(o.peak_ratio());
         for (i, t) in o.tallies.iter().enumerate() {
             let kind = faults[i % faults.len()];
             if kind.is_health() {
@@ -150,6 +156,7 @@ mod tests {
             false_alarm_samples: [0; 2],
             over_range: [0; 2],
             max_t_ratio: [peak, 0.0],
+            max_noise_peak: [0.0; 2],
             alarm_starts: Vec::new(),
             tallies: detected
                 .iter()
@@ -179,13 +186,18 @@ mod tests {
         assert_eq!(choose(&table, &[0, 1], &[0, 1, 2, 3], &kinds()), Some(3));
         assert_eq!(choose(&table, &[0, 1], &[0, 1, 2], &kinds()), Some(2));
         assert_eq!(choose(&table, &[0, 1], &[0, 1], &kinds()), Some(1));
-        // Between clean settings the larger margin wins over more subtle detections.
+        // Between clean settings: the one with margin wins over more subtle detections; with
+        // margin both, the more sensitive one; without, the larger margin.
         let row = vec![
             with_peak(0, [10, 10, 9], 0.9),
             with_peak(0, [10, 10, 2], 0.4),
+            with_peak(0, [10, 10, 3], 0.45),
+            with_peak(0, [10, 10, 9], 0.7),
         ];
         let table = vec![row.clone(), row];
         assert_eq!(choose(&table, &[0, 1], &[0, 1], &kinds()), Some(1));
+        assert_eq!(choose(&table, &[0, 1], &[0, 1, 2], &kinds()), Some(2));
+        assert_eq!(choose(&table, &[0, 1], &[0, 3], &kinds()), Some(3));
     }
 
     #[test]

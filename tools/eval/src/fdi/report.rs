@@ -298,7 +298,7 @@ pub fn to_table(r: &FdiReport) -> String {
     );
     let _ = writeln!(
         s,
-        "{:22} {:9} {:>6} {:>10} {:>10} {:>11} {:>11} {:>11} {:>11} {:>7} {:>28}",
+        "{:22} {:9} {:>6} {:>10} {:>10} {:>11} {:>11} {:>11} {:>11} {:>7} {:>34}",
         "trial",
         "config",
         "s",
@@ -309,12 +309,12 @@ pub fn to_table(r: &FdiReport) -> String {
         "σ̂ gyro °/s",
         "σ̂ acc m/s²",
         "clipped",
-        "setting: Pfa σ× motion skew"
+        "setting: Pfa σ× motion skew noise"
     );
     for t in &r.per_trial {
         let _ = writeln!(
             s,
-            "{:22} {:9} {:>6.1} {:>10} {:>10} {:>11.2} {:>11.2} {:>11.3} {:>11.3} {:>7} {:>28}",
+            "{:22} {:9} {:>6.1} {:>10} {:>10} {:>11.2} {:>11.2} {:>11.3} {:>11.3} {:>7} {:>34}",
             t.trial,
             t.configuration,
             t.seconds,
@@ -416,11 +416,12 @@ pub fn to_table(r: &FdiReport) -> String {
 
 fn setting_text(t: &DetectorSetting) -> String {
     format!(
-        "{:.0e} {:.1} {:.3} {:.0}ms",
+        "{:.0e} {:.1} {:.2} {:.0}ms {:.0}",
         t.false_alarm_probability,
         t.noise_scale,
         t.motion_noise_fraction,
-        t.timing_skew_s * 1e3
+        t.timing_skew_s * 1e3,
+        t.noise_ratio
     )
 }
 
@@ -454,7 +455,7 @@ fn roc_table(r: &FdiReport) -> String {
     for o in &r.operating_points {
         let _ = writeln!(
             s,
-            "operating point {:9}: {} (Pfa, σ×, motion, skew; {:.2} false alarms per flight hour cross-validated)",
+            "operating point {:9}: {} (Pfa, σ×, motion, skew, noise ratio; {:.2} false alarms per flight hour cross-validated)",
             o.configuration,
             setting_text(&o.setting),
             o.cv_false_alarms_per_hour

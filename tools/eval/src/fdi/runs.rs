@@ -134,6 +134,8 @@ pub(crate) struct CleanRun {
     pub samples: [usize; 2],
     /// Largest T / threshold after learning, per type.
     pub max_t_ratio: [f64; 2],
+    /// Largest noise-outlier margin after learning, per type (above 1 = a noisy channel).
+    pub max_noise_peak: [f64; 2],
     /// Each alarm episode's sensor, first row and reason.
     pub starts: Vec<(Sensor, usize, &'static str)>,
     pub snapshot: Option<ImuFuser>,
@@ -152,6 +154,7 @@ pub(crate) fn run_clean(
         episodes: [0; 2],
         samples: [0; 2],
         max_t_ratio: [0.0; 2],
+        max_noise_peak: [0.0; 2],
         starts: Vec::new(),
         snapshot: None,
     };
@@ -186,6 +189,9 @@ pub(crate) fn run_clean(
             was[j] = a;
             if !s.learning && s.threshold.is_finite() {
                 run.max_t_ratio[j] = run.max_t_ratio[j].max(s.test_statistic / s.threshold);
+            }
+            if !s.learning {
+                run.max_noise_peak[j] = run.max_noise_peak[j].max(s.noise_peak);
             }
         }
     }

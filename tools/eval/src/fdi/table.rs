@@ -45,6 +45,8 @@ pub(crate) struct FlightOutcome {
     pub false_alarm_samples: [usize; 2],
     pub over_range: [usize; 2],
     pub max_t_ratio: [f64; 2],
+    /// Largest noise-outlier margin, gyro and accel.
+    pub max_noise_peak: [f64; 2],
     /// Each false alarm's sensor, first row and reason.
     pub alarm_starts: Vec<(Sensor, usize, &'static str)>,
     /// Detection and isolation per sensor type and fault kind: index `sensor · kinds + kind`.
@@ -54,6 +56,15 @@ pub(crate) struct FlightOutcome {
 impl FlightOutcome {
     pub(crate) fn false_alarm_episodes(&self) -> usize {
         self.false_alarms.iter().sum()
+    }
+
+    /// The closest any fault-free check came to alarming, as a fraction of its threshold: the
+    /// parity statistic or the noise-outlier level, either type.
+    pub(crate) fn peak_ratio(&self) -> f64 {
+        self.max_t_ratio
+            .iter()
+            .chain(&self.max_noise_peak)
+            .fold(0.0, |m, r| m.max(*r))
     }
 }
 
@@ -74,6 +85,7 @@ pub(crate) fn run_setting(
         false_alarm_samples: clean.samples,
         over_range: clean.over_range,
         max_t_ratio: clean.max_t_ratio,
+        max_noise_peak: clean.max_noise_peak,
         alarm_starts: clean.starts,
         tallies: vec![Tally::default(); 2 * faults.len()],
     };

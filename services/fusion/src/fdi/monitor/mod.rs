@@ -220,6 +220,7 @@ impl SensorMonitor {
             saturated_suspect,
             block_saturated: active.count_ones() >= 3 && (active & !found.at_rail).count_ones() < 3,
             auto_readmitted: self.retest_exclusions(input),
+            noise_peak: found.noise_peak,
         };
 
         // The solution before the test sets the motion's share of the noise for this sample.

@@ -25,6 +25,8 @@ pub(super) struct HealthOutcome {
     pub block_saturated: bool,
     /// Channels the recovery re-test returned on this sample.
     pub auto_readmitted: u32,
+    /// The noise-outlier check's margin on this sample (see [`SensorStatus::noise_peak`]).
+    pub noise_peak: f64,
 }
 
 impl SensorMonitor {
@@ -48,6 +50,7 @@ impl SensorMonitor {
             learning: parity.learning,
             block_saturated: health.block_saturated,
             auto_readmitted: health.auto_readmitted,
+            noise_peak: health.noise_peak,
             ..SensorStatus::ABSENT
         };
         for i in 0..n {
