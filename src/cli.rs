@@ -206,8 +206,9 @@ pub struct EvalFdiArgs {
     /// One JSON object on stdout instead of tables.
     #[arg(long)]
     pub json: bool,
-    /// Configuration file (its `[fusion.fdi]` settings are used; geometry and noise are the
-    /// evaluation's).
+    /// Configuration file (its `[fusion.fdi]` settings are used, except those the evaluation
+    /// chooses by cross-validation: false-alarm probability, noise, motion noise, timing skew,
+    /// noise-outlier ratio; geometry is the evaluation's).
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// Only trials whose name contains this text, e.g. `Horizontal/path_1`. Repeatable.
