@@ -1,5 +1,7 @@
 //! Per-channel gyro biases from the start-up window at rest: subtracted channel by channel, so a
-//! later exclusion does not step the fused rate by the remaining channels' projected biases.
+//! later exclusion does not step the fused rate by the remaining channels' projected biases; and
+//! what the window leaves or never had (its own error, a later drift, no window at all): the mean
+//! parity, taken out of the solve at the exclusion.
 
 mod fuser_block;
 
@@ -42,28 +44,57 @@ fn mean(frames: &[Fused]) -> [f64; 3] {
     fuser_block::mean_rate(frames)
 }
 
-/// Step of the mean fused rate across the exclusion, and its noise-only σ per axis: the means of
-/// two independent runs of `SIDE` samples (4 then 3 channels), plus the bias estimate's own error
-/// (σ²/W per channel) projected through the difference of the two solvers.
-fn step_and_sigma(block: &Block, frames: &[Fused], window: usize) -> ([f64; 3], [f64; 3]) {
-    let before = mean(&frames[EXCLUDE_AT - SIDE..EXCLUDE_AT]);
-    let after = mean(&frames[EXCLUDE_AT..]);
+/// (G3 − G4) y: the step an exclusion of [`DROPPED`] makes of channel values y left in the solve.
+fn projected_step(block: &Block, y: &[f64; 4]) -> [f64; 3] {
+    let v = channel_variance();
+    let full = WlsSolver::new(&block.gyro, 0b1111, &[v; 4]).unwrap();
+    let three = WlsSolver::new(&block.gyro, 0b1111 & !DROPPED, &[v; 4]).unwrap();
+    std::array::from_fn(|a| three.solve(y).0[a] - full.solve(y).0[a])
+}
+
+/// Size of `step` in units of `sigma`, over the three axes.
+fn in_sigmas(step: &[f64; 3], sigma: &[f64; 3]) -> f64 {
+    (0..3)
+        .map(|a| (step[a] / sigma[a]).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// Step of the mean fused rate across an exclusion at sample `at`: the `side` samples after it
+/// less the `side` before.
+fn step_at(frames: &[Fused], at: usize, side: usize) -> [f64; 3] {
+    let before = mean(&frames[at - side..at]);
+    let after = mean(&frames[at..at + side]);
+    std::array::from_fn(|a| after[a] - before[a])
+}
+
+/// Noise-only σ per axis of [`step_at`]: the means of two independent runs of `side` samples
+/// (4 then 3 channels), plus the error of a bias estimate over `window` samples (σ²/W per
+/// channel) projected through the difference of the two solvers.
+fn step_sigma(block: &Block, window: usize, side: usize) -> [f64; 3] {
     let v = channel_variance();
     let full = WlsSolver::new(&block.gyro, 0b1111, &[v; 4]).unwrap();
     let three = WlsSolver::new(&block.gyro, 0b1111 & !DROPPED, &[v; 4]).unwrap();
     let (c4, c3) = (full.covariance(), three.covariance());
     let estimate_var = if window > 0 { v / window as f64 } else { 0.0 };
-    let sigma = std::array::from_fn(|a| {
-        // (G3 − G4) e for the estimate error e: variance Σ_i (G3 − G4)_ai² σ²/W.
-        let unit = |i: usize| {
-            let mut z = [0.0; 4];
-            z[i] = 1.0;
-            three.solve(&z).0[a] - full.solve(&z).0[a]
-        };
-        let projected: f64 = (0..4).map(|i| unit(i).powi(2) * estimate_var).sum();
-        ((c4[a][a] + c3[a][a]) / SIDE as f64 + projected).sqrt()
+    let units: [[f64; 3]; 4] = std::array::from_fn(|i| {
+        let mut z = [0.0; 4];
+        z[i] = 1.0;
+        projected_step(block, &z)
     });
-    (std::array::from_fn(|a| after[a] - before[a]), sigma)
+    std::array::from_fn(|a| {
+        // (G3 − G4) e for the estimate error e: variance Σ_i (G3 − G4)_ai² σ²/W.
+        let projected: f64 = units.iter().map(|u| u[a].powi(2) * estimate_var).sum();
+        ((c4[a][a] + c3[a][a]) / side as f64 + projected).sqrt()
+    })
+}
+
+/// [`step_at`] the exclusion of [`run`] and [`step_sigma`].
+fn step_and_sigma(block: &Block, frames: &[Fused], window: usize) -> ([f64; 3], [f64; 3]) {
+    (
+        step_at(frames, EXCLUDE_AT, SIDE),
+        step_sigma(block, window, SIDE),
+    )
 }
 
 #[test]
@@ -102,7 +133,7 @@ fn rest_bias_removes_the_step_at_an_exclusion() {
 }
 
 #[test]
-fn without_rest_bias_an_exclusion_steps_by_the_projected_bias_difference() {
+fn without_rest_bias_the_learnt_parity_offset_removes_the_step() {
     let cfg = FusionConfig {
         rest_bias_s: 0.0,
         ..FusionConfig::default()
@@ -111,25 +142,71 @@ fn without_rest_bias_an_exclusion_steps_by_the_projected_bias_difference() {
     assert_eq!(block.fuser.rest_bias_state(), RestBiasState::Disabled);
     assert!(block.fuser.gyro_rest_bias().iter().all(|b| *b == 0.0));
     assert!(frames.iter().all(|f| !f.gyro_status.detected_not_isolated));
-    let v = channel_variance();
-    let full = WlsSolver::new(&block.gyro, 0b1111, &[v; 4]).unwrap();
-    let three = WlsSolver::new(&block.gyro, 0b1011, &[v; 4]).unwrap();
-    let mut b = [0.0; 4];
-    b.copy_from_slice(&BIASES);
-    let expected: [f64; 3] = std::array::from_fn(|a| three.solve(&b).0[a] - full.solve(&b).0[a]);
-    let (step, sigma) = step_and_sigma(&block, &frames, 0);
+    // The biases' parity part is learnt over every sample before the exclusion (running mean),
+    // and taken out of the solve when the set changes: what is left is that mean's error.
+    let (step, sigma) = step_and_sigma(&block, &frames, EXCLUDE_AT);
     for a in 0..3 {
         assert!(
-            (step[a] - expected[a]).abs() < 4.5 * sigma[a],
-            "axis {a}: step {step:?} vs (G3 − G4) b = {expected:?}, σ {sigma:?}"
+            step[a].abs() < 4.5 * sigma[a],
+            "axis {a}: step {step:?}, σ {sigma:?}"
         );
     }
-    // The step is well outside the noise: the test above can tell the two apart.
-    let size: f64 = (0..3)
-        .map(|a| (expected[a] / sigma[a]).powi(2))
-        .sum::<f64>()
-        .sqrt();
-    assert!(size > 20.0, "step of {size} σ");
+    // Uncorrected, the exclusion would step by (G3 − G4) b, well outside the noise: the test
+    // above can tell the two apart.
+    let uncorrected = projected_step(&block, &BIASES);
+    assert!(in_sigmas(&uncorrected, &sigma) > 20.0, "{uncorrected:?}");
+}
+
+#[test]
+fn a_bias_drift_after_the_rest_window_is_taken_out_at_an_exclusion() {
+    // After the window the block turns steadily (in motion only the parity watches the
+    // channels); channel 0's bias then drifts by 1.5 σ (0.75 σ in the parity: below the
+    // threshold, so it is offset, not fault), and channel 2 drops out 18 s later.
+    const DRIFT_AT: usize = 2_000;
+    const EXCLUDE: usize = 20_000;
+    const LONG_SIDE: usize = 1_000;
+    let turn = [0.0, 0.0, 0.3];
+    let drift = 1.5 * default_gyro_sigma_rps();
+    let cfg = FusionConfig::default();
+    let window = cfg.rest_bias_samples().unwrap() as usize;
+    let mut block = Block::new(&cfg, 11);
+    block.gyro_bias = BIASES;
+    let frames: Vec<Fused> = (0..EXCLUDE + LONG_SIDE)
+        .map(|k| {
+            if k == DRIFT_AT {
+                block.gyro_bias[0] += drift;
+            }
+            let valid = if k < EXCLUDE {
+                ALL_VALID
+            } else {
+                ALL_VALID & !DROPPED
+            };
+            let rate = if k < window { ZERO } else { turn };
+            block.step(rate, AT_REST_FORCE, valid)
+        })
+        .collect();
+    assert!(block.fuser.rest_bias_estimated());
+    assert!(frames.iter().all(|f| !f.gyro_status.detected_not_isolated));
+    assert_eq!(frames[EXCLUDE].gyro_mask, 0b1011);
+    let step = step_at(&frames, EXCLUDE, LONG_SIDE);
+    // The mean parity is a running mean since the start: it holds the drift for the
+    // (EXCLUDE − DRIFT_AT) / EXCLUDE of its samples that had it, so the exclusion steps by the
+    // rest, DRIFT_AT / EXCLUDE = 10 % of (G3 − G4) δ; σ: the means across the exclusion and the
+    // mean's own error (σ²/EXCLUDE per channel).
+    let uncorrected = projected_step(&block, &[drift, 0.0, 0.0, 0.0]);
+    let left = DRIFT_AT as f64 / EXCLUDE as f64;
+    let sigma = step_sigma(&block, EXCLUDE, LONG_SIDE);
+    for a in 0..3 {
+        assert!(
+            (step[a] - left * uncorrected[a]).abs() < 4.5 * sigma[a],
+            "axis {a}: step {step:?}, expected {left} × {uncorrected:?}, σ {sigma:?}"
+        );
+    }
+    // A mean that followed at the parity offset's 1/60 000 per sample after the first second
+    // would still miss exp(−18 s / 60 s) = 74 % of the drift: far outside these bounds.
+    let slow = (-((EXCLUDE - DRIFT_AT) as f64) / 60_000.0).exp();
+    let gap: [f64; 3] = std::array::from_fn(|a| (slow - left) * uncorrected[a]);
+    assert!(in_sigmas(&gap, &sigma) > 10.0, "{gap:?} vs σ {sigma:?}");
 }
 
 #[test]

@@ -155,7 +155,10 @@ impl RedundantSensor {
         };
         let (estimate, status) = self.monitor.step(&input, stationary, events);
         let estimate = match self.kalman.as_mut() {
-            Some(kf) => Self::filter(kf, &self.geometry, &self.variances, estimate, &z),
+            Some(kf) => {
+                let z = self.monitor.corrected(&z);
+                Self::filter(kf, &self.geometry, &self.variances, estimate, &z)
+            }
             None => estimate,
         };
         (estimate, status)

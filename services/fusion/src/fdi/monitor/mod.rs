@@ -14,7 +14,9 @@
 //!    twins; see [`super::isolation`]); otherwise, while stationary, the reference may isolate
 //!    it among the contenders ([`super::stationary`]); otherwise the candidates are Suspect, the
 //!    fault is reported as detected-not-isolated, and every channel stays in the solution;
-//! 4. weighted least squares over the active set.
+//! 4. weighted least squares over the active set, on the values less the correction of
+//!    [`solve_correction`] (the parity part of the residual channel biases, taken up at each
+//!    reconfiguration so that the solution does not step).
 //!
 //! **Exclusions latch.** While the type has a solution, an excluded channel is never re-admitted
 //! automatically, not even when it looks healthy again. In 2005 the air data inertial reference
@@ -32,6 +34,7 @@
 
 mod health;
 mod parity_decision;
+mod solve_correction;
 mod status;
 
 use super::MAX_PARITY;
@@ -49,6 +52,7 @@ use crate::geometry::{Geometry, MAX_CHANNELS};
 use crate::wls::WlsSolver;
 use ipc_types::{ChannelState, FaultReason, SensorType};
 use parity_decision::motion_variance;
+use solve_correction::SolveCorrection;
 use status::{HealthOutcome, ParityOutcome};
 
 /// One sample of one sensor type as the monitor sees it.
@@ -137,6 +141,8 @@ pub struct SensorMonitor {
     /// The learnt parity offset in channel terms, as of the last parity space that had one: it
     /// outlives a loss of the parity space (fewer than four channels) and is carried into the next.
     channel_offset: [f64; MAX_CHANNELS],
+    /// Subtracted from the values before the solve (see [`solve_correction`]).
+    correction: SolveCorrection,
     /// Re-test of the exclusions while the type has no solution.
     retest: ExclusionRetest,
 }
@@ -189,6 +195,7 @@ impl SensorMonitor {
             last_x: [0.0; 3],
             motion_variance: 0.0,
             channel_offset: [0.0; MAX_CHANNELS],
+            correction: SolveCorrection::new(settings.parity_offset_window),
             retest: ExclusionRetest::default(),
         };
         monitor.reconfigure();
@@ -224,7 +231,11 @@ impl SensorMonitor {
         };
 
         // The solution before the test sets the motion's share of the noise for this sample.
-        let before_test = self.solver.as_ref().map(|s| (s.mask(), s.solve(z)));
+        let corrected = self.correction.apply(z);
+        let before_test = self
+            .solver
+            .as_ref()
+            .map(|s| (s.mask(), s.solve(&corrected)));
         if let Some((_, (x, _))) = &before_test {
             self.motion_variance = motion_variance(&self.settings, x, &self.last_x);
         }
@@ -234,7 +245,8 @@ impl SensorMonitor {
             Some(solver) => {
                 let (x, var) = match before_test {
                     Some((mask, solution)) if mask == solver.mask() => solution,
-                    _ => solver.solve(z),
+                    // The test reconfigured: the correction has moved with the set.
+                    _ => solver.solve(&self.correction.apply(z)),
                 };
                 self.last_x = x;
                 SensorEstimate {
@@ -274,6 +286,9 @@ impl SensorMonitor {
     /// the stationary reference move with them, so the removal neither raises a parity alarm nor
     /// spoils the reference. No allocation.
     pub fn subtract_channel_biases(&mut self, bias: &[f64; MAX_CHANNELS]) {
+        if let Some(solver) = &self.solver {
+            self.correction.shift(&self.geometry, solver, bias);
+        }
         if let (Some(space), Some(offset)) = (&self.parity, self.offset.as_mut()) {
             let dim = space.dimension();
             let mut vb = [0.0; MAX_PARITY];
@@ -326,6 +341,9 @@ impl SensorMonitor {
             _ => 1.0,
         };
         let old_parity = self.parity;
+        if let (Some(solver), Some(parity)) = (&self.solver, &self.parity) {
+            self.correction.rebase(&self.geometry, solver, parity);
+        }
         self.solver = WlsSolver::new(&self.geometry, mask, &self.variances[..n]).ok();
         self.parity = self
             .solver
@@ -356,6 +374,12 @@ impl SensorMonitor {
         self.window.clear();
         self.episode = 0;
         self.reference.clear_recent();
+    }
+
+    /// `z` less the correction the solution is computed on (see [`solve_correction`]); what
+    /// another estimator over the same channels must use.
+    pub fn corrected(&self, z: &[f64; MAX_CHANNELS]) -> [f64; MAX_CHANNELS] {
+        self.correction.apply(z)
     }
 
     /// Channels in service (bit i = channel i).

@@ -63,6 +63,7 @@ impl SensorMonitor {
             if let Some(offset) = self.offset.as_mut() {
                 offset.update(&raw, dim, learning_seen);
             }
+            self.correction.learn(space, z);
             let truncation = self.settings.truncation[dim];
             if let Some(estimate) = self.adaptive.as_mut()
                 && estimate.update(&p, learning_seen, truncation)
