@@ -45,7 +45,7 @@ pub enum Command {
         #[arg(long)]
         json: bool,
         /// Fail when no report arrives within this many seconds.
-        #[arg(long, default_value_t = 2.0)]
+        #[arg(long, allow_negative_numbers = true, default_value_t = 2.0)]
         timeout: f64,
     },
     /// Print every sample of a topic.
@@ -60,7 +60,7 @@ pub enum Command {
         #[arg(long)]
         csv: bool,
         /// Fail when no sample arrives for this many seconds (0: wait for ever).
-        #[arg(long, default_value_t = 10.0)]
+        #[arg(long, allow_negative_numbers = true, default_value_t = 10.0)]
         timeout: f64,
     },
     /// Inject a fault into one channel of the running simulator ("kill a sensor").
@@ -73,7 +73,7 @@ pub enum Command {
     /// Measure latency from serial receive through every stage to the navigation state.
     Latency {
         /// How long to measure, s.
-        #[arg(long, default_value_t = 5.0)]
+        #[arg(long, allow_negative_numbers = true, default_value_t = 5.0)]
         seconds: f64,
         /// One JSON object instead of the table.
         #[arg(long)]
@@ -119,7 +119,7 @@ pub struct CalibrateMagArgs {
     pub file: PathBuf,
     /// Local field magnitude, µT (default: mean magnitude of the samples once the hard iron is
     /// removed).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub field_ut: Option<f64>,
     /// One JSON object on stdout instead of the summary.
     #[arg(long)]
@@ -229,10 +229,10 @@ pub struct McArgs {
     #[arg(long)]
     pub runs: Option<usize>,
     /// Flight time simulated, s (default: the whole UAV profile).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub duration: Option<f64>,
     /// Time of the gyro kill, s (default 300 s, or half the flight when --duration is shorter).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub kill_at: Option<f64>,
     /// Worker threads.
     #[arg(long)]
@@ -291,7 +291,7 @@ pub struct UpArgs {
     #[arg(long)]
     pub scenario: Option<ScenarioArg>,
     /// Stop after this many seconds and exit 0.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub duration: Option<f64>,
     /// With --duration: print a JSON summary as the last line.
     #[arg(long)]
@@ -363,11 +363,11 @@ pub struct SimArgs {
     #[arg(long)]
     pub link: Option<PathBuf>,
     /// Stop after this many seconds (the uav scenario then flies its circuits for that long).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub duration: Option<f64>,
     /// Uav scenario: length of the flight, s, its circuits repeated as many times as fit
     /// (overrides sim.uav_flight_s; default: --duration).
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, allow_negative_numbers = true, value_name = "SECONDS")]
     pub flight_s: Option<f64>,
     /// Faults for the simulator to apply.
     #[command(flatten)]
@@ -378,16 +378,24 @@ pub struct SimArgs {
 #[derive(Debug, Clone, clap::Args)]
 pub struct SoakArgs {
     /// How long to run, minutes.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub minutes: f64,
     /// Seed of the fault schedule.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Shortest time between two faults, s.
-    #[arg(long = "min-interval", default_value_t = 2.0)]
+    #[arg(
+        long = "min-interval",
+        allow_negative_numbers = true,
+        default_value_t = 2.0
+    )]
     pub min_interval_s: f64,
     /// Longest time between two faults, s.
-    #[arg(long = "max-interval", default_value_t = 6.0)]
+    #[arg(
+        long = "max-interval",
+        allow_negative_numbers = true,
+        default_value_t = 6.0
+    )]
     pub max_interval_s: f64,
     /// Kinds of fault, comma-separated: kill (SIGKILL a service), hang (SIGSTOP a service until
     /// the watchdog replaces it), sensor (fault one gyro or accelerometer channel, then clear and

@@ -94,3 +94,18 @@ fn soak_refuses_bad_arguments_before_starting_anything() {
         &["--min-interval 3 / --max-interval 2"],
     );
 }
+
+/// A negative number reaches the range check, which names the option and the value, instead of
+/// being taken for an unknown option.
+#[test]
+fn negative_numbers_get_the_range_message() {
+    fails_with(
+        &["up", "--duration", "-5"],
+        &["--duration -5: must be a positive number of seconds"],
+    );
+    fails_with(
+        &["sim", "--duration", "-5"],
+        &["--duration -5: must be a positive number of seconds"],
+    );
+    fails_with(&["soak", "--minutes", "-1"], &["--minutes -1"]);
+}

@@ -42,6 +42,33 @@ fn echo_and_latency_read_a_running_pipeline() {
         assert_eq!(pair[1], pair[0] + 1, "{seqs:?}");
     }
 
+    // A reader that closes the pipe after one line (`rins echo nav | head -1`): echo ends quietly
+    // with success instead of reporting a broken pipe.
+    let mut reader = ipc
+        .command()
+        .args(["echo", "nav", "--timeout", "120"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("cannot start rins echo");
+    let stdout = reader.stdout.take().expect("piped stdout");
+    let mut first = String::new();
+    std::io::BufRead::read_line(&mut std::io::BufReader::new(stdout), &mut first)
+        .expect("one line from echo");
+    assert!(first.starts_with('{'), "{first}");
+    let closed = reader.wait_with_output().expect("echo did not finish");
+    assert!(
+        closed.status.success(),
+        "echo into a closed pipe: {:?} {}",
+        closed.status,
+        String::from_utf8_lossy(&closed.stderr)
+    );
+    assert!(
+        closed.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&closed.stderr)
+    );
+
     let latency = ipc.run(&["latency", "--seconds", "2", "--json"]);
     assert!(
         latency.status.success(),
