@@ -1,6 +1,6 @@
 //! Commands to the pipeline and their answers: fault injection into the simulator
 //! ([`SimControl`], answered by [`FaultApplied`]) and re-admission of an excluded channel by
-//! fusion ([`FusionControl`]).
+//! fusion ([`FusionControl`], answered by [`FusionReply`]).
 
 use iceoryx2::prelude::ZeroCopySend;
 use serde::Serialize;
@@ -119,6 +119,48 @@ pub struct FusionControl {
     pub sensor: u8,
     /// Channel index within the sensor type, from 0.
     pub channel: u8,
+    /// Chosen by the sender and returned in the [`FusionReply`], so that a sender knows its
+    /// answer among others'.
+    pub request_id: u32,
+}
+
+wire_enum! {
+    /// What fusion did with one [`FusionControl`] request ([`FusionReply::outcome`]).
+    pub enum ReadmitOutcome: u8 {
+        /// The channel is back in the solution and stayed clean over the probation period.
+        Readmitted = 0 => "readmitted",
+        /// The channel was not excluded: nothing to do.
+        NotExcluded = 1 => "not-excluded",
+        /// The sensor block has no such channel.
+        NoSuchChannel = 2 => "no-such-channel",
+        /// The request could not be read (payload version, unknown sensor type).
+        BadRequest = 3 => "bad-request",
+        /// The channel was excluded again during the probation period: the fault is still
+        /// present ([`FusionReply::reason`] says which test found it).
+        FaultStillPresent = 4 => "fault-still-present",
+    }
+}
+
+/// Fusion's answer to one [`FusionControl`] request, on [`crate::names::FUSION_REPLY`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::FusionReply")]
+pub struct FusionReply {
+    /// Layout version, [`crate::PAYLOAD_VERSION`].
+    pub version: u16,
+    /// [`SensorType`] as u8, as given in the request.
+    pub sensor: u8,
+    /// Channel index, as given in the request.
+    pub channel: u8,
+    /// The request's [`FusionControl::request_id`].
+    pub request_id: u32,
+    /// [`ReadmitOutcome`] as u8.
+    pub outcome: u8,
+    /// [`crate::FaultReason`] as u8: why the channel is excluded again (or was never excluded:
+    /// `none`).
+    pub reason: u8,
     /// Zero; makes the padding explicit so that the layout has no hidden bytes.
-    pub _pad: [u8; 4],
+    pub _pad: [u8; 2],
+    /// Process id of the fusion process that answers.
+    pub pid: u32,
 }

@@ -4,6 +4,8 @@
 use iceoryx2::prelude::ZeroCopySend;
 use serde::Serialize;
 
+use crate::{ChannelState, FaultReason, MAX_CHANNELS};
+
 wire_enum! {
     /// Which process a [`Health`] message speaks for; the name is the process's service name.
     pub enum ServiceKind: u8 {
@@ -74,10 +76,38 @@ pub struct Health {
     pub rejected: u64,
     /// Periods in which the process's input went quiet for longer than its deadline.
     pub stale_input_episodes: u64,
+    /// Bytes read from the input device (acquisition).
+    pub bytes_received: u64,
+    /// Serial frames that decoded with a valid CRC and sane content (acquisition), published or
+    /// withheld as duplicate or late.
+    pub valid_frames: u64,
     /// 1 while the input is quiet (stale) now.
     pub input_stale: u8,
+    /// [`LinkError`] as u8: why the last undecodable bytes could not be decoded (acquisition).
+    pub last_decode_error: u8,
     /// Zero; makes the padding explicit so that the layout has no hidden bytes.
-    pub _pad2: [u8; 7],
+    pub _pad2: [u8; 6],
+}
+
+wire_enum! {
+    /// Why the last bytes acquisition could not decode were refused ([`Health::last_decode_error`],
+    /// [`LinkReport::last_decode_error`]).
+    #[derive(Default)]
+    pub enum LinkError: u8 {
+        /// Nothing undecodable seen yet.
+        #[default]
+        None = 0 => "none",
+        /// Bytes without the frame sync word (wrong baud rate, wrong protocol, line noise).
+        NoSync = 1 => "no-sync",
+        /// A frame whose type byte names no known frame type.
+        UnknownFrameType = 2 => "unknown-frame-type",
+        /// A frame whose length disagrees with its type.
+        BadLength = 3 => "bad-length",
+        /// A frame whose CRC does not match.
+        CrcMismatch = 4 => "crc-mismatch",
+        /// A frame with a valid CRC and insane content (channel counts, samples out of range).
+        BadContent = 5 => "bad-content",
+    }
 }
 
 /// Up to this many processes in a [`HealthReport`].
@@ -145,4 +175,111 @@ pub struct HealthReport {
     pub uptime_ms: u64,
     /// One entry per supervised process; the first [`HealthReport::count`] are in use.
     pub services: [ServiceHealth; MAX_SUPERVISED],
+    /// The serial line, from acquisition's last heartbeat.
+    pub link: LinkReport,
+    /// The redundant channels, from fusion's latest output.
+    pub redundancy: RedundancyReport,
+    /// The navigation solution in use, from the lane the consumers follow.
+    pub nav: NavReport,
+}
+
+/// The serial line as acquisition last reported it ([`HealthReport::link`]). Counters count
+/// since the acquisition process started.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::LinkReport")]
+pub struct LinkReport {
+    /// 1 once a heartbeat of acquisition has been seen; the rest is meaningless while 0.
+    pub heard: u8,
+    /// [`LinkError`] as u8: why the last undecodable bytes were refused.
+    pub last_decode_error: u8,
+    /// Zero; makes the padding explicit so that the layout has no hidden bytes.
+    pub _pad: [u8; 6],
+    /// Bytes read from the device.
+    pub bytes_received: u64,
+    /// Frames with a valid CRC and sane content.
+    pub valid_frames: u64,
+    /// Bytes skipped because they did not belong to a valid frame.
+    pub discarded_bytes: u64,
+    /// Frames with a bad CRC.
+    pub crc_errors: u64,
+    /// Frames with a valid CRC and malformed content.
+    pub malformed: u64,
+    /// Times the device was reopened.
+    pub reconnects: u64,
+}
+
+/// The redundant channels as fusion last judged them ([`HealthReport::redundancy`]); the same
+/// fields as [`crate::FusedImu`] carries.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::RedundancyReport")]
+pub struct RedundancyReport {
+    /// 1 once a fused sample has been seen; the rest is meaningless while 0.
+    pub heard: u8,
+    /// Gyro channels fitted.
+    pub n_gyro: u8,
+    /// Accelerometer channels fitted.
+    pub n_accel: u8,
+    /// Zero; makes the padding explicit so that the layout has no hidden bytes.
+    pub _pad: [u8; 1],
+    /// [`crate::fused_flags`] of the latest fused sample.
+    pub flags: u32,
+    /// Per gyro channel, [`crate::ChannelState`] as u8.
+    pub gyro_state: [u8; MAX_CHANNELS],
+    /// Per accelerometer channel, [`crate::ChannelState`] as u8.
+    pub accel_state: [u8; MAX_CHANNELS],
+    /// Per gyro channel, [`crate::FaultReason`] as u8.
+    pub gyro_reason: [u8; MAX_CHANNELS],
+    /// Per accelerometer channel, [`crate::FaultReason`] as u8.
+    pub accel_reason: [u8; MAX_CHANNELS],
+    /// Gyro parity test statistic (0 without a parity space).
+    pub gyro_test_statistic: f32,
+    /// Accelerometer parity test statistic (0 without a parity space).
+    pub accel_test_statistic: f32,
+    /// Age of the fused sample when the report was made, ms.
+    pub age_ms: u32,
+    /// Zero; makes the padding explicit so that the layout has no hidden bytes.
+    pub _pad2: [u8; 4],
+}
+
+impl Default for RedundancyReport {
+    fn default() -> Self {
+        Self {
+            heard: 0,
+            n_gyro: 0,
+            n_accel: 0,
+            _pad: [0; 1],
+            flags: 0,
+            gyro_state: [ChannelState::Absent as u8; MAX_CHANNELS],
+            accel_state: [ChannelState::Absent as u8; MAX_CHANNELS],
+            gyro_reason: [FaultReason::None as u8; MAX_CHANNELS],
+            accel_reason: [FaultReason::None as u8; MAX_CHANNELS],
+            gyro_test_statistic: 0.0,
+            accel_test_statistic: 0.0,
+            age_ms: 0,
+            _pad2: [0; 4],
+        }
+    }
+}
+
+/// The navigation solution in use as the watchdog last saw it ([`HealthReport::nav`]).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::NavReport")]
+pub struct NavReport {
+    /// 1 once a navigation sample has been seen; the rest is meaningless while 0.
+    pub heard: u8,
+    /// [`crate::NavMode`] as u8.
+    pub mode: u8,
+    /// The lane that produced it, [`crate::NavState::lane`].
+    pub lane: u8,
+    /// [`crate::Integrity`] as u8.
+    pub integrity: u8,
+    /// [`crate::aiding`] bits.
+    pub aiding: u32,
+    /// [`crate::integrity_reason`] bits.
+    pub integrity_reasons: u32,
+    /// Age of the navigation sample when the report was made, ms.
+    pub age_ms: u32,
 }

@@ -26,16 +26,22 @@ mod truth;
 pub mod names;
 
 pub use altitude::Altitude;
-pub use control::{FaultApplied, FaultOutcome, FusionControl, SensorType, SimControl, SimFault};
+pub use control::{
+    FaultApplied, FaultOutcome, FusionControl, FusionReply, ReadmitOutcome, SensorType, SimControl,
+    SimFault,
+};
 pub use fused::{ChannelState, FaultReason, FusedImu, fused_flags};
 pub use header::{Header, Stage};
-pub use health::{Health, HealthReport, MAX_SUPERVISED, ServiceHealth, ServiceKind, ServiceState};
+pub use health::{
+    Health, HealthReport, LinkError, LinkReport, MAX_SUPERVISED, NavReport, RedundancyReport,
+    ServiceHealth, ServiceKind, ServiceState,
+};
 pub use nav::{AIDING_SOURCES, Integrity, NAV_STATES, NavMode, NavState, aiding, integrity_reason};
 pub use raw::{MAX_TEMPERATURES, RawAux, RawBaro, RawImu, RawMag, status};
 pub use truth::Truth;
 
 /// Version of every payload layout in this crate. Bump it on any layout change.
-pub const PAYLOAD_VERSION: u16 = 5;
+pub const PAYLOAD_VERSION: u16 = 6;
 
 /// Up to this many single-axis channels per sensor type (gyro, accelerometer).
 pub const MAX_CHANNELS: usize = 16;

@@ -31,6 +31,8 @@ pub const SIM_CONTROL: &str = "rins/control/sim";
 pub const SIM_FAULT_APPLIED: &str = "rins/sim/fault";
 /// Commands to fusion (re-admission of excluded channels, [`crate::FusionControl`]).
 pub const FUSION_CONTROL: &str = "rins/control/fusion";
+/// Fusion's answers to [`FUSION_CONTROL`] requests ([`crate::FusionReply`]).
+pub const FUSION_REPLY: &str = "rins/control/fusion/reply";
 
 /// Every published topic, with the short name `rins echo` accepts.
 pub const TOPICS: [(&str, &str); 10] = [

@@ -1,12 +1,13 @@
 //! The payload layouts are the contract between processes built at different times: their size
 //! and alignment must not change without a new [`PAYLOAD_VERSION`]. The figures are the layouts of
-//! version 5.
+//! version 6.
 
 use std::mem::{align_of, offset_of, size_of};
 
 use rins_ipc_types::{
-    Altitude, FaultApplied, FusedImu, FusionControl, Header, Health, HealthReport, NavState,
-    PAYLOAD_VERSION, RawAux, RawBaro, RawImu, RawMag, ServiceHealth, SimControl, Truth,
+    Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, Header, Health, HealthReport,
+    LinkReport, NavReport, NavState, PAYLOAD_VERSION, RawAux, RawBaro, RawImu, RawMag,
+    RedundancyReport, ServiceHealth, SimControl, Truth,
 };
 
 /// Size and alignment in bytes of `T`.
@@ -15,8 +16,8 @@ fn layout<T>() -> (usize, usize) {
 }
 
 #[test]
-fn the_layouts_are_those_of_version_5() {
-    assert_eq!(PAYLOAD_VERSION, 5);
+fn the_layouts_are_those_of_version_6() {
+    assert_eq!(PAYLOAD_VERSION, 6);
 }
 
 #[test]
@@ -32,10 +33,14 @@ fn every_payload_keeps_its_size_and_alignment() {
     assert_eq!(layout::<Truth>(), (144, 8));
     assert_eq!(layout::<SimControl>(), (16, 8));
     assert_eq!(layout::<FaultApplied>(), (24, 8));
-    assert_eq!(layout::<FusionControl>(), (8, 2));
-    assert_eq!(layout::<Health>(), (128, 8));
+    assert_eq!(layout::<FusionControl>(), (8, 4));
+    assert_eq!(layout::<FusionReply>(), (16, 4));
+    assert_eq!(layout::<Health>(), (144, 8));
     assert_eq!(layout::<ServiceHealth>(), (24, 4));
-    assert_eq!(layout::<HealthReport>(), (216, 8));
+    assert_eq!(layout::<LinkReport>(), (56, 8));
+    assert_eq!(layout::<RedundancyReport>(), (88, 4));
+    assert_eq!(layout::<NavReport>(), (16, 4));
+    assert_eq!(layout::<HealthReport>(), (376, 8));
 }
 
 /// A reader checks the version before anything else, so it must sit at the same place in every
@@ -54,10 +59,11 @@ fn the_version_leads_every_payload_and_the_header_stays_in_place() {
         offset_of!(SimControl, version),
         offset_of!(FaultApplied, version),
         offset_of!(FusionControl, version),
+        offset_of!(FusionReply, version),
         offset_of!(Health, version),
         offset_of!(HealthReport, version),
     ];
-    assert_eq!(version, [0; 13]);
+    assert_eq!(version, [0; 14]);
     let header = [
         offset_of!(RawBaro, header),
         offset_of!(RawMag, header),

@@ -2,8 +2,8 @@
 //! variant decodes back to itself, and a number or name no variant has decodes to `None`.
 
 use rins_ipc_types::{
-    ChannelState, FaultOutcome, FaultReason, Integrity, NavMode, SensorType, ServiceKind,
-    ServiceState, SimFault, Stage,
+    ChannelState, FaultOutcome, FaultReason, Integrity, LinkError, NavMode, ReadmitOutcome,
+    SensorType, ServiceKind, ServiceState, SimFault, Stage,
 };
 
 /// Checks `$enum` against its expected `(variant, wire value, name)` list, in order.
@@ -182,6 +182,38 @@ fn stage() {
             (Fusion, 1, "fusion"),
             (Altimeter, 2, "altimeter"),
             (Navigator, 3, "navigator"),
+        ]
+    );
+}
+
+#[test]
+fn link_error() {
+    check_wire_enum!(
+        LinkError,
+        from_u8,
+        [
+            (None, 0, "none"),
+            (NoSync, 1, "no-sync"),
+            (UnknownFrameType, 2, "unknown-frame-type"),
+            (BadLength, 3, "bad-length"),
+            (CrcMismatch, 4, "crc-mismatch"),
+            (BadContent, 5, "bad-content"),
+        ]
+    );
+    assert_eq!(LinkError::default(), LinkError::None);
+}
+
+#[test]
+fn readmit_outcome() {
+    check_wire_enum!(
+        ReadmitOutcome,
+        from_u8,
+        [
+            (Readmitted, 0, "readmitted"),
+            (NotExcluded, 1, "not-excluded"),
+            (NoSuchChannel, 2, "no-such-channel"),
+            (BadRequest, 3, "bad-request"),
+            (FaultStillPresent, 4, "fault-still-present"),
         ]
     );
 }

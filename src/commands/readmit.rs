@@ -23,7 +23,7 @@ pub fn run(channel: &str) -> Result<()> {
         version: PAYLOAD_VERSION,
         sensor: channel.sensor as u8,
         channel: channel.index,
-        _pad: [0; 4],
+        request_id: std::process::id(),
     };
     let sent = control::send(
         &node,
