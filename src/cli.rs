@@ -65,10 +65,15 @@ pub enum Command {
     },
     /// Inject a fault into one channel of the running simulator ("kill a sensor").
     Inject(InjectArgs),
-    /// Return a channel that fusion excluded to service (exclusions latch until then).
+    /// Return a channel that fusion excluded to service and wait for fusion's answer: readmitted
+    /// once it stayed in the solution through its probation, or refused (fault still present, no
+    /// such channel); exits non-zero unless it is in the solution.
     Readmit {
         /// Channel: gyro or accel followed by its 0-based index, e.g. gyro2, accel0.
         channel: String,
+        /// Longest wait for fusion's answer, s (the probation is 1 s at 1 kHz by default).
+        #[arg(long, allow_negative_numbers = true, default_value_t = 5.0)]
+        timeout: f64,
     },
     /// Measure latency from serial receive through every stage to the navigation state.
     Latency {

@@ -214,6 +214,39 @@ fn readmit_outcome() {
             (NoSuchChannel, 2, "no-such-channel"),
             (BadRequest, 3, "bad-request"),
             (FaultStillPresent, 4, "fault-still-present"),
+            (Busy, 5, "busy"),
         ]
+    );
+}
+
+#[test]
+fn every_flag_word_names_each_of_its_bits_once() {
+    use rins_ipc_types::{aiding, bit_names, fused_flags, integrity_reason};
+    for names in [
+        &fused_flags::NAMES[..],
+        &aiding::SOURCE_NAMES[..],
+        &aiding::STALE_NAMES[..],
+        &integrity_reason::NAMES[..],
+    ] {
+        let all = names.iter().fold(0u32, |acc, (bit, _)| {
+            assert_eq!(bit.count_ones(), 1, "{names:?}");
+            assert_eq!(acc & bit, 0, "a bit named twice in {names:?}");
+            acc | bit
+        });
+        assert_eq!(bit_names(all, names).len(), names.len());
+    }
+    assert_eq!(
+        bit_names(
+            fused_flags::GYRO_INSUFFICIENT | 1 << 31,
+            &fused_flags::NAMES
+        ),
+        ["gyro-insufficient"]
+    );
+    assert_eq!(
+        bit_names(
+            aiding::BARO | aiding::GRAVITY | aiding::MAG_STALE,
+            &aiding::SOURCE_NAMES
+        ),
+        ["baro", "gravity"]
     );
 }

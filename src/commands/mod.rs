@@ -44,7 +44,9 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Soak(args) => rins_soak::run(&args.into()).map(|()| ExitCode::SUCCESS),
         Command::Status { json, timeout } => status::run(json, timeout).map(|()| ExitCode::SUCCESS),
         Command::Inject(args) => inject::run(&args).map(|()| ExitCode::SUCCESS),
-        Command::Readmit { channel } => readmit::run(&channel).map(|()| ExitCode::SUCCESS),
+        Command::Readmit { channel, timeout } => {
+            readmit::run(&channel, timeout).map(|()| ExitCode::SUCCESS)
+        }
         Command::Latency { seconds, json } => {
             latency::run(seconds, json).map(|()| ExitCode::SUCCESS)
         }

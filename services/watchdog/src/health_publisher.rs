@@ -88,12 +88,15 @@ impl HealthPublisher {
                 self.last_outputs[kind as usize] = n;
             }
         }
-        let report = build_report(
-            monotonic_ns(),
+        let now_ns = monotonic_ns();
+        let mut report = build_report(
+            now_ns,
             self.started.elapsed().as_millis() as u64,
             &views,
             u64::try_from(self.silent_after.as_nanos()).unwrap_or(u64::MAX),
         );
+        report.redundancy = monitor.redundancy_report(now_ns);
+        report.nav = monitor.nav_report(now_ns);
         self.publisher.publish(report)?;
         Ok(Some(report))
     }

@@ -11,6 +11,7 @@ pub mod kill_decisions;
 pub mod monitor;
 pub mod output_deadline;
 pub mod process_graph;
+pub mod redundancy_view;
 pub mod restart_policy;
 pub mod restart_timing;
 pub mod run_summary;

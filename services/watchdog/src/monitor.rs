@@ -3,14 +3,16 @@
 
 use anyhow::Result;
 use ipc_types::{
-    Altitude, FaultApplied, FusedImu, Health, Integrity, NavMode, NavState, RawBaro, RawImu,
-    RawMag, ServiceKind, Truth, names,
+    Altitude, FaultApplied, FusedImu, Health, Integrity, NavMode, NavReport, NavState, RawBaro,
+    RawImu, RawMag, RedundancyReport, ServiceKind, Truth, names,
 };
+use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{IpcNode, TopicSubscriber};
 use rins_runtime::nav_subscriber::NavSubscriber;
 
 use crate::accuracy::Accuracy;
 use crate::fault_tracking::FaultTracker;
+use crate::redundancy_view::{nav_of, redundancy_of};
 use crate::seq_gaps::SeqGaps;
 
 /// Truth is kept this many IMU frames back, to meet the navigation output that comes later.
@@ -103,6 +105,12 @@ pub struct Monitor {
     pub nav_gaps: SeqGaps,
     /// The newest navigation sample.
     pub last_nav: Option<NavState>,
+    /// When the newest navigation sample was taken in (CLOCK_MONOTONIC ns).
+    pub last_nav_at_ns: u64,
+    /// The newest fused sample: the channel states the operator views show.
+    pub last_fused: Option<FusedImu>,
+    /// When the newest fused sample was taken in (CLOCK_MONOTONIC ns).
+    pub last_fused_at_ns: u64,
     /// Navigation error against the simulator's truth.
     pub accuracy: Accuracy,
     /// Navigation samples after alignment per integrity level (ok, degraded, invalid).
@@ -132,6 +140,9 @@ impl Monitor {
             totals: [0; COUNTED.len()],
             nav_gaps: SeqGaps::default(),
             last_nav: None,
+            last_nav_at_ns: 0,
+            last_fused: None,
+            last_fused_at_ns: 0,
             accuracy: Accuracy::default(),
             integrity_samples: [0; 3],
             faults: FaultTracker::new(),
@@ -201,6 +212,8 @@ impl Monitor {
         while let Some(f) = self.fused.receive()? {
             self.totals[3] += 1;
             self.faults.on_fused(&f);
+            self.last_fused = Some(f);
+            self.last_fused_at_ns = monotonic_ns();
         }
         self.totals[4] += drain_count(&self.alt)?;
         // Truth first, so a navigation sample finds the truth of its own frame.
@@ -210,6 +223,7 @@ impl Monitor {
         while let Some(nav) = self.nav.receive()? {
             self.totals[5] += 1;
             self.on_nav(nav);
+            self.last_nav_at_ns = monotonic_ns();
         }
         while let Some(h) = self.health.receive()? {
             self.on_health(&h);
@@ -257,12 +271,32 @@ impl Monitor {
         }
     }
 
+    /// The report's redundancy part from the newest fused sample, as of `now_ns` (not heard
+    /// before the first).
+    pub fn redundancy_report(&self, now_ns: u64) -> RedundancyReport {
+        self.last_fused.map_or_else(RedundancyReport::default, |f| {
+            redundancy_of(&f, age_ms(now_ns, self.last_fused_at_ns))
+        })
+    }
+
+    /// The report's navigation part from the newest navigation sample, as of `now_ns`.
+    pub fn nav_report(&self, now_ns: u64) -> NavReport {
+        self.last_nav.map_or_else(NavReport::default, |n| {
+            nav_of(&n, age_ms(now_ns, self.last_nav_at_ns))
+        })
+    }
+
     /// Acquisition counters summed over every acquisition process seen.
     pub fn device_counters(&self) -> DeviceCounters {
         self.acquisition
             .iter()
             .fold(DeviceCounters::default(), |acc, (_, c)| acc.plus(c))
     }
+}
+
+/// Milliseconds from `then_ns` to `now_ns`, saturating.
+fn age_ms(now_ns: u64, then_ns: u64) -> u32 {
+    u32::try_from(now_ns.saturating_sub(then_ns) / 1_000_000).unwrap_or(u32::MAX)
 }
 
 fn drain_count<T: std::fmt::Debug + Copy + iceoryx2::prelude::ZeroCopySend>(

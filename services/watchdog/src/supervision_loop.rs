@@ -185,6 +185,7 @@ impl StatusLines {
                 &rates,
                 monitor.nav_gaps.missing,
                 &monitor.device_counters(),
+                &monitor.redundancy_report(rins_runtime::clock::monotonic_ns()),
                 monitor.last_nav.as_ref(),
             )
         );

@@ -91,6 +91,10 @@ pub struct FdiConfig {
     /// Samples in a row an excluded channel must be valid, off the converter rails, varying and
     /// consistent with the others before it returns by itself.
     pub readmit_after_samples: u32,
+    /// Fused samples a channel re-admitted by command must stay in the solution before the
+    /// command is answered `readmitted`; excluded again within them, the answer is
+    /// `fault-still-present`.
+    pub readmit_probation_samples: u32,
 }
 
 impl Default for FdiConfig {
@@ -119,6 +123,7 @@ impl Default for FdiConfig {
             timing_skew_s: 0.0,
             readmit: ReadmitPolicy::Auto,
             readmit_after_samples: 1_000,
+            readmit_probation_samples: 1_000,
         }
     }
 }
@@ -278,6 +283,11 @@ impl FdiConfig {
             ));
         }
         at_least("readmit_after_samples", self.readmit_after_samples, 10)?;
+        at_least(
+            "readmit_probation_samples",
+            self.readmit_probation_samples,
+            10,
+        )?;
         Ok(FdiSettings {
             readmit: self.readmit,
             readmit_after_samples: self.readmit_after_samples,
