@@ -24,19 +24,6 @@ fn channel<'a>(report: &'a Value, name: &str) -> &'a Value {
         .unwrap_or_else(|| panic!("no {name} in {report}"))
 }
 
-/// Polls `rins status --json` until `done` holds (or fails after `limit`).
-fn wait_for(ipc: &Isolated, limit: Duration, done: impl Fn(&Value) -> bool) -> Value {
-    let start = Instant::now();
-    loop {
-        let report = ipc.status();
-        if done(&report) {
-            return report;
-        }
-        assert!(start.elapsed() < limit, "gave up waiting: {report}");
-        std::thread::sleep(Duration::from_millis(200));
-    }
-}
-
 /// Waits for a status line on `lines` that contains `text`.
 fn wait_for_line(lines: &mpsc::Receiver<String>, text: &str, limit: Duration) -> String {
     let deadline = Instant::now() + limit;
@@ -74,7 +61,7 @@ fn a_killed_gyro_is_seen_excluded_and_readmit_reports_its_outcome() {
     });
 
     // Every channel in use, the solution navigating on the primary lane.
-    let healthy = wait_for(&ipc, Duration::from_secs(120), |r| {
+    let healthy = ipc.status_until(Duration::from_secs(120), |r| {
         r["navigation"]["mode"] == "navigating" && r["redundancy"]["gyro"]["in_use"] == 4
     });
     assert_eq!(healthy["redundancy"]["accel"]["in_use"], 4, "{healthy}");
@@ -89,7 +76,7 @@ fn a_killed_gyro_is_seen_excluded_and_readmit_reports_its_outcome() {
 
     let out = ipc.run_with_timeout(&["inject", "gyro2", "dead"], Duration::from_secs(10));
     assert!(out.status.success(), "inject failed:\n{}", stderr(&out));
-    let excluded = wait_for(&ipc, Duration::from_secs(10), |r| {
+    let excluded = ipc.status_until(Duration::from_secs(10), |r| {
         channel(r, "gyro2")["state"] == "excluded"
     });
     assert_eq!(
@@ -140,7 +127,7 @@ fn a_killed_gyro_is_seen_excluded_and_readmit_reports_its_outcome() {
         "{}",
         String::from_utf8_lossy(&out.stdout)
     );
-    let back = wait_for(&ipc, Duration::from_secs(10), |r| {
+    let back = ipc.status_until(Duration::from_secs(10), |r| {
         channel(r, "gyro2")["state"] == "ok"
     });
     assert_eq!(back["redundancy"]["gyro"]["in_use"], 4, "{back}");

@@ -74,6 +74,24 @@ impl Isolated {
         last_json(&out)
     }
 
+    /// Polls `rins status --json` until `done` holds of the report, and returns it; fails after
+    /// `limit`.
+    pub fn status_until(
+        &self,
+        limit: std::time::Duration,
+        done: impl Fn(&serde_json::Value) -> bool,
+    ) -> serde_json::Value {
+        let start = std::time::Instant::now();
+        loop {
+            let report = self.status();
+            if done(&report) {
+                return report;
+            }
+            assert!(start.elapsed() < limit, "gave up waiting: {report}");
+            std::thread::sleep(std::time::Duration::from_millis(200));
+        }
+    }
+
     /// Shared-memory entries of this namespace still present.
     pub fn shm_entries(&self) -> Vec<String> {
         std::fs::read_dir("/dev/shm")
