@@ -8,7 +8,9 @@ use std::time::{Duration, Instant};
 use anyhow::{Result, bail};
 use ipc_types::{HealthReport, ServiceKind, ServiceState, names};
 use rins_runtime::ipc::{TopicSubscriber, create_node};
-use rins_watchdog::redundancy_view::{NavView, RedundancyView, nav_view, redundancy_view};
+use rins_watchdog::redundancy_view::{
+    NavView, RedundancyView, SensorRow, nav_view, redundancy_view,
+};
 use serde::Serialize;
 
 /// One process as printed.
@@ -66,7 +68,7 @@ pub fn rows(report: &HealthReport) -> StatusReport {
 
 pub fn table(report: &StatusReport) -> String {
     let mut out = format!("up {:.1} s\n", report.uptime_s);
-    out.push_str("service      state       pid      restarts  heartbeat  output\n");
+    out.push_str("service            state       pid      restarts  heartbeat  output\n");
     for r in &report.services {
         let age = r
             .heartbeat_age_ms
@@ -76,7 +78,7 @@ pub fn table(report: &StatusReport) -> String {
             .map_or_else(|| "-".to_string(), |h| format!("{h:.0}/s"));
         let stale = if r.input_stale { "  input stale" } else { "" };
         out.push_str(&format!(
-            "{:<12} {:<11} {:<8} {:<9} {:<10} {rate}{stale}\n",
+            "{:<18} {:<11} {:<8} {:<9} {:<10} {rate}{stale}\n",
             r.service, r.state, r.pid, r.restarts, age
         ));
     }
@@ -116,9 +118,18 @@ fn channel_table(r: &RedundancyView) -> String {
             c.reason.as_deref().unwrap_or("-")
         ));
     }
+    // Three channels leave no parity space: no statistic to show.
+    let statistic = |row: &SensorRow| {
+        if row.in_use > 3 {
+            format!("{:.2}", row.test_statistic)
+        } else {
+            "- (no parity with 3 channels)".to_string()
+        }
+    };
     out.push_str(&format!(
-        "parity test  gyro {:.2}  accel {:.2}\n",
-        r.gyro.test_statistic, r.accel.test_statistic
+        "parity test  gyro {}  accel {}\n",
+        statistic(&r.gyro),
+        statistic(&r.accel)
     ));
     out
 }
@@ -245,7 +256,10 @@ mod tests {
         assert_eq!(t.matches("\ngyro").count(), 4, "{t}");
         assert_eq!(t.matches("\naccel").count(), 4, "{t}");
         assert!(t.contains("gyro1        excluded    parity"), "{t}");
-        assert!(t.contains("parity test  gyro 2.50"), "{t}");
+        assert!(
+            t.contains("parity test  gyro - (no parity with 3 channels)  accel 0.00"),
+            "{t}"
+        );
         let json: serde_json::Value =
             serde_json::from_str(&serde_json::to_string(&r).expect("serialises")).expect("json");
         assert_eq!(json["redundancy"]["gyro"]["in_use"], 3);
