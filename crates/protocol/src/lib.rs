@@ -24,7 +24,7 @@ pub use diagnosis::{likely_cause, link_error};
 pub use error::{DecodeError, EncodeError, ImuContentError};
 pub use frame::*;
 pub use layout::{MAX_FRAME_LEN, MAX_PAYLOAD_LEN};
-pub use line_report::{LineReport, LineVerdict, ScanOutcome, TypeRate, scan_outcome};
+pub use line_report::{DeviceSpans, LineReport, LineVerdict, ScanOutcome, TypeRate, scan_outcome};
 pub use resume_point::{ResumeError, ResumePoint};
 pub use seq_extend::{SeqExtender, SeqVerdict};
 pub use time_extend::{ExtendedTime, TimeExtender};

@@ -6,7 +6,7 @@ use ipc_types::LinkError;
 
 use super::decoder::DecoderStats;
 use super::diagnosis::{likely_cause, link_error};
-use super::frame::FrameType;
+use super::frame::{DecodedFrame, FrameType};
 
 /// Frames of one type seen during a listen.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -15,8 +15,35 @@ pub struct TypeRate {
     pub frame_type: FrameType,
     /// Frames of this type handed out.
     pub frames: u64,
-    /// Frames per second over the listen.
+    /// The device's rate: frames per second of device time between the first and the last frame
+    /// of the type (the arrival rate when fewer than two frames came). A device catching up on a
+    /// backlog, or a driver handing over bytes in bursts, does not change it; frames lost on the
+    /// line lower it.
     pub hz: f64,
+    /// Frames per second of the listen: what arrived.
+    pub arrival_hz: f64,
+}
+
+/// Device time of the first and the last frame of each type handed out, for the device's rates.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct DeviceSpans {
+    first_us: [Option<u64>; FrameType::COUNT],
+    last_us: [Option<u64>; FrameType::COUNT],
+}
+
+impl DeviceSpans {
+    /// Takes a frame the decoder handed out.
+    pub fn observe(&mut self, frame: &DecodedFrame) {
+        let i = frame.payload.frame_type().index();
+        self.first_us[i].get_or_insert(frame.device_time_us);
+        self.last_us[i] = Some(frame.device_time_us);
+    }
+
+    /// Device seconds from the first to the last frame of `t`; `None` before two distinct times.
+    pub fn span_s(&self, t: FrameType) -> Option<f64> {
+        let (first, last) = (self.first_us[t.index()]?, self.last_us[t.index()]?);
+        (last > first).then(|| (last - first) as f64 * 1e-6)
+    }
 }
 
 /// What the line carried during one listen.
@@ -53,16 +80,20 @@ pub enum LineVerdict {
 
 impl LineReport {
     /// The report of a listen of `seconds` (> 0) whose decoder ended with `stats` (a fresh decoder
-    /// per listen: the counters are taken as the listen's own).
-    pub fn from_stats(stats: &DecoderStats, seconds: f64) -> Self {
+    /// per listen: the counters are taken as the listen's own) and whose frames spanned `spans`.
+    pub fn from_listen(stats: &DecoderStats, spans: &DeviceSpans, seconds: f64) -> Self {
         let types = FrameType::ALL
             .into_iter()
             .filter_map(|t| {
                 let frames = stats.frames_by_type[t.index()];
+                let arrival_hz = frames as f64 / seconds;
                 (frames > 0).then(|| TypeRate {
                     frame_type: t,
                     frames,
-                    hz: frames as f64 / seconds,
+                    hz: spans
+                        .span_s(t)
+                        .map_or(arrival_hz, |span| (frames - 1) as f64 / span),
+                    arrival_hz,
                 })
             })
             .collect();
@@ -192,9 +223,31 @@ mod tests {
         }
     }
 
+    fn from_stats(stats: &DecoderStats, seconds: f64) -> LineReport {
+        LineReport::from_listen(stats, &DeviceSpans::default(), seconds)
+    }
+
+    #[test]
+    fn device_time_gives_the_device_rate_whatever_the_arrival() {
+        use crate::{BaroFrame, Payload};
+        let mut spans = DeviceSpans::default();
+        // 1500 baro frames 20 ms apart (50 Hz on the device), arrived within 3 s: a backlog.
+        for k in 0..1500u64 {
+            spans.observe(&DecodedFrame {
+                seq: k,
+                device_time_us: 1_000_000 + k * 20_000,
+                payload: Payload::Baro(BaroFrame::default()),
+            });
+        }
+        let r = LineReport::from_listen(&stats([0, 1500, 0, 0], 60_000, 0), &spans, 3.0);
+        assert_eq!(r.types.len(), 1);
+        assert!((r.types[0].hz - 50.0).abs() < 1e-9, "{:?}", r.types[0]);
+        assert_eq!(r.types[0].arrival_hz, 500.0);
+    }
+
     #[test]
     fn frames_give_rates_per_type_and_the_verdict_names_them() {
-        let r = LineReport::from_stats(&stats([3000, 150, 300, 0], 120_000, 0), 3.0);
+        let r = from_stats(&stats([3000, 150, 300, 0], 120_000, 0), 3.0);
         assert_eq!(r.verdict(), LineVerdict::Frames);
         assert_eq!(r.types.len(), 3);
         assert_eq!(
@@ -214,7 +267,7 @@ mod tests {
         // No 0xA5 at all: not even the start of a sync word.
         let garbage: Vec<u8> = (0..9600u32).map(|i| (i * 7 % 160) as u8).collect();
         d.push(&garbage, 0, |_| panic!("no frame in garbage"));
-        let r = LineReport::from_stats(&d.stats(), 1.0);
+        let r = from_stats(&d.stats(), 1.0);
         assert_eq!(r.verdict(), LineVerdict::BytesWithoutFrames);
         assert_eq!((r.bytes, r.discarded_bytes), (9600, 9600));
         assert_eq!(r.last_error, LinkError::NoSync);
@@ -223,7 +276,7 @@ mod tests {
             "bytes but no valid frame: wrong baud rate or protocol (no sync word in 9600 bytes: \
              wrong baud rate or not a rins device?)"
         );
-        let silent = LineReport::from_stats(&DecoderStats::default(), 3.0);
+        let silent = from_stats(&DecoderStats::default(), 3.0);
         assert_eq!(silent.verdict(), LineVerdict::NoBytes);
         assert!(silent.verdict_line().starts_with("no bytes in 3.0 s"));
         let crc = DecoderStats {
@@ -234,7 +287,7 @@ mod tests {
             }),
             ..stats([100, 0, 0, 0], 5000, 200)
         };
-        let line = LineReport::from_stats(&crc, 1.0).verdict_line();
+        let line = from_stats(&crc, 1.0).verdict_line();
         assert!(
             line.contains("with 4 CRC failures") && line.contains("line noise"),
             "{line}"
@@ -244,7 +297,7 @@ mod tests {
     fn report(valid: u64, bytes: u64, crc: u64) -> LineReport {
         LineReport {
             crc_errors: crc,
-            ..LineReport::from_stats(&stats([valid, 0, 0, 0], bytes, 0), 1.0)
+            ..from_stats(&stats([valid, 0, 0, 0], bytes, 0), 1.0)
         }
     }
 

@@ -5,7 +5,7 @@ use std::io::Read;
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow};
-use rins_protocol::{Decoder, DecoderStats, LineReport};
+use rins_protocol::{Decoder, DeviceSpans, LineReport};
 use rins_runtime::clock::monotonic_ns;
 use serialport::{ClearBuffer, SerialPort};
 
@@ -21,19 +21,33 @@ pub fn listen(path: &str, baud: u32, seconds: f64) -> Result<LineReport> {
     let mut port = port::open(path, baud, READ_TIMEOUT)?;
     port.clear(ClearBuffer::Input)
         .map_err(|e| anyhow!("cannot clear the input of {path}: {e}"))?;
-    let stats = read_for(&mut port, path, Duration::from_secs_f64(seconds))?;
-    Ok(LineReport::from_stats(&stats, seconds))
+    let mut decoder = Decoder::new();
+    let mut spans = DeviceSpans::default();
+    read_for(
+        &mut port,
+        path,
+        Duration::from_secs_f64(seconds),
+        &mut decoder,
+        &mut spans,
+    )?;
+    Ok(LineReport::from_listen(&decoder.stats(), &spans, seconds))
 }
 
-fn read_for(port: &mut serialport::TTYPort, path: &str, length: Duration) -> Result<DecoderStats> {
-    let mut decoder = Decoder::new();
+/// Reads `port` for `length` into `decoder`, noting the device time of every frame in `spans`.
+fn read_for(
+    port: &mut serialport::TTYPort,
+    path: &str,
+    length: Duration,
+    decoder: &mut Decoder,
+    spans: &mut DeviceSpans,
+) -> Result<()> {
     let mut buf = [0u8; 4096];
     let end = Instant::now() + length;
     while Instant::now() < end {
         match port.read(&mut buf) {
             // The other end hung up: nothing more will come.
             Ok(0) => break,
-            Ok(n) => decoder.push(&buf[..n], monotonic_ns(), |_| {}),
+            Ok(n) => decoder.push(&buf[..n], monotonic_ns(), |f| spans.observe(&f)),
             Err(e)
                 if matches!(
                     e.kind(),
@@ -42,5 +56,5 @@ fn read_for(port: &mut serialport::TTYPort, path: &str, length: Duration) -> Res
             Err(e) => return Err(anyhow!("cannot read serial device {path}: {e}")),
         }
     }
-    Ok(decoder.stats())
+    Ok(())
 }
