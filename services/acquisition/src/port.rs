@@ -14,8 +14,11 @@ pub fn open(path: &str, baud: u32, read_timeout: Duration) -> Result<serialport:
         .timeout(read_timeout)
         .open_native()
         .map_err(|e| {
-            // The driver words ENOTTY as the historical "Not a typewriter": say what it means.
-            let hint = if openable_but_not_a_terminal(path) {
+            // The driver words ENOTTY as the historical "Not a typewriter", and a port held by
+            // another reader as a lock failure: say what each means.
+            let hint = if e.kind() == serialport::ErrorKind::NoDevice {
+                " (another program has it open: a running `rins up`?)"
+            } else if openable_but_not_a_terminal(path) {
                 " (not a terminal device, so not a serial port)"
             } else {
                 ""

@@ -96,9 +96,11 @@ pub fn no_valid_frame(port: &str, s: &Summary) -> Option<String> {
         return None;
     }
     let seen = if s.bytes_received == 0 {
-        "0 bytes received: is the device powered, connected and sending? (`rins probe --port \
-         PATH` listens to it)"
-            .to_string()
+        format!(
+            "0 bytes received: is it the device's path, and is the device powered, connected and \
+             sending? (`rins probe --port {port}` listens to it; acquisition's log says why it \
+             could not open it)"
+        )
     } else {
         let last = LinkError::from_name(&s.last_decode_error).unwrap_or(LinkError::None);
         format!(
