@@ -6,12 +6,11 @@ mod common;
 
 use std::fs::File;
 use std::process::{Child, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use common::device::{DeviceTick, FakeDevice};
 use common::{Isolated, PipelineSlot, Scratch, stderr, stop_up_output};
 use rins_sim::Scenario;
-use serde_json::Value;
 
 /// Bytes of garbage per device tick (1 kHz): 8000 B/s.
 const GARBAGE_PER_TICK: usize = 8;
@@ -40,22 +39,6 @@ fn spawn_up_logging(ipc: &Isolated, args: &[&str], log: &std::path::Path) -> Chi
         .stderr(Stdio::from(file))
         .spawn()
         .expect("cannot start rins up")
-}
-
-/// Polls `rins status --json` until `done` holds; fails after two minutes.
-fn status_until(ipc: &Isolated, done: impl Fn(&Value) -> bool) -> Value {
-    let deadline = Instant::now() + Duration::from_secs(120);
-    loop {
-        let out = ipc.run(&["status", "--json", "--timeout", "10"]);
-        if out.status.success() {
-            let report = common::last_json(&out);
-            if done(&report) {
-                return report;
-            }
-        }
-        assert!(Instant::now() < deadline, "status never got there");
-        std::thread::sleep(Duration::from_millis(200));
-    }
 }
 
 fn count(s: &str, what: &str) -> usize {
@@ -90,7 +73,7 @@ fn garbage_on_the_line_shows_in_status_summary_and_one_warning() {
         &log,
     );
     // Acquisition has read garbage for more than its one-second window.
-    let report = status_until(&ipc, |r| {
+    let report = ipc.status_until(Duration::from_secs(120), |r| {
         r["link"]["bytes_received"].as_u64().unwrap_or(0) > 3 * 8000
     });
     let link = &report["link"];
@@ -107,7 +90,7 @@ fn garbage_on_the_line_shows_in_status_summary_and_one_warning() {
     );
     // The warning is logged once, however long the garbage goes on: two more heartbeats.
     let before = link["bytes_received"].as_u64().unwrap_or(0);
-    status_until(&ipc, |r| {
+    ipc.status_until(Duration::from_secs(120), |r| {
         r["link"]["bytes_received"].as_u64().unwrap_or(0) > before + 2 * 8000
     });
     let out = stop_up_output(&ipc, up);
