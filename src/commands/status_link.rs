@@ -3,45 +3,38 @@
 
 use ipc_types::LinkReport;
 use rins_watchdog::link::link_error_name;
-use serde::Serialize;
+use serde::ser::{Serialize, SerializeStruct, Serializer};
 
-/// The serial line as printed (`link` in the JSON); absent until acquisition has been heard.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
-pub struct LinkRow {
-    /// Bytes read from the device.
-    pub bytes_received: u64,
-    /// Frames with a valid CRC and sane content.
-    pub valid_frames: u64,
-    /// Bytes skipped because they belonged to no valid frame.
-    pub discarded_bytes: u64,
-    /// Frames with a bad CRC.
-    pub crc_errors: u64,
-    /// Frames with a valid CRC and malformed content.
-    pub malformed: u64,
-    /// Times the device was reopened.
-    pub reconnects: u64,
-    /// Why the last undecodable bytes were refused: `none`, `no-sync`, `crc-mismatch`, ...
-    pub last_decode_error: String,
+/// The serial line as printed (`link` in the JSON): the report's counters, the last decode error
+/// by name (`none`, `no-sync`, `crc-mismatch`, ...), without the layout's own fields.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinkRow(pub LinkReport);
+
+impl Serialize for LinkRow {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let l = &self.0;
+        let mut row = s.serialize_struct("LinkRow", 7)?;
+        row.serialize_field("bytes_received", &l.bytes_received)?;
+        row.serialize_field("valid_frames", &l.valid_frames)?;
+        row.serialize_field("discarded_bytes", &l.discarded_bytes)?;
+        row.serialize_field("crc_errors", &l.crc_errors)?;
+        row.serialize_field("malformed", &l.malformed)?;
+        row.serialize_field("reconnects", &l.reconnects)?;
+        row.serialize_field("last_decode_error", &link_error_name(l.last_decode_error))?;
+        row.end()
+    }
 }
 
 /// The printable link of a report; `None` while acquisition has not been heard.
 pub fn link_row(link: &LinkReport) -> Option<LinkRow> {
-    (link.heard != 0).then(|| LinkRow {
-        bytes_received: link.bytes_received,
-        valid_frames: link.valid_frames,
-        discarded_bytes: link.discarded_bytes,
-        crc_errors: link.crc_errors,
-        malformed: link.malformed,
-        reconnects: link.reconnects,
-        last_decode_error: link_error_name(link.last_decode_error),
-    })
+    (link.heard != 0).then_some(LinkRow(*link))
 }
 
 /// The table's `link` line.
 pub fn link_line(link: Option<&LinkRow>) -> String {
     match link {
         None => "link         not heard from acquisition yet\n".to_string(),
-        Some(l) => format!(
+        Some(LinkRow(l)) => format!(
             "link         {} bytes, {} valid frames, {} discarded, crc {}, malformed {}, \
              reconnects {}, last decode error {}\n",
             l.bytes_received,
@@ -50,7 +43,7 @@ pub fn link_line(link: Option<&LinkRow>) -> String {
             l.crc_errors,
             l.malformed,
             l.reconnects,
-            l.last_decode_error
+            link_error_name(l.last_decode_error)
         ),
     }
 }
@@ -73,10 +66,14 @@ mod tests {
             ..LinkReport::default()
         };
         let row = link_row(&report).expect("heard");
-        assert_eq!(row.last_decode_error, "no-sync");
-        let json = serde_json::to_value(&row).expect("serialisable");
+        let json = serde_json::to_value(row).expect("serialisable");
         assert_eq!(json["last_decode_error"], "no-sync");
         assert_eq!(json["bytes_received"], 9600);
+        assert_eq!(json["valid_frames"], 0);
+        assert!(
+            json.get("heard").is_none() && json.get("_pad").is_none(),
+            "{json}"
+        );
         let line = link_line(Some(&row));
         assert!(
             line.contains("9600 bytes, 0 valid frames, 9600 discarded")
