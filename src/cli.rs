@@ -300,7 +300,8 @@ pub struct UpArgs {
     /// Simulator scenario (overrides sim.scenario).
     #[arg(long)]
     pub scenario: Option<ScenarioArg>,
-    /// Stop after this many seconds and exit 0.
+    /// Stop after this many seconds and exit 0; non-zero when no valid frame arrived in all that
+    /// time (the message names the port and what the line carried).
     #[arg(long, allow_negative_numbers = true)]
     pub duration: Option<f64>,
     /// With --duration: print a JSON summary as the last line.
