@@ -13,6 +13,8 @@ use rins_watchdog::redundancy_view::{
 };
 use serde::Serialize;
 
+use super::status_link;
+
 /// One process as printed.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ServiceRow {
@@ -36,6 +38,7 @@ pub struct StatusReport {
     pub navigation: Option<NavView>,
     /// `None` before the first fused sample.
     pub redundancy: Option<RedundancyView>,
+    pub link: Option<status_link::LinkRow>,
 }
 
 /// The printable form of a report; entries with unknown codes are named by their number.
@@ -63,6 +66,7 @@ pub fn rows(report: &HealthReport) -> StatusReport {
         services,
         navigation: nav_view(&report.nav),
         redundancy: redundancy_view(&report.redundancy),
+        link: status_link::link_row(&report.link),
     }
 }
 
@@ -99,6 +103,7 @@ pub fn table(report: &StatusReport) -> String {
         Some(r) => out.push_str(&channel_table(r)),
         None => out.push_str("redundancy   no fused output yet\n"),
     }
+    out.push_str(&status_link::link_line(report.link.as_ref()));
     out
 }
 

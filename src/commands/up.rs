@@ -12,6 +12,7 @@ use rins_runtime::shm_cleanup;
 use rins_runtime::shutdown::Shutdown;
 use rins_watchdog::deployment_checks::{ensure_no_live_deployment, refuse_foreign_entries};
 use rins_watchdog::health_publisher::HealthPublisher;
+use rins_watchdog::link::no_valid_frame;
 use rins_watchdog::monitor::Monitor;
 use rins_watchdog::process_graph::pipeline_services;
 use rins_watchdog::restart_timing::RestartTiming;
@@ -170,12 +171,19 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
         .filter(|e| e.belongs_to(settings.owner))
         .count() as u64;
     outcome?;
+    let summary = Summary {
+        shm_leaked: leaked,
+        ..summary
+    };
     if args.json {
-        let summary = Summary {
-            shm_leaked: leaked,
-            ..summary
-        };
         println!("{}", serde_json::to_string(&summary)?);
+    }
+    // A timed run that never saw a frame did not do what was asked: a bring-up script must see it.
+    if args.duration.is_some()
+        && !shutdown.requested()
+        && let Some(why) = no_valid_frame(&port, &summary)
+    {
+        bail!("{why}");
     }
     Ok(std::process::ExitCode::SUCCESS)
 }

@@ -9,6 +9,7 @@ use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{IpcNode, TopicPublisher};
 
 use crate::health_report::{ProcessView, build_report};
+use crate::link::link_report;
 use crate::monitor::{HeartbeatSeen, Monitor};
 use crate::supervisor::Supervisor;
 
@@ -97,6 +98,7 @@ impl HealthPublisher {
         );
         report.redundancy = monitor.redundancy_report(now_ns);
         report.nav = monitor.nav_report(now_ns);
+        report.link = link_report(monitor);
         self.publisher.publish(report)?;
         Ok(Some(report))
     }

@@ -8,6 +8,7 @@ pub mod fault_tracking;
 pub mod health_publisher;
 pub mod health_report;
 pub mod kill_decisions;
+pub mod link;
 pub mod monitor;
 pub mod output_deadline;
 pub mod process_graph;

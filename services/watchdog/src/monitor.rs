@@ -12,6 +12,7 @@ use rins_runtime::nav_subscriber::NavSubscriber;
 
 use crate::accuracy::Accuracy;
 use crate::fault_tracking::FaultTracker;
+use crate::link::LinkRate;
 use crate::redundancy_view::{nav_of, redundancy_of};
 use crate::seq_gaps::SeqGaps;
 
@@ -53,6 +54,12 @@ pub struct DeviceCounters {
     pub resync_bytes: u64,
     /// Times the device was reopened.
     pub reconnects: u64,
+    /// Bytes read from the device.
+    pub bytes_received: u64,
+    /// Frames with a valid CRC and sane content (published, or withheld as duplicate or late).
+    pub valid_frames: u64,
+    /// [`ipc_types::LinkError`] as u8 of the last refusal.
+    pub last_decode_error: u8,
 }
 
 impl DeviceCounters {
@@ -68,10 +75,14 @@ impl DeviceCounters {
             time_rebases: h.time_rebases,
             resync_bytes: h.resync_bytes,
             reconnects: h.reconnects,
+            bytes_received: h.bytes_received,
+            valid_frames: h.valid_frames,
+            last_decode_error: h.last_decode_error,
         }
     }
 
-    /// The sum of two processes' counters.
+    /// The sum of two processes' counters; the last refusal is `o`'s (the later process) when it
+    /// has one.
     pub fn plus(&self, o: &Self) -> Self {
         Self {
             crc_errors: self.crc_errors + o.crc_errors,
@@ -83,6 +94,13 @@ impl DeviceCounters {
             time_rebases: self.time_rebases + o.time_rebases,
             resync_bytes: self.resync_bytes + o.resync_bytes,
             reconnects: self.reconnects + o.reconnects,
+            bytes_received: self.bytes_received + o.bytes_received,
+            valid_frames: self.valid_frames + o.valid_frames,
+            last_decode_error: if o.last_decode_error != 0 {
+                o.last_decode_error
+            } else {
+                self.last_decode_error
+            },
         }
     }
 }
@@ -122,6 +140,8 @@ pub struct Monitor {
     acquisition: Vec<(u32, DeviceCounters)>,
     /// Last heartbeat per [`ServiceKind`].
     pub heartbeats: [Option<HeartbeatSeen>; ServiceKind::ALL.len()],
+    /// The serial line over acquisition's last two heartbeats.
+    pub link: LinkRate,
 }
 
 impl Monitor {
@@ -157,6 +177,7 @@ impl Monitor {
             .into_boxed_slice(),
             acquisition: Vec::new(),
             heartbeats: [None; ServiceKind::ALL.len()],
+            link: LinkRate::default(),
         })
     }
 
@@ -265,6 +286,7 @@ impl Monitor {
             return;
         }
         let counters = DeviceCounters::from_heartbeat(h);
+        self.link.observe(h.pid, h.now_ns, &counters);
         match self.acquisition.iter_mut().find(|(pid, _)| *pid == h.pid) {
             Some(entry) => entry.1 = counters,
             None => self.acquisition.push((h.pid, counters)),
