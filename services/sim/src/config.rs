@@ -86,7 +86,7 @@ pub struct SimConfig {
 impl Default for SimConfig {
     fn default() -> Self {
         Self {
-            scenario: Scenario::Static,
+            scenario: Scenario::Uav,
             seed: 1,
             imu_rate_hz: 1000.0,
             baro_rate_hz: 50.0,

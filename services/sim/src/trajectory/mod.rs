@@ -30,9 +30,10 @@ use walk::WalkPath;
 #[serde(rename_all = "lowercase")]
 pub enum Scenario {
     /// Parked level at the origin, fixed heading.
-    #[default]
     Static,
     /// Take-off, climb, cruise circuits with banked turns, descent and landing (see [`uav_profile`]).
+    /// The default: something moves as soon as the pipeline runs.
+    #[default]
     Uav,
     /// A foot-mounted sensor walked once round a 50 m × 12.9 m rectangle (see [`walk`]).
     Walk,
