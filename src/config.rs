@@ -176,6 +176,7 @@ impl RinsConfig {
             rins_sim::Scenario::Static => "static",
             rins_sim::Scenario::Uav => "uav",
             rins_sim::Scenario::Walk => "walk",
+            rins_sim::Scenario::Calibrate => "calibrate",
         }
     }
 
@@ -185,6 +186,7 @@ impl RinsConfig {
             ScenarioArg::Static => rins_sim::Scenario::Static,
             ScenarioArg::Uav => rins_sim::Scenario::Uav,
             ScenarioArg::Walk => rins_sim::Scenario::Walk,
+            ScenarioArg::Calibrate => rins_sim::Scenario::Calibrate,
         };
     }
 }
