@@ -1,7 +1,7 @@
 //! `[sim.calibration]`: the `calibrate` scenario's motion and the magnetometer distortion it
 //! carries, so `rins calibrate mag` has something to find.
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::error::{SimError, check_range};
 use crate::sensor_model::SensorModelConfig;
@@ -11,7 +11,7 @@ use crate::sensor_model::config::check_mag_distortion;
 pub const MIN_SWEEP_S: f64 = 2.0;
 
 /// The calibrate scenario's settings.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct CalibrationConfig {
     /// Time of one full yaw turn, s; a cycle of eight turns and the tilts between them lasts

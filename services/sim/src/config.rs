@@ -1,6 +1,6 @@
 //! Simulator configuration (the `[sim]` section of the product configuration).
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::calibration_config::CalibrationConfig;
 use crate::error::{SimError, check_positive, check_range};
@@ -14,7 +14,7 @@ pub const MAX_IMU_RATE_HZ: f64 = 100_000.0;
 pub const MAX_ABS_LATITUDE_DEG: f64 = 85.0;
 
 /// Local Earth magnetic field as configured.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct EarthFieldConfig {
     /// Total intensity, µT.
@@ -47,7 +47,7 @@ impl EarthFieldConfig {
 }
 
 /// Everything the simulator needs besides the sensor geometry and the seed.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SimConfig {
     /// Motion to simulate.

@@ -1,6 +1,6 @@
 //! Error-model parameters of the simulated sensor block (defaults: small-UAV MEMS block).
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::error::{SimError, check_positive, check_range};
 use rins_earth::STANDARD_GRAVITY;
@@ -14,7 +14,7 @@ pub const MAX_TEMPERATURE_SENSORS: u8 = ipc_types::MAX_TEMPERATURES as u8;
 
 /// Per-channel error model of gyros and accelerometers, module temperatures, barometer,
 /// magnetometer and foot-pressure noise. Units are in the field names; degrees and g only here.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SensorModelConfig {
     /// Gyro full scale: ±this maps to ±2048 counts, °/s. Not a key of `[sim.sensors]`: the simulated

@@ -21,7 +21,7 @@ pub mod uav_profile;
 pub mod walk;
 
 use nalgebra::{UnitQuaternion, Vector3};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use calibration::CalibrationPath;
 use flight::FlightPath;
@@ -29,7 +29,7 @@ use rins_earth::STANDARD_GRAVITY;
 use walk::WalkPath;
 
 /// Which motion the simulator produces.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Scenario {
     /// Parked level at the origin, fixed heading.
