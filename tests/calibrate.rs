@@ -388,7 +388,10 @@ fn calibrate_scenario_gives_the_simulated_iron_back() {
     ]));
     assert_eq!(report["samples"].as_u64(), Some(MAG_SAMPLES as u64));
     // Turned through the whole sphere of directions (1/3 for a uniform sphere, 0 for a plane).
-    assert!(report["direction_spread"].as_f64().expect("number") > 0.2, "{report}");
+    assert!(
+        report["direction_spread"].as_f64().expect("number") > 0.2,
+        "{report}"
+    );
     let cal = calibration(&report);
     // As for the file above: eight times the σ √(3/N) of a fitted centre, plus the 1 nT frames.
     let sigma = sim.sensors.mag_noise_ut;

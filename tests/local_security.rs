@@ -243,7 +243,10 @@ fn a_planted_resume_point_and_symlinked_temporary_file_are_neither_followed_nor_
     // through, nor the files deleted when they are another user's.
     let ipc = Isolated::new("resume");
     let _slot = PipelineSlot::take();
-    let up = common::spawn_up_navigating(&ipc, &["--scenario", "static", "--duration", "60", "--json"]);
+    let up = common::spawn_up_navigating(
+        &ipc,
+        &["--scenario", "static", "--duration", "60", "--json"],
+    );
     let shm = Path::new("/dev/shm");
     let point = shm.join(format!("{}acquisition.resume", ipc.prefix));
     let tmp = shm.join(format!("{}acquisition.tmp", ipc.prefix));
@@ -418,7 +421,10 @@ fn an_axis_that_is_not_a_unit_vector_is_refused() {
 fn stops_cleanly_on(sig: Signal, name: &str) {
     let ipc = Isolated::new(name);
     let _slot = PipelineSlot::take();
-    let up = common::spawn_up_navigating(&ipc, &["--scenario", "static", "--duration", "120", "--json"]);
+    let up = common::spawn_up_navigating(
+        &ipc,
+        &["--scenario", "static", "--duration", "120", "--json"],
+    );
     let pids = processes_of(&ipc.prefix);
     assert!(
         pids.len() >= 6,
@@ -468,7 +474,10 @@ fn sigterm_during_start_up_is_a_clean_stop() {
     // The same stop of an already running pipeline, by the helper every pipeline test uses.
     let ipc = Isolated::new("late");
     let _slot = PipelineSlot::take();
-    let up = common::spawn_up(&ipc, &["--scenario", "static", "--duration", "60", "--json"]);
+    let up = common::spawn_up(
+        &ipc,
+        &["--scenario", "static", "--duration", "60", "--json"],
+    );
     std::thread::sleep(Duration::from_millis(500));
     stop_up(&ipc, up);
 }

@@ -33,7 +33,11 @@ impl Default for CalibrationConfig {
             // A few µT: what a motor or a battery near the magnetometer typically adds.
             hard_iron_ut: [5.0, -3.0, 2.0],
             // A few per cent off identity.
-            soft_iron: [[1.04, 0.02, -0.01], [0.02, 0.97, 0.015], [-0.01, 0.015, 1.02]],
+            soft_iron: [
+                [1.04, 0.02, -0.01],
+                [0.02, 0.97, 0.015],
+                [-0.01, 0.015, 1.02],
+            ],
         }
     }
 }

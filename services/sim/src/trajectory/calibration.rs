@@ -68,10 +68,7 @@ impl CalibrationPath {
         let targets = TILTS_DEG.iter().map(Some).chain([None]);
         for target in targets {
             let (to_roll, to_pitch) = target.copied().unwrap_or((360.0, 0.0));
-            let step_deg = f64::max(
-                (to_roll - previous.0).abs(),
-                (to_pitch - previous.1).abs(),
-            );
+            let step_deg = f64::max((to_roll - previous.0).abs(), (to_pitch - previous.1).abs());
             if step_deg > 0.0 {
                 let step_s = sweep_s * step_deg / STEP_DEG_PER_SWEEP;
                 roll.step_to(t, step_s, f64::to_radians(to_roll));
@@ -163,7 +160,11 @@ mod tests {
         let (path, _) = CalibrationPath::new(start(), 6.0);
         // Eight turns of 6 s; tilt steps of 60° (5), 75°, 150° and 75°: 600° at 180° per turn.
         let expected = 8.0 * 6.0 + 6.0 * 600.0 / 180.0;
-        assert!((path.cycle_s() - expected).abs() < 1e-9, "{}", path.cycle_s());
+        assert!(
+            (path.cycle_s() - expected).abs() < 1e-9,
+            "{}",
+            path.cycle_s()
+        );
         let begin = path.sample(3.0);
         let end = path.sample(3.0 + path.cycle_s() - 1e-9);
         assert!(begin.attitude.angle_to(&end.attitude) < 1e-6);
@@ -186,7 +187,11 @@ mod tests {
         }
         // A turn runs at 360° over the turn less one ramp, 72 °/s; the step that rolls 60° while
         // pitching 75° peaks at √(48² + 60²) = 76.8 °/s. The simulated gyros reach 300 °/s.
-        assert!((peak.to_degrees() - 76.8).abs() < 0.5, "{}", peak.to_degrees());
+        assert!(
+            (peak.to_degrees() - 76.8).abs() < 0.5,
+            "{}",
+            peak.to_degrees()
+        );
         assert!(path.sample(1.0).stance && !path.sample(10.0).stance);
     }
 
@@ -200,7 +205,10 @@ mod tests {
             let b = path.sample(t + h).attitude;
             let numeric = (a.inverse() * b).scaled_axis() / h;
             let exact = path.sample(t + 0.5 * h).angular_rate_b;
-            assert!((numeric - exact).norm() < 1e-5, "t {t}: {numeric} vs {exact}");
+            assert!(
+                (numeric - exact).norm() < 1e-5,
+                "t {t}: {numeric} vs {exact}"
+            );
         }
     }
 
