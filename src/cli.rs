@@ -292,6 +292,9 @@ pub enum ScenarioArg {
     Uav,
     /// A foot-mounted sensor walked round a rectangle.
     Walk,
+    /// Turned on the spot through every orientation, the magnetometer distorted by hard and soft
+    /// iron (`[sim.calibration]`): data for `rins calibrate mag`.
+    Calibrate,
 }
 
 /// Options of `rins up`.
