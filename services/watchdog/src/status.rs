@@ -1,16 +1,9 @@
 //! The once-a-second status line.
 
 use ipc_types::{Integrity, NavMode, NavState, integrity_reason};
-use nalgebra::{Quaternion, UnitQuaternion};
+pub use rins_earth::euler_deg;
 
 use crate::monitor::{COUNTED, DeviceCounters};
-
-/// Roll, pitch, yaw in degrees (ZYX) of a body→NED quaternion [w, x, y, z].
-pub fn euler_deg(q: [f64; 4]) -> [f64; 3] {
-    let u = UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
-    let (r, p, y) = u.euler_angles();
-    [r.to_degrees(), p.to_degrees(), y.to_degrees()]
-}
 
 /// One status line: per-topic rates over the last period, losses, and the current solution.
 pub fn status_line(
@@ -78,6 +71,7 @@ pub fn status_line(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::UnitQuaternion;
 
     #[test]
     fn euler_of_a_known_attitude() {
