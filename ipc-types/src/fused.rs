@@ -114,6 +114,24 @@ pub mod fused_flags {
     /// counts): nothing was fused, the sample only carries the frame's header onwards so that
     /// downstream stages see the input and why it is unusable.
     pub const INPUT_REJECTED: u32 = 1 << 7;
+
+    /// Every flag with its name as tools print it, in bit order.
+    pub const NAMES: [(u32, &str); 8] = [
+        (
+            GYRO_FAULT_DETECTED_NOT_ISOLATED,
+            "gyro-fault-detected-not-isolated",
+        ),
+        (
+            ACCEL_FAULT_DETECTED_NOT_ISOLATED,
+            "accel-fault-detected-not-isolated",
+        ),
+        (GYRO_INSUFFICIENT, "gyro-insufficient"),
+        (ACCEL_INSUFFICIENT, "accel-insufficient"),
+        (GYRO_REST_BIAS_PENDING, "gyro-rest-bias-pending"),
+        (GYRO_SATURATED, "gyro-saturated"),
+        (ACCEL_SATURATED, "accel-saturated"),
+        (INPUT_REJECTED, "input-rejected"),
+    ];
 }
 
 impl Default for FusedImu {

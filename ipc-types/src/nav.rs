@@ -117,6 +117,17 @@ pub mod aiding {
     /// Magnetometer aiding is configured but no reading arrived within the aiding timeout: the
     /// heading coasts on the gyros.
     pub const MAG_STALE: u32 = 1 << 9;
+
+    /// Every bit with its name as tools print it, in bit order.
+    pub const NAMES: [(u32, &str); 7] = [
+        (BARO, "baro"),
+        (MAG, "mag"),
+        (ZUPT, "zupt"),
+        (HUPT, "hupt"),
+        (GRAVITY, "gravity"),
+        (BARO_STALE, "baro-stale"),
+        (MAG_STALE, "mag-stale"),
+    ];
 }
 
 /// Aiding sources counted in [`NavState::aiding_accepted`] / [`NavState::aiding_rejected`], in

@@ -217,3 +217,46 @@ fn readmit_outcome() {
         ]
     );
 }
+
+/// Every bit-set constant of a module, so that a bit added without a name is caught.
+fn assert_names_cover(names: &[(u32, &str)], bits: &[u32]) {
+    let named: Vec<u32> = names.iter().map(|(b, _)| *b).collect();
+    assert_eq!(named, bits, "every bit named once, in bit order");
+    for (bit, name) in names {
+        assert_eq!(bit.count_ones(), 1, "{name} is one bit");
+        assert!(!name.is_empty() && !name.contains(','), "{name:?}");
+    }
+}
+
+#[test]
+fn bit_names() {
+    use rins_ipc_types::{aiding, fused_flags as f, status};
+    assert_names_cover(
+        &f::NAMES,
+        &[
+            f::GYRO_FAULT_DETECTED_NOT_ISOLATED,
+            f::ACCEL_FAULT_DETECTED_NOT_ISOLATED,
+            f::GYRO_INSUFFICIENT,
+            f::ACCEL_INSUFFICIENT,
+            f::GYRO_REST_BIAS_PENDING,
+            f::GYRO_SATURATED,
+            f::ACCEL_SATURATED,
+            f::INPUT_REJECTED,
+        ],
+    );
+    assert_names_cover(
+        &aiding::NAMES,
+        &[
+            aiding::BARO,
+            aiding::MAG,
+            aiding::ZUPT,
+            aiding::HUPT,
+            aiding::GRAVITY,
+            aiding::BARO_STALE,
+            aiding::MAG_STALE,
+        ],
+    );
+    assert_names_cover(&status::NAMES, &[status::DEVICE_ERROR, status::SATURATION]);
+    assert_eq!(f::NAMES[2].1, "gyro-insufficient");
+    assert_eq!(aiding::NAMES[5].1, "baro-stale");
+}
