@@ -59,6 +59,10 @@ pub enum Command {
         /// Comma-separated values with a header line, instead of one JSON object per line.
         #[arg(long)]
         csv: bool,
+        /// Print the wire form: padding, unused channel slots, enums and bit sets as numbers, no
+        /// derived angles (by default: channels in use, names, roll/pitch/yaw and degrees).
+        #[arg(long)]
+        raw: bool,
         /// Fail when no sample arrives for this many seconds (0: wait for ever).
         #[arg(long, allow_negative_numbers = true, default_value_t = 10.0)]
         timeout: f64,

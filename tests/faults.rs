@@ -252,7 +252,7 @@ impl Pipeline {
 /// Valid-mask bit of gyro `i` in the last of a few raw IMU frames.
 fn gyro_valid(ipc: &Isolated, i: u32) -> bool {
     let out = ipc.run_with_timeout(
-        &["echo", "raw-imu", "--count", "3"],
+        &["echo", "raw-imu", "--raw", "--count", "3"],
         Duration::from_secs(10),
     );
     assert!(out.status.success(), "echo failed:\n{}", stderr(&out));
