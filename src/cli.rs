@@ -406,6 +406,9 @@ pub struct SoakArgs {
     /// readmit it), disconnect (unplug the serial device for 0.2-1 s).
     #[arg(long, default_value = "kill,sensor")]
     pub faults: String,
+    /// Print the summary as one JSON object on stdout (progress stays on stderr).
+    #[arg(long)]
+    pub json: bool,
 }
 
 impl From<SoakArgs> for rins_soak::SoakArgs {
@@ -416,6 +419,7 @@ impl From<SoakArgs> for rins_soak::SoakArgs {
             min_interval_s: a.min_interval_s,
             max_interval_s: a.max_interval_s,
             faults: a.faults,
+            json: a.json,
         }
     }
 }
