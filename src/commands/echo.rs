@@ -9,9 +9,10 @@ use ipc_types::{
     Altitude, FusedImu, Health, HealthReport, NavState, RawAux, RawBaro, RawImu, RawMag, Truth,
     names,
 };
-use rins_runtime::ipc::{IpcNode, SampleSource, TopicSubscriber, create_node};
+use rins_runtime::ipc::{IpcNode, SampleSource, TopicSubscriber};
 use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::shutdown::Shutdown;
+use rins_runtime::tool_node::ToolNode;
 use serde_json::Value;
 
 use super::echo_readable::{BIT_FIELDS, Readable};
@@ -128,9 +129,10 @@ where
 {
     let started_ns = rins_runtime::clock::monotonic_ns();
     let shutdown = Shutdown::install()?;
-    let settings = rins_runtime::join_check::settings_to_join()?;
-    let node = create_node(&format!("echo-{}", std::process::id()), &settings)?;
-    let mut sub = open(&node)?;
+    // Ports are made after the tool node, so they are dropped before it cleans up.
+    let tool = ToolNode::join("echo")?;
+    let node = tool.node();
+    let mut sub = open(node)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     let mut printed = 0u64;

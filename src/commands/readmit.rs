@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use anyhow::{Result, anyhow};
 use ipc_types::{FusionControl, PAYLOAD_VERSION, names};
-use rins_runtime::ipc::create_node;
+use rins_runtime::tool_node::ToolNode;
 use rins_sim::fault_command::ChannelId;
 
 use crate::commands::control;
@@ -17,8 +17,9 @@ const DELIVERY_GRACE: Duration = Duration::from_millis(500);
 
 pub fn run(channel: &str) -> Result<()> {
     let channel = ChannelId::parse(channel).map_err(|e| anyhow!("{e}"))?;
-    let settings = rins_runtime::join_check::settings_to_join()?;
-    let node = create_node(&format!("readmit-{}", std::process::id()), &settings)?;
+    // Ports are made after the tool node, so they are dropped before it cleans up.
+    let tool = ToolNode::join("readmit")?;
+    let (node, settings) = (tool.node(), tool.settings());
     let command = FusionControl {
         version: PAYLOAD_VERSION,
         sensor: channel.sensor as u8,
@@ -26,8 +27,8 @@ pub fn run(channel: &str) -> Result<()> {
         request_id: std::process::id(),
     };
     let sent = control::send(
-        &node,
-        &settings,
+        node,
+        settings,
         names::FUSION_CONTROL,
         "fusion process",
         command,
