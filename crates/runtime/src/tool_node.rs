@@ -7,13 +7,15 @@
 //! tool may have created the root itself: made by the tool when no pipeline runs, they would stay
 //! until the next `rins up` cleans them. So once the node is gone and no live node is left on the
 //! deployment, what is left on its prefix is a tool's and is removed, and the root too when this
-//! tool created it and it is empty. While a pipeline runs, its files are left alone.
+//! tool created it and it is empty. While a pipeline runs, its files are left alone but for the
+//! connection segments to the tool's own subscribers, which the pipeline's publishers may keep for
+//! a long time.
 
 use std::path::Path;
 
 use anyhow::Result;
 
-use crate::ipc::{IpcNode, IpcSettings, create_node, for_each_live_node};
+use crate::ipc::{IpcNode, IpcSettings, create_node, for_each_live_node, own_ports};
 use crate::{join_check, private_dir, shm_cleanup, user};
 
 /// A tool's node on the deployment of the environment's prefix and root (see
@@ -56,6 +58,22 @@ impl ToolNode {
     }
 }
 
+/// With a pipeline running: removes the connection segments from its publishers to this process's
+/// subscribers, which are gone (see [`own_ports`]); everything else there is the pipeline's.
+fn remove_connections_to_own_receivers(settings: &IpcSettings) {
+    let ours = own_ports::receivers();
+    let uid = user::effective_uid();
+    for entry in shm_cleanup::inspect(Path::new(shm_cleanup::SHM_DIR), &settings.prefix) {
+        if entry.belongs_to(uid)
+            && ours
+                .iter()
+                .any(|&id| own_ports::is_connection_to(&entry.name, id))
+        {
+            let _ = std::fs::remove_file(Path::new(shm_cleanup::SHM_DIR).join(&entry.name));
+        }
+    }
+}
+
 /// What a [`ToolNode`] removes once its node is gone.
 struct Cleanup {
     settings: IpcSettings,
@@ -71,7 +89,11 @@ impl Drop for Cleanup {
             return;
         }
         let mut alive = 0usize;
-        if for_each_live_node(&self.settings, |_| alive += 1).is_err() || alive > 0 {
+        if for_each_live_node(&self.settings, |_| alive += 1).is_err() {
+            return;
+        }
+        if alive > 0 {
+            remove_connections_to_own_receivers(&self.settings);
             return;
         }
         let removed = shm_cleanup::remove_all(&self.settings, self.root_created);
