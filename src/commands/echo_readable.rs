@@ -202,32 +202,30 @@ impl Readable for FusedImu {
     }
 }
 
+/// A solution or its truth: the wire form with times by stage and the angles in degrees.
+fn solution(
+    sample: &impl Serialize,
+    quaternion: [f64; 4],
+    lat_rad: f64,
+    lon_rad: f64,
+) -> serde_json::Result<Map<String, Value>> {
+    let mut m = wire(sample)?;
+    header(&mut m);
+    angles(&mut m, quaternion, lat_rad, lon_rad);
+    Ok(m)
+}
+
 impl Readable for NavState {
     fn readable(&self) -> serde_json::Result<Value> {
-        let mut m = wire(self)?;
-        header(&mut m);
+        let mut m = solution(self, self.quaternion, self.latitude_rad, self.longitude_rad)?;
         nav_status(&mut m);
-        angles(
-            &mut m,
-            self.quaternion,
-            self.latitude_rad,
-            self.longitude_rad,
-        );
         Ok(Value::Object(m))
     }
 }
 
 impl Readable for Truth {
     fn readable(&self) -> serde_json::Result<Value> {
-        let mut m = wire(self)?;
-        header(&mut m);
-        angles(
-            &mut m,
-            self.quaternion,
-            self.latitude_rad,
-            self.longitude_rad,
-        );
-        Ok(Value::Object(m))
+        solution(self, self.quaternion, self.latitude_rad, self.longitude_rad).map(Value::Object)
     }
 }
 
