@@ -297,7 +297,8 @@ pub struct UpArgs {
     /// Stop after this many seconds and exit 0.
     #[arg(long, allow_negative_numbers = true)]
     pub duration: Option<f64>,
-    /// With --duration: print a JSON summary as the last line.
+    /// Print the run's summary as one JSON object, the only thing on stdout (the status lines go
+    /// to stderr). Without it, a run with --duration ends with the summary as text.
     #[arg(long)]
     pub json: bool,
     /// Configuration file (default: the built-in configuration).
