@@ -18,6 +18,8 @@ pub struct BuiltServices {
     pub fuser: ImuFuser,
     /// How long fusion waits for raw IMU before it reports acquisition stale.
     pub fusion_input_deadline: Duration,
+    /// Fused samples a channel re-admitted by command stays on probation.
+    pub readmit_probation_samples: u32,
     /// The altimeter's estimator.
     pub altimeter: AltitudeEstimator,
     /// The navigator (either lane runs one).
@@ -49,6 +51,7 @@ impl RinsConfig {
         Ok(BuiltServices {
             fuser,
             fusion_input_deadline: rins_fusion::service::input_deadline(self.fusion.sample_rate_hz),
+            readmit_probation_samples: self.fusion.fdi.readmit_probation_samples,
             altimeter,
             navigator,
         })

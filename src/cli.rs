@@ -48,6 +48,11 @@ pub enum Command {
         #[arg(long, allow_negative_numbers = true, default_value_t = 2.0)]
         timeout: f64,
     },
+    /// Listen to a serial device and say what is on the line: bytes, frame types and their rates,
+    /// CRC failures, malformed frames, discarded bytes, the last decode error and a verdict.
+    /// With --scan, listen at each standard baud rate and say which gives valid frames (a
+    /// pseudo-terminal, such as the simulator's, ignores the rate: it shows frames at every one).
+    Probe(ProbeArgs),
     /// Print every sample of a topic.
     Echo {
         /// Topic: raw-imu, raw-baro, raw-mag, raw-aux, fused-imu, altitude, nav, truth, heartbeat,
@@ -69,10 +74,15 @@ pub enum Command {
     },
     /// Inject a fault into one channel of the running simulator ("kill a sensor").
     Inject(InjectArgs),
-    /// Return a channel that fusion excluded to service (exclusions latch until then).
+    /// Return a channel that fusion excluded to service and wait for fusion's answer: readmitted
+    /// once it stayed in the solution through its probation, or refused (fault still present, no
+    /// such channel); exits non-zero unless it is in the solution.
     Readmit {
         /// Channel: gyro or accel followed by its 0-based index, e.g. gyro2, accel0.
         channel: String,
+        /// Longest wait for fusion's answer, s (the probation is 1 s at 1 kHz by default).
+        #[arg(long, allow_negative_numbers = true, default_value_t = 5.0)]
+        timeout: f64,
     },
     /// Measure latency from serial receive through every stage to the navigation state.
     Latency {
@@ -286,6 +296,9 @@ pub enum ScenarioArg {
     Uav,
     /// A foot-mounted sensor walked round a rectangle.
     Walk,
+    /// Turned on the spot through every orientation, the magnetometer distorted by hard and soft
+    /// iron (`[sim.calibration]`): data for `rins calibrate mag`.
+    Calibrate,
 }
 
 /// Options of `rins up`.
@@ -294,7 +307,8 @@ pub struct UpArgs {
     /// Simulator scenario (overrides sim.scenario).
     #[arg(long)]
     pub scenario: Option<ScenarioArg>,
-    /// Stop after this many seconds and exit 0.
+    /// Stop after this many seconds and exit 0; non-zero when no valid frame arrived in all that
+    /// time (the message names the port and what the line carried).
     #[arg(long, allow_negative_numbers = true)]
     pub duration: Option<f64>,
     /// Print the run's summary as one JSON object, the only thing on stdout (the status lines go
@@ -333,6 +347,28 @@ impl FaultArgs {
     pub fn is_empty(&self) -> bool {
         self.inject.is_empty() && self.faults.is_none()
     }
+}
+
+/// Options of `rins probe`.
+#[derive(Debug, Args)]
+pub struct ProbeArgs {
+    /// The serial device, e.g. /dev/ttyUSB0.
+    #[arg(long)]
+    pub port: PathBuf,
+    /// Line speed, baud (default: acquisition.baud of the built-in configuration, 921600).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub baud: Option<u32>,
+    /// How long to listen, s (> 0, <= 3600); with --scan, at each rate (default 3, with --scan 1).
+    #[arg(long, allow_negative_numbers = true)]
+    pub seconds: Option<f64>,
+    /// Try the standard baud rates, 9600 to 921600, then 1500000, 2000000 and 3000000 where the
+    /// driver accepts them, and say which gives valid frames. A pseudo-terminal ignores the rate,
+    /// so on one every rate shows frames.
+    #[arg(long, conflicts_with = "baud")]
+    pub scan: bool,
+    /// One JSON object on stdout instead of the report.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Options of `rins inject`.

@@ -11,7 +11,7 @@ use rins_navigator::config::NavigatorConfig;
 use rins_runtime::bounded_file;
 use rins_sim::SimConfig;
 use rins_watchdog::config::WatchdogConfig;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::cli::ScenarioArg;
 
@@ -24,7 +24,7 @@ pub const PEDESTRIAN: &str = include_str!("../config/pedestrian.toml");
 pub const UAV: &str = include_str!("../config/uav.toml");
 
 /// What the sensor block's datasheet says about its converters.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct DeviceConfig {
     /// Gyro full scale: ±this many °/s over the 12-bit range.
@@ -80,7 +80,7 @@ impl DeviceConfig {
 }
 
 /// Which processes `rins up` runs.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct DeploymentConfig {
     /// 1: one navigator; 2: a primary and a hot standby.
@@ -108,7 +108,7 @@ impl DeploymentConfig {
 
 /// The whole configuration file: one table per service plus the device and the deployment. Every
 /// table has defaults, and an unknown key anywhere is refused.
-#[derive(Debug, Clone, PartialEq, Deserialize, Default)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, Default)]
 #[serde(deny_unknown_fields, default)]
 pub struct RinsConfig {
     /// `[device]`: the sensor block's converters.
@@ -176,6 +176,7 @@ impl RinsConfig {
             rins_sim::Scenario::Static => "static",
             rins_sim::Scenario::Uav => "uav",
             rins_sim::Scenario::Walk => "walk",
+            rins_sim::Scenario::Calibrate => "calibrate",
         }
     }
 
@@ -185,6 +186,7 @@ impl RinsConfig {
             ScenarioArg::Static => rins_sim::Scenario::Static,
             ScenarioArg::Uav => rins_sim::Scenario::Uav,
             ScenarioArg::Walk => rins_sim::Scenario::Walk,
+            ScenarioArg::Calibrate => rins_sim::Scenario::Calibrate,
         };
     }
 }

@@ -1,11 +1,12 @@
 //! `rins calibrate mag`: samples from the simulator's own magnetometer model, with known hard and
-//! soft iron, go through the command and come back as the calibration that undoes them.
+//! soft iron, go through the command and come back as the calibration that undoes them — from a
+//! file made here, and end to end from a running pipeline on the `calibrate` scenario.
 
 mod common;
 
 use std::process::Output;
 
-use common::Isolated;
+use common::{Isolated, PipelineSlot, spawn_up_navigating, stop_up};
 use rins_navigator::attitude::quaternion_from_euler;
 use rins_navigator::mag_calibration::MagCalibration;
 use rins_protocol::MagFrame;
@@ -116,43 +117,11 @@ fn sim_readings_round_trip_to_the_configured_iron() {
     let sigma = sim.sensors.mag_noise_ut;
     let samples = sim_readings(&sim);
     let csv = mag_csv(&plain_csv(&samples));
-    let field_arg = field_ut.to_string();
     let ipc = Isolated::new("calibrate");
-    let report = stdout_json(&ipc.run(&[
-        "calibrate",
-        "mag",
-        csv.path(),
-        "--field-ut",
-        &field_arg,
-        "--json",
-    ]));
+    let report = fit_with_field(&ipc, &csv, field_ut);
     assert_eq!(report["samples"].as_u64(), Some(SAMPLES as u64));
     let cal = calibration(&report);
-
-    // The centre of a sphere fitted to N readings with per-axis noise σ has σ √(3/N) per axis;
-    // the ellipsoid's extra parameters widen that by a small factor. Eight of those, plus the
-    // 1 nT quantisation of the frame.
-    let tolerance = 8.0 * sigma * (3.0 / SAMPLES as f64).sqrt() + 1e-3;
-    for (got, want) in cal.hard_iron_ut.iter().zip(HARD_IRON_UT) {
-        assert!(
-            (got - want).abs() < tolerance,
-            "hard iron {:?}, tolerance {tolerance} µT",
-            cal.hard_iron_ut
-        );
-    }
-    let expected = inverse(SOFT_IRON);
-    for (got, want) in cal
-        .soft_iron_correction
-        .iter()
-        .flatten()
-        .zip(expected.iter().flatten())
-    {
-        assert!(
-            (got - want).abs() < 0.01,
-            "W = {:?}",
-            cal.soft_iron_correction
-        );
-    }
+    assert_undoes_the_test_iron(&cal, SAMPLES, sigma);
     for m in &samples {
         let h = norm(cal.apply(*m));
         assert!(
@@ -170,6 +139,48 @@ fn sim_readings_round_trip_to_the_configured_iron() {
     let w = fragment.soft_iron_correction.iter().flatten();
     for (a, b) in w.zip(cal.soft_iron_correction.iter().flatten()) {
         assert!((a - b).abs() <= 5e-7);
+    }
+}
+
+/// `rins calibrate mag FILE --field-ut F --json`, its report.
+fn fit_with_field(ipc: &Isolated, csv: &common::TempFile, field_ut: f64) -> serde_json::Value {
+    let field_arg = field_ut.to_string();
+    stdout_json(&ipc.run(&[
+        "calibrate",
+        "mag",
+        csv.path(),
+        "--field-ut",
+        &field_arg,
+        "--json",
+    ]))
+}
+
+/// `cal`, fitted to `samples` readings with per-axis noise `sigma` µT, undoes [`HARD_IRON_UT`] and
+/// [`SOFT_IRON`].
+fn assert_undoes_the_test_iron(cal: &MagCalibration, samples: usize, sigma: f64) {
+    // The centre of a sphere fitted to N readings with per-axis noise σ has σ √(3/N) per axis;
+    // the ellipsoid's extra parameters widen that by a small factor. Eight of those, plus the
+    // 1 nT quantisation of the frame.
+    let tolerance = 8.0 * sigma * (3.0 / samples as f64).sqrt() + 1e-3;
+    for (got, want) in cal.hard_iron_ut.iter().zip(HARD_IRON_UT) {
+        assert!(
+            (got - want).abs() < tolerance,
+            "hard iron {:?}, want {HARD_IRON_UT:?} within {tolerance} µT",
+            cal.hard_iron_ut
+        );
+    }
+    let expected = inverse(SOFT_IRON);
+    for (got, want) in cal
+        .soft_iron_correction
+        .iter()
+        .flatten()
+        .zip(expected.iter().flatten())
+    {
+        assert!(
+            (got - want).abs() < 0.01,
+            "W = {:?}, want {expected:?}",
+            cal.soft_iron_correction
+        );
     }
 }
 
@@ -334,4 +345,59 @@ fn unusable_samples_are_refused_with_the_reason() {
         &["calibrate", "mag", all.path(), "--field-ut", "0"],
         &["--field-ut 0: must be a positive number"],
     );
+}
+
+/// `[sim.calibration]` with the test's iron and 3 s turns: one cycle of turns lasts 34 s.
+fn calibrate_scenario_config() -> String {
+    let row = |r: [f64; 3]| format!("[{}, {}, {}]", r[0], r[1], r[2]);
+    format!(
+        "[sim.calibration]\nsweep_s = 3.0\nhard_iron_ut = {}\nsoft_iron = [{}, {}, {}]\n",
+        row(HARD_IRON_UT),
+        row(SOFT_IRON[0]),
+        row(SOFT_IRON[1]),
+        row(SOFT_IRON[2])
+    )
+}
+
+/// `rins up --scenario calibrate` in one terminal, `rins echo raw-mag --csv` and `rins calibrate
+/// mag` in the other: the fit recovers the iron the configuration gave the simulator.
+#[test]
+fn calibrate_scenario_gives_the_simulated_iron_back() {
+    const MAG_SAMPLES: usize = 3500;
+    let _slot = PipelineSlot::take();
+    let config = common::TempFile::new("calibrate", "toml", &calibrate_scenario_config());
+    let ipc = Isolated::new("calibrate_e2e");
+    let up = spawn_up_navigating(
+        &ipc,
+        &[
+            "--scenario",
+            "calibrate",
+            "--config",
+            config.path(),
+            "--duration",
+            "300",
+            "--json",
+        ],
+    );
+    // 35 s at 100 Hz: a whole cycle of turns, wherever in the cycle it starts.
+    let count = MAG_SAMPLES.to_string();
+    let echo = ipc.run(&["echo", "raw-mag", "--csv", "--count", &count]);
+    stop_up(&ipc, up);
+    assert!(echo.status.success(), "{}", common::stderr(&echo));
+    let csv = mag_csv(&String::from_utf8_lossy(&echo.stdout));
+
+    let sim = SimConfig::default();
+    let report = fit_with_field(&ipc, &csv, sim.earth_field.intensity_ut);
+    assert_eq!(report["samples"].as_u64(), Some(MAG_SAMPLES as u64));
+    // Turned through the whole sphere of directions (1/3 for a uniform sphere, 0 for a plane).
+    assert!(
+        report["direction_spread"].as_f64().expect("number") > 0.2,
+        "{report}"
+    );
+    let cal = calibration(&report);
+    eprintln!(
+        "calibrate scenario: hard iron {:?} µT, W {:?}",
+        cal.hard_iron_ut, cal.soft_iron_correction
+    );
+    assert_undoes_the_test_iron(&cal, MAG_SAMPLES, sim.sensors.mag_noise_ut);
 }

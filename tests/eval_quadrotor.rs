@@ -197,7 +197,7 @@ fn per_unit(report: &Value, key: &str) -> Vec<f64> {
 
 /// The AHRS mode on the twelve flights: every flight evaluated, the data's three repeated
 /// timestamps and one missing sample repaired, each unit alone and each unit's own filter scored,
-/// and the fused solution below every one of the units' own filters (the claim the README makes).
+/// and the fused solution below every one of the units' own filters (the claim docs/accuracy.md makes).
 #[test]
 fn eval_quadrotor_ahrs_scores_every_flight_beside_each_units_own_filter() {
     let Some(dir) = common::quadrotor_data_dir() else {

@@ -211,7 +211,7 @@ fn an_existing_directory_used_as_root_is_kept_with_its_files() {
     std::fs::create_dir(&ipc.root).unwrap();
     std::fs::set_permissions(&ipc.root, std::fs::Permissions::from_mode(0o700)).unwrap();
     std::fs::write(ipc.root.join("notes.txt"), "mine").unwrap();
-    let out = ipc.run(&["up", "--duration", "2", "--json"]);
+    let out = ipc.run(&["up", "--scenario", "static", "--duration", "2", "--json"]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(common::num(&common::last_json(&out), "frames") > 0.0);
     assert_eq!(
@@ -243,7 +243,10 @@ fn a_planted_resume_point_and_symlinked_temporary_file_are_neither_followed_nor_
     // through, nor the files deleted when they are another user's.
     let ipc = Isolated::new("resume");
     let _slot = PipelineSlot::take();
-    let up = common::spawn_up_navigating(&ipc, &["--duration", "60", "--json"]);
+    let up = common::spawn_up_navigating(
+        &ipc,
+        &["--scenario", "static", "--duration", "60", "--json"],
+    );
     let shm = Path::new("/dev/shm");
     let point = shm.join(format!("{}acquisition.resume", ipc.prefix));
     let tmp = shm.join(format!("{}acquisition.tmp", ipc.prefix));
@@ -282,7 +285,7 @@ fn a_planted_resume_point_and_symlinked_temporary_file_are_neither_followed_nor_
         std::fs::set_permissions(dir, std::fs::Permissions::from_mode(0o700)).unwrap();
     }
     std::os::unix::fs::symlink(&secret, run.join("acquisition.tmp")).unwrap();
-    let out = ipc.run(&["up", "--duration", "3", "--json"]);
+    let out = ipc.run(&["up", "--scenario", "static", "--duration", "3", "--json"]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(common::num(&common::last_json(&out), "frames") > 1000.0);
     assert_eq!(std::fs::read_to_string(&secret).unwrap(), "root-only");
@@ -322,7 +325,7 @@ fn another_users_deployment_on_our_prefix_is_neither_joined_nor_removed() {
     let their_root = std::env::temp_dir().join(format!("{}attacker", ipc.prefix));
     let mut attacker = ipc.command();
     attacker
-        .args(["up", "--duration", "60"])
+        .args(["up", "--scenario", "static", "--duration", "60"])
         .env("RINS_IPC_ROOT", &their_root)
         .uid(NOBODY)
         .gid(NOBODY)
@@ -418,7 +421,10 @@ fn an_axis_that_is_not_a_unit_vector_is_refused() {
 fn stops_cleanly_on(sig: Signal, name: &str) {
     let ipc = Isolated::new(name);
     let _slot = PipelineSlot::take();
-    let up = common::spawn_up_navigating(&ipc, &["--duration", "120", "--json"]);
+    let up = common::spawn_up_navigating(
+        &ipc,
+        &["--scenario", "static", "--duration", "120", "--json"],
+    );
     let pids = processes_of(&ipc.prefix);
     assert!(
         pids.len() >= 6,
@@ -450,7 +456,7 @@ fn sigterm_during_start_up_is_a_clean_stop() {
         let _slot = PipelineSlot::take();
         let up = ipc
             .command()
-            .args(["up", "--duration", "60"])
+            .args(["up", "--scenario", "static", "--duration", "60"])
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()
@@ -468,7 +474,10 @@ fn sigterm_during_start_up_is_a_clean_stop() {
     // The same stop of an already running pipeline, by the helper every pipeline test uses.
     let ipc = Isolated::new("late");
     let _slot = PipelineSlot::take();
-    let up = common::spawn_up(&ipc, &["--duration", "60", "--json"]);
+    let up = common::spawn_up(
+        &ipc,
+        &["--scenario", "static", "--duration", "60", "--json"],
+    );
     std::thread::sleep(Duration::from_millis(500));
     stop_up(&ipc, up);
 }

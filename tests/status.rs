@@ -3,7 +3,7 @@
 
 mod common;
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use common::{Isolated, PipelineSlot, TempFile, spawn_up, spawn_up_navigating, stop_up};
 use rins_test_support::signal::{Signal, process_exists, send_signal};
@@ -16,19 +16,6 @@ fn service<'a>(report: &'a Value, name: &str) -> &'a Value {
         .iter()
         .find(|s| s["service"] == name)
         .unwrap_or_else(|| panic!("no {name} in {report}"))
-}
-
-/// Polls the status until `done` holds (or fails after `limit`).
-fn wait_for(ipc: &Isolated, limit: Duration, done: impl Fn(&Value) -> bool) -> Value {
-    let start = Instant::now();
-    loop {
-        let report = ipc.status();
-        if done(&report) {
-            return report;
-        }
-        assert!(start.elapsed() < limit, "gave up waiting: {report}");
-        std::thread::sleep(Duration::from_millis(200));
-    }
 }
 
 #[test]
@@ -48,7 +35,7 @@ fn status_shows_every_process_and_counts_a_restart_after_sigkill() {
         "navigator",
         "sim",
     ];
-    let report = wait_for(&ipc, Duration::from_secs(20), |r| {
+    let report = ipc.status_until(Duration::from_secs(20), |r| {
         names.iter().all(|n| service(r, n)["state"] == "running")
     });
     for name in names {
@@ -71,7 +58,7 @@ fn status_shows_every_process_and_counts_a_restart_after_sigkill() {
     let old_pid = service(&report, "fusion")["pid"].as_u64().unwrap();
     // A process of this test's own pipeline.
     send_signal(old_pid, Signal::Kill).expect("SIGKILL");
-    let after = wait_for(&ipc, Duration::from_secs(20), |r| {
+    let after = ipc.status_until(Duration::from_secs(20), |r| {
         let f = service(r, "fusion");
         f["restarts"] == 1 && f["state"] == "running"
     });
@@ -118,13 +105,13 @@ fn stopped_service_is_replaced(test: &str, watchdog: &str, name: &str, limit: Du
             "--json",
         ],
     );
-    let report = wait_for(&ipc, Duration::from_secs(60), |r| {
+    let report = ipc.status_until(Duration::from_secs(60), |r| {
         service(r, name)["state"] == "running"
     });
     let old_pid = service(&report, name)["pid"].as_u64().unwrap();
     // SIGSTOP: the process is still there but does nothing, as if hung.
     send_signal(old_pid, Signal::Stop).expect("SIGSTOP");
-    let after = wait_for(&ipc, limit, |r| {
+    let after = ipc.status_until(limit, |r| {
         let s = service(r, name);
         s["restarts"] == 1 && s["state"] == "running"
     });
@@ -178,7 +165,7 @@ fn fusion_says_when_acquisition_goes_quiet_and_when_it_is_back() {
         &ipc,
         &["--scenario", "static", "--duration", "300", "--json"],
     );
-    let report = wait_for(&ipc, Duration::from_secs(60), |r| {
+    let report = ipc.status_until(Duration::from_secs(60), |r| {
         service(r, "acquisition")["state"] == "running"
             && service(r, "fusion")["state"] == "running"
     });
@@ -188,10 +175,10 @@ fn fusion_says_when_acquisition_goes_quiet_and_when_it_is_back() {
     // a second) says so; after the 3 s heartbeat timeout the watchdog replaces acquisition and
     // fusion's input returns.
     send_signal(pid, Signal::Stop).expect("SIGSTOP");
-    wait_for(&ipc, Duration::from_secs(10), |r| {
+    ipc.status_until(Duration::from_secs(10), |r| {
         service(r, "fusion")["input_stale"] == true
     });
-    wait_for(&ipc, Duration::from_secs(30), |r| {
+    ipc.status_until(Duration::from_secs(30), |r| {
         let a = service(r, "acquisition");
         a["restarts"] == 1
             && a["state"] == "running"

@@ -138,6 +138,8 @@ wire_enum! {
         /// The channel was excluded again during the probation period: the fault is still
         /// present ([`FusionReply::reason`] says which test found it).
         FaultStillPresent = 4 => "fault-still-present",
+        /// Too many re-admissions are on probation at once: nothing was done, ask again.
+        Busy = 5 => "busy",
     }
 }
 

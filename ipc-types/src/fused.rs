@@ -115,15 +115,12 @@ pub mod fused_flags {
     /// downstream stages see the input and why it is unusable.
     pub const INPUT_REJECTED: u32 = 1 << 7;
 
-    /// Every flag with its name as tools print it, in bit order.
+    /// Every flag with its name, in bit order.
     pub const NAMES: [(u32, &str); 8] = [
-        (
-            GYRO_FAULT_DETECTED_NOT_ISOLATED,
-            "gyro-fault-detected-not-isolated",
-        ),
+        (GYRO_FAULT_DETECTED_NOT_ISOLATED, "gyro-fault-not-isolated"),
         (
             ACCEL_FAULT_DETECTED_NOT_ISOLATED,
-            "accel-fault-detected-not-isolated",
+            "accel-fault-not-isolated",
         ),
         (GYRO_INSUFFICIENT, "gyro-insufficient"),
         (ACCEL_INSUFFICIENT, "accel-insufficient"),

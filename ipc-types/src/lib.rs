@@ -45,3 +45,14 @@ pub const PAYLOAD_VERSION: u16 = 6;
 
 /// Up to this many single-axis channels per sensor type (gyro, accelerometer).
 pub const MAX_CHANNELS: usize = 16;
+
+/// The names of the bits of `bits` that `names` lists, in the list's order; bits it does not list
+/// are left out (a flag word's `NAMES`: [`fused_flags::NAMES`], [`aiding::SOURCE_NAMES`],
+/// [`integrity_reason::NAMES`]).
+pub fn bit_names(bits: u32, names: &[(u32, &'static str)]) -> Vec<&'static str> {
+    names
+        .iter()
+        .filter(|(bit, _)| bits & bit != 0)
+        .map(|(_, name)| *name)
+        .collect()
+}

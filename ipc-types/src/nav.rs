@@ -87,12 +87,7 @@ pub mod integrity_reason {
 
     /// The names of the bits set in `reasons`, comma-separated (empty for none).
     pub fn describe(reasons: u32) -> String {
-        let names: Vec<&str> = NAMES
-            .iter()
-            .filter(|(bit, _)| reasons & bit != 0)
-            .map(|(_, name)| *name)
-            .collect();
-        names.join(",")
+        crate::bit_names(reasons, &NAMES).join(",")
     }
 }
 
@@ -118,16 +113,17 @@ pub mod aiding {
     /// heading coasts on the gyros.
     pub const MAG_STALE: u32 = 1 << 9;
 
-    /// Every bit with its name as tools print it, in bit order.
-    pub const NAMES: [(u32, &str); 7] = [
+    /// Every source with its name, in bit order.
+    pub const SOURCE_NAMES: [(u32, &str); 5] = [
         (BARO, "baro"),
         (MAG, "mag"),
         (ZUPT, "zupt"),
         (HUPT, "hupt"),
         (GRAVITY, "gravity"),
-        (BARO_STALE, "baro-stale"),
-        (MAG_STALE, "mag-stale"),
     ];
+
+    /// Every stale-source bit with the source's name.
+    pub const STALE_NAMES: [(u32, &str); 2] = [(BARO_STALE, "baro"), (MAG_STALE, "mag")];
 }
 
 /// Aiding sources counted in [`NavState::aiding_accepted`] / [`NavState::aiding_rejected`], in

@@ -18,8 +18,6 @@ const POLL: Duration = Duration::from_millis(20);
 /// that had not yet connected would never see it once the sender is gone.
 pub struct SentCommand<T: Debug + ZeroCopySend + 'static> {
     _publisher: Publisher<ipc::Service, T, ()>,
-    /// Subscribers the command reached.
-    pub receivers: usize,
 }
 
 /// Publishes `value` on `topic` once a subscriber exists, waiting up to `wait` for one; `listener`
@@ -79,6 +77,5 @@ pub fn send<T: Debug + ZeroCopySend + Copy + 'static>(
     }
     Ok(SentCommand {
         _publisher: publisher,
-        receivers,
     })
 }

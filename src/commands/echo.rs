@@ -269,10 +269,7 @@ mod tests {
         }
         assert!(!keys.iter().any(|k| k.contains("_pad")), "{keys:?}");
         let flags = columns.iter().find(|(k, _)| k == "flags").unwrap();
-        assert_eq!(
-            flags.1,
-            "gyro-fault-detected-not-isolated|gyro-rest-bias-pending"
-        );
+        assert_eq!(flags.1, "gyro-fault-not-isolated|gyro-rest-bias-pending");
         assert!(keys.contains(&"header.stage_pub_ns.navigator"), "{keys:?}");
         // 41 columns where the wire form has 89.
         assert_eq!(columns.len(), 41, "{keys:?}");

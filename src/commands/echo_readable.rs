@@ -77,24 +77,37 @@ fn name(map: &mut Map<String, Value>, key: &str, decode: impl Fn(u8) -> Option<&
     }
 }
 
-/// The names of the bits set in `bits`, in bit order; a bit without a name as `"bit N"`.
-pub fn bit_names(bits: u32, names: &[(u32, &'static str)]) -> Vec<String> {
-    (0..32)
-        .map(|i| 1u32 << i)
-        .filter(|bit| bits & bit != 0)
-        .map(|bit| match names.iter().find(|(b, _)| *b == bit) {
-            Some((_, name)) => (*name).to_string(),
-            None => format!("bit {}", bit.trailing_zeros()),
-        })
-        .collect()
+/// One list of bit names and what to append to each name (`-stale` for the aiding sources that
+/// went quiet).
+type BitGroup<'a> = (&'a [(u32, &'static str)], &'a str);
+
+/// The names of the bits set in `bits`, group by group; a bit no group names as `"bit N"`.
+fn named_bits(bits: u32, groups: &[BitGroup<'_>]) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut named = 0u32;
+    for (names, suffix) in groups {
+        out.extend(
+            ipc_types::bit_names(bits, names)
+                .iter()
+                .map(|n| format!("{n}{suffix}")),
+        );
+        named |= names.iter().fold(0, |all, (bit, _)| all | bit);
+    }
+    let unknown = bits & !named;
+    out.extend(
+        (0..32)
+            .filter(|i| unknown & (1 << i) != 0)
+            .map(|i| format!("bit {i}")),
+    );
+    out
 }
 
 /// Replaces the bit set at `key` by the list of its bits' names.
-fn bits(map: &mut Map<String, Value>, key: &str, names: &[(u32, &'static str)]) {
+fn bits(map: &mut Map<String, Value>, key: &str, groups: &[BitGroup<'_>]) {
     if let Some(v) = map.get_mut(key)
         && let Some(set) = v.as_u64().and_then(|b| u32::try_from(b).ok())
     {
-        *v = Value::from(bit_names(set, names));
+        *v = Value::from(named_bits(set, groups));
     }
 }
 
@@ -145,7 +158,7 @@ fn channels(map: &mut Map<String, Value>, n_gyro: u8, n_accel: u8) {
             FaultReason::from_u8(c).map(FaultReason::name)
         });
     }
-    bits(map, "flags", &fused_flags::NAMES);
+    bits(map, "flags", &[(&fused_flags::NAMES, "")]);
 }
 
 /// Mode, integrity and their bit sets, as [`NavState`] and the health report's nav carry them.
@@ -154,8 +167,15 @@ fn nav_status(map: &mut Map<String, Value>) {
     name(map, "integrity", |c| {
         Integrity::from_u8(c).map(Integrity::name)
     });
-    bits(map, "aiding", &aiding::NAMES);
-    bits(map, "integrity_reasons", &integrity_reason::NAMES);
+    bits(
+        map,
+        "aiding",
+        &[
+            (&aiding::SOURCE_NAMES, ""),
+            (&aiding::STALE_NAMES, "-stale"),
+        ],
+    );
+    bits(map, "integrity_reasons", &[(&integrity_reason::NAMES, "")]);
 }
 
 /// Applies `edit` to the object at `key`.
@@ -184,7 +204,7 @@ impl Readable for RawImu {
         cut(&mut m, "gyro_counts", self.n_gyro);
         cut(&mut m, "accel_counts", self.n_accel);
         cut(&mut m, "temperature_c", self.n_temperature);
-        bits(&mut m, "status", &status::NAMES);
+        bits(&mut m, "status", &[(&status::NAMES, "")]);
         m.insert(
             "valid_mask".into(),
             Value::from(valid_channel_names(self.valid_mask)),

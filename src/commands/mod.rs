@@ -10,11 +10,13 @@ mod geometry;
 mod inject;
 mod latency;
 mod mc;
+mod probe;
 mod progress;
 mod readmit;
 mod service;
 mod sim;
 mod status;
+mod status_link;
 mod up;
 
 use std::process::ExitCode;
@@ -45,8 +47,11 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         } => echo::run(&topic, count, csv, raw, timeout).map(|()| ExitCode::SUCCESS),
         Command::Soak(args) => rins_soak::run(&args.into()).map(|()| ExitCode::SUCCESS),
         Command::Status { json, timeout } => status::run(json, timeout).map(|()| ExitCode::SUCCESS),
+        Command::Probe(args) => probe::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Inject(args) => inject::run(&args).map(|()| ExitCode::SUCCESS),
-        Command::Readmit { channel } => readmit::run(&channel).map(|()| ExitCode::SUCCESS),
+        Command::Readmit { channel, timeout } => {
+            readmit::run(&channel, timeout).map(|()| ExitCode::SUCCESS)
+        }
         Command::Latency { seconds, json } => {
             latency::run(seconds, json).map(|()| ExitCode::SUCCESS)
         }

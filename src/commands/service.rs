@@ -32,6 +32,7 @@ pub fn run(name: ServiceName, config_path: Option<&Path>, port: Option<String>) 
         ServiceName::Fusion => rins_fusion::service::FusionService {
             fuser: built.fuser,
             input_deadline: built.fusion_input_deadline,
+            readmit_probation_samples: built.readmit_probation_samples,
         }
         .run(ctx),
         ServiceName::Altimeter => rins_altimeter::service::AltimeterService {

@@ -1,5 +1,7 @@
 //! `rins status [--json] [--timeout S]`: the watchdog's latest health report as a table (or one
-//! JSON object): per process its state, pid, restarts, heartbeat age and output rate.
+//! JSON object): per process its state, pid, restarts, heartbeat age and output rate; the
+//! navigation mode, lane and aiding; every redundant channel with its state and reason, and the
+//! parity test statistics.
 
 use std::time::{Duration, Instant};
 
@@ -7,7 +9,12 @@ use anyhow::{Result, bail};
 use ipc_types::{HealthReport, ServiceKind, ServiceState, names};
 use rins_runtime::ipc::TopicSubscriber;
 use rins_runtime::tool_node::ToolNode;
+use rins_watchdog::redundancy_view::{
+    NavView, RedundancyView, SensorRow, nav_view, redundancy_view,
+};
 use serde::Serialize;
+
+use super::status_link;
 
 /// One process as printed.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -28,6 +35,11 @@ pub struct ServiceRow {
 pub struct StatusReport {
     pub uptime_s: f64,
     pub services: Vec<ServiceRow>,
+    /// `None` before the first navigation sample.
+    pub navigation: Option<NavView>,
+    /// `None` before the first fused sample.
+    pub redundancy: Option<RedundancyView>,
+    pub link: Option<status_link::LinkRow>,
 }
 
 /// The printable form of a report; entries with unknown codes are named by their number.
@@ -53,12 +65,15 @@ pub fn rows(report: &HealthReport) -> StatusReport {
     StatusReport {
         uptime_s: report.uptime_ms as f64 * 1e-3,
         services,
+        navigation: nav_view(&report.nav),
+        redundancy: redundancy_view(&report.redundancy),
+        link: status_link::link_row(&report.link),
     }
 }
 
 pub fn table(report: &StatusReport) -> String {
     let mut out = format!("up {:.1} s\n", report.uptime_s);
-    out.push_str("service      state       pid      restarts  heartbeat  output\n");
+    out.push_str("service            state       pid      restarts  heartbeat  output\n");
     for r in &report.services {
         let age = r
             .heartbeat_age_ms
@@ -68,10 +83,60 @@ pub fn table(report: &StatusReport) -> String {
             .map_or_else(|| "-".to_string(), |h| format!("{h:.0}/s"));
         let stale = if r.input_stale { "  input stale" } else { "" };
         out.push_str(&format!(
-            "{:<12} {:<11} {:<8} {:<9} {:<10} {rate}{stale}\n",
+            "{:<18} {:<11} {:<8} {:<9} {:<10} {rate}{stale}\n",
             r.service, r.state, r.pid, r.restarts, age
         ));
     }
+    match &report.navigation {
+        Some(n) => {
+            out.push_str(&format!(
+                "\nnavigation   {}, integrity {}",
+                n.summary, n.integrity
+            ));
+            if !n.integrity_reasons.is_empty() {
+                out.push_str(&format!(" ({})", n.integrity_reasons.join(",")));
+            }
+            out.push('\n');
+        }
+        None => out.push_str("\nnavigation   no output yet\n"),
+    }
+    match &report.redundancy {
+        Some(r) => out.push_str(&channel_table(r)),
+        None => out.push_str("redundancy   no fused output yet\n"),
+    }
+    out.push_str(&status_link::link_line(report.link.as_ref()));
+    out
+}
+
+/// The redundancy part of the table: the summary, every channel with its state and reason, and
+/// the parity test statistic of each type.
+fn channel_table(r: &RedundancyView) -> String {
+    let mut out = format!("redundancy   {}\n", r.summary);
+    if !r.flags.is_empty() {
+        out.push_str(&format!("fused flags  {}\n", r.flags.join(",")));
+    }
+    out.push_str("channel      state       reason\n");
+    for c in &r.channels {
+        out.push_str(&format!(
+            "{:<12} {:<11} {}\n",
+            c.channel,
+            c.state,
+            c.reason.as_deref().unwrap_or("-")
+        ));
+    }
+    // Three channels leave no parity space: no statistic to show.
+    let statistic = |row: &SensorRow| {
+        if row.in_use > 3 {
+            format!("{:.2}", row.test_statistic)
+        } else {
+            "- (no parity with 3 channels)".to_string()
+        }
+    };
+    out.push_str(&format!(
+        "parity test  gyro {}  accel {}\n",
+        statistic(&r.gyro),
+        statistic(&r.accel)
+    ));
     out
 }
 
@@ -152,5 +217,60 @@ mod tests {
             t.contains("navigator") && t.contains("1000/s") && t.contains("120 ms"),
             "{t}"
         );
+        assert!(r.navigation.is_none() && r.redundancy.is_none());
+        assert!(
+            t.contains("navigation   no output yet") && t.contains("no fused output yet"),
+            "{t}"
+        );
+    }
+
+    #[test]
+    fn the_table_lists_every_channel_with_its_state_and_reason() {
+        use ipc_types::{ChannelState, FaultReason, FusedImu, NavMode, NavState};
+        use rins_watchdog::redundancy_view::{nav_of, redundancy_of};
+        let mut fused = FusedImu {
+            n_gyro: 4,
+            n_accel: 4,
+            gyro_test_statistic: 2.5,
+            ..FusedImu::default()
+        };
+        fused.gyro_state[..4].fill(ChannelState::Ok as u8);
+        fused.accel_state[..4].fill(ChannelState::Ok as u8);
+        fused.gyro_state[1] = ChannelState::Excluded as u8;
+        fused.gyro_reason[1] = FaultReason::Parity as u8;
+        let report = HealthReport {
+            redundancy: redundancy_of(&fused, 5),
+            nav: nav_of(
+                &NavState {
+                    mode: NavMode::Navigating as u8,
+                    lane: 1,
+                    ..NavState::default()
+                },
+                5,
+            ),
+            ..HealthReport::default()
+        };
+        let r = rows(&report);
+        let t = table(&r);
+        assert!(
+            t.contains("redundancy   gyro 3/4 (gyro1 parity) accel 4/4"),
+            "{t}"
+        );
+        assert!(
+            t.contains("navigation   navigating, lane 1, integrity ok"),
+            "{t}"
+        );
+        assert_eq!(t.matches("\ngyro").count(), 4, "{t}");
+        assert_eq!(t.matches("\naccel").count(), 4, "{t}");
+        assert!(t.contains("gyro1        excluded    parity"), "{t}");
+        assert!(
+            t.contains("parity test  gyro - (no parity with 3 channels)  accel 0.00"),
+            "{t}"
+        );
+        let json: serde_json::Value =
+            serde_json::from_str(&serde_json::to_string(&r).expect("serialises")).expect("json");
+        assert_eq!(json["redundancy"]["gyro"]["in_use"], 3);
+        assert_eq!(json["redundancy"]["channels"][1]["reason"], "parity");
+        assert_eq!(json["navigation"]["lane"], 1);
     }
 }

@@ -12,6 +12,7 @@ use rins_runtime::shm_cleanup;
 use rins_runtime::shutdown::Shutdown;
 use rins_watchdog::deployment_checks::{ensure_no_live_deployment, refuse_foreign_entries};
 use rins_watchdog::health_publisher::HealthPublisher;
+use rins_watchdog::link::no_valid_frame;
 use rins_watchdog::monitor::Monitor;
 use rins_watchdog::process_graph::pipeline_services;
 use rins_watchdog::restart_timing::RestartTiming;
@@ -181,6 +182,13 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     } else if args.duration.is_some() {
         // A timed run ends with what it measured; one stopped by hand ends quietly.
         print!("{}", summary_text(&summary));
+    }
+    // A timed run that never saw a frame did not do what was asked: a bring-up script must see it.
+    if args.duration.is_some()
+        && !shutdown.requested()
+        && let Some(why) = no_valid_frame(&port, &summary)
+    {
+        bail!("{why}");
     }
     Ok(std::process::ExitCode::SUCCESS)
 }

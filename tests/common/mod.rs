@@ -74,6 +74,24 @@ impl Isolated {
         last_json(&out)
     }
 
+    /// Polls `rins status --json` until `done` holds of the report, and returns it; fails after
+    /// `limit`.
+    pub fn status_until(
+        &self,
+        limit: std::time::Duration,
+        done: impl Fn(&serde_json::Value) -> bool,
+    ) -> serde_json::Value {
+        let start = std::time::Instant::now();
+        loop {
+            let report = self.status();
+            if done(&report) {
+                return report;
+            }
+            assert!(start.elapsed() < limit, "gave up waiting: {report}");
+            std::thread::sleep(std::time::Duration::from_millis(200));
+        }
+    }
+
     /// Shared-memory entries of this namespace still present.
     pub fn shm_entries(&self) -> Vec<String> {
         std::fs::read_dir("/dev/shm")
@@ -237,12 +255,17 @@ pub fn spawn_up_navigating(ipc: &Isolated, args: &[&str]) -> std::process::Child
 /// Stops a pipeline from [`spawn_up`] with SIGTERM, as an operator does, checks that it ended
 /// cleanly with no shared memory left, and returns its JSON summary.
 pub fn stop_up(ipc: &Isolated, up: std::process::Child) -> serde_json::Value {
+    last_json(&stop_up_output(ipc, up))
+}
+
+/// [`stop_up`], returning everything `rins up` wrote: the status lines, then the summary.
+pub fn stop_up_output(ipc: &Isolated, up: std::process::Child) -> Output {
     // Our own child process, not reaped yet.
     send_signal(u64::from(up.id()), Signal::Terminate).expect("SIGTERM to our own child");
     let out = up.wait_with_output().expect("rins up did not finish");
     assert!(out.status.success(), "rins up: {:?}", out.status);
     assert_eq!(ipc.shm_entries(), Vec::<String>::new());
-    last_json(&out)
+    out
 }
 
 /// Runs `rins ARGS` on a private namespace and checks that it fails with every `expected`

@@ -7,7 +7,7 @@ use super::codec::decode_frame;
 use super::continuity::Continuity;
 use super::error::DecodeError;
 use super::frame::{DecodedFrame, Frame, FrameType};
-use super::layout::{MAX_FRAME_LEN, SYNC};
+use super::layout::{FRAME_OVERHEAD, LEN_OFFSET, MAX_FRAME_LEN, SYNC};
 use super::resume_point::{ResumeError, ResumePoint};
 use super::seq_extend::{SeqExtender, SeqVerdict};
 use super::time_extend::TimeExtender;
@@ -56,6 +56,19 @@ pub struct DecoderStats {
     pub resync_bytes: u64,
     /// Bytes of valid frames not handed out (duplicates, late frames).
     pub withheld_bytes: u64,
+    /// Bytes pushed into the decoder: everything read from the line.
+    pub bytes: u64,
+    /// Why the last bytes that could not be decoded were refused: [`DecodeError::NoSync`] when
+    /// bytes without a sync word were skipped (outside a rejected candidate's own bytes), else the
+    /// rejected candidate's error. `None` until something was refused.
+    pub last_error: Option<DecodeError>,
+}
+
+impl DecoderStats {
+    /// Frames with a valid CRC and sane content: handed out, or withheld as duplicate or late.
+    pub fn valid_frames(&self) -> u64 {
+        self.frames + self.duplicates + self.late
+    }
 }
 
 /// Streaming frame decoder. Feed it bytes as they arrive with [`Decoder::push`].
@@ -71,6 +84,9 @@ pub struct Decoder {
     stats: DecoderStats,
     seq: [SeqExtender; FrameType::COUNT],
     time: TimeExtender,
+    /// Bytes after the first byte of the last rejected candidate that it claimed as its own:
+    /// skipping them is part of that rejection, not a missing sync word.
+    reject_cover: usize,
 }
 
 impl Default for Decoder {
@@ -89,6 +105,7 @@ impl Decoder {
             stats: DecoderStats::default(),
             seq: [SeqExtender::default(); FrameType::COUNT],
             time: TimeExtender::default(),
+            reject_cover: 0,
         }
     }
 
@@ -96,6 +113,7 @@ impl Decoder {
     /// calls `on_frame` for every complete, valid, new frame, in stream order. Bytes of an
     /// incomplete frame are kept for the next call.
     pub fn push(&mut self, mut bytes: &[u8], rx_ns: u64, mut on_frame: impl FnMut(DecodedFrame)) {
+        self.stats.bytes += bytes.len() as u64;
         while !bytes.is_empty() {
             let n = (BUF_LEN - self.len).min(bytes.len());
             let (head, rest) = bytes.split_at(n);
@@ -166,15 +184,16 @@ impl Decoder {
                 // A trailing first sync byte may be completed by the next push.
                 let keep = usize::from(pending.last() == Some(&SYNC[0]));
                 let dropped = pending.len() - keep;
-                self.stats.resync_bytes += dropped as u64;
+                self.skipped(dropped);
                 start += dropped;
                 break;
             };
-            self.stats.resync_bytes += offset as u64;
+            self.skipped(offset);
             start += offset;
             match decode_frame(&self.buf[start..self.len]) {
                 Ok((frame, used)) => {
                     start += used;
+                    self.reject_cover = 0;
                     if let Some(decoded) = self.classify(frame, rx_ns) {
                         on_frame(decoded);
                     } else {
@@ -188,6 +207,15 @@ impl Decoder {
                     } else {
                         self.stats.malformed += 1;
                     }
+                    self.stats.last_error = Some(e);
+                    // The candidate's bytes after its first: the whole length its header
+                    // announces, whatever its type (an unknown type is still a frame's worth).
+                    let claimed = if start + LEN_OFFSET < self.len {
+                        FRAME_OVERHEAD + usize::from(self.buf[start + LEN_OFFSET])
+                    } else {
+                        LEN_OFFSET + 1
+                    };
+                    self.reject_cover = claimed - 1;
                     self.stats.resync_bytes += 1;
                     start += 1;
                 }
@@ -195,6 +223,16 @@ impl Decoder {
         }
         self.buf.copy_within(start..self.len, 0);
         self.len -= start;
+    }
+
+    /// Counts `n` bytes skipped while searching for a sync word; those beyond the last rejected
+    /// candidate's own bytes mean the line carries something that is not frames.
+    fn skipped(&mut self, n: usize) {
+        self.stats.resync_bytes += n as u64;
+        if n > self.reject_cover {
+            self.stats.last_error = Some(DecodeError::NoSync);
+        }
+        self.reject_cover = self.reject_cover.saturating_sub(n);
     }
 
     /// The frame as it is handed out, or `None` for a duplicate or late frame; counts either way.

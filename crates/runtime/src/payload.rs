@@ -2,8 +2,8 @@
 //! once, on receipt), and the header each stage stamps with its publish time.
 
 use ipc_types::{
-    Altitude, FaultApplied, FusedImu, FusionControl, Header, NavState, PAYLOAD_VERSION, RawAux,
-    RawBaro, RawImu, RawMag, SimControl, Truth,
+    Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, Header, NavState,
+    PAYLOAD_VERSION, RawAux, RawBaro, RawImu, RawMag, SimControl, Truth,
 };
 
 /// A payload that carries the [`PAYLOAD_VERSION`] of the build that wrote it.
@@ -44,7 +44,7 @@ macro_rules! stamped {
     )*};
 }
 
-versioned!(FusionControl, SimControl, FaultApplied);
+versioned!(FusionControl, FusionReply, SimControl, FaultApplied);
 stamped!(
     RawImu, RawBaro, RawMag, RawAux, FusedImu, Altitude, NavState, Truth
 );

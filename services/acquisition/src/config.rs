@@ -1,9 +1,9 @@
 //! `[acquisition]` configuration.
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// `[acquisition]` of the configuration: the serial device and how it is read.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct AcquisitionConfig {
     /// Serial device path (a real port, or the simulator's link). `rins up` fills it in for the simulator.

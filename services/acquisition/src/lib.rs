@@ -4,6 +4,9 @@
 
 pub mod backoff;
 pub mod config;
+pub mod line_watch;
+pub mod listen;
+pub mod port;
 pub mod presence;
 pub mod resume_file;
 pub mod service;

@@ -16,10 +16,12 @@ use rins_runtime::stage_io::StagePublisher;
 
 use crate::backoff::Backoff;
 use crate::config::AcquisitionConfig;
+use crate::line_watch::LineWatch;
+use crate::port;
 use crate::presence::{Opened, Presence};
 use crate::resume_file;
 use crate::to_ipc;
-use rins_protocol::{DecodedFrame, Decoder, DecoderStats, FrameType, Payload};
+use rins_protocol::{DecodedFrame, Decoder, DecoderStats, FrameType, Payload, link_error};
 
 /// The topics acquisition publishes, one per frame type; each sample leaves stamped with the
 /// acquisition's publish time.
@@ -86,10 +88,11 @@ fn millis(d: Duration) -> u64 {
 }
 
 fn open_port(path: &str, config: &AcquisitionConfig) -> Result<serialport::TTYPort> {
-    serialport::new(path, config.baud)
-        .timeout(Duration::from_millis(config.read_timeout_ms))
-        .open_native()
-        .map_err(|e| anyhow!("cannot open serial device {path}: {e}"))
+    port::open(
+        path,
+        config.baud,
+        Duration::from_millis(config.read_timeout_ms),
+    )
 }
 
 /// The acquisition process: reads the configured serial device until a stop is requested.
@@ -146,6 +149,7 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
         Duration::from_millis(config.reconnect_max_ms),
     ));
     let mut buf = [0u8; 4096];
+    let mut line = LineWatch::new(monotonic_ns(), &decoder.stats());
 
     while !shutdown.requested() {
         let mut port = match open_port(&path, config) {
@@ -195,6 +199,7 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
         }
         // Bytes of a frame cut by the disconnect must not be glued to the next stream.
         decoder.reset();
+        line.opened(monotonic_ns(), &decoder.stats());
 
         // Allocation-free and lock-free until the device is lost.
         let mut lost = None;
@@ -238,6 +243,9 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
                 resume_rejected = stats.resume_rejected;
                 warn_resume_ignored(&decoder, resume_rejected);
             }
+            if let Some(warning) = line.observe(monotonic_ns(), &stats) {
+                tracing::warn!(port = %path, "{}", warning.message(&path));
+            }
             fill_counters(&mut counters, &stats);
             heartbeat.tick(&counters)?;
         }
@@ -272,6 +280,9 @@ fn fill_counters(counters: &mut Health, stats: &DecoderStats) {
     counters.seq_jumps = stats.seq_jumps;
     counters.time_rebases = stats.time_rebases;
     counters.resync_bytes = stats.resync_bytes;
+    counters.bytes_received = stats.bytes;
+    counters.valid_frames = stats.valid_frames();
+    counters.last_decode_error = link_error(stats.last_error.as_ref()) as u8;
 }
 
 /// A part of the resume point did not fit the device's first frames (a device restarted, or a

@@ -8,10 +8,10 @@
 
 use crate::error::ConfigError;
 use rins_earth::isa::{altitude_per_pascal, pressure_to_altitude};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// Altimeter configuration.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct AltimeterConfig {
     /// Reference pressure for height zero, Pa (default 101 325).

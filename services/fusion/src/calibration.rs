@@ -15,7 +15,7 @@
 use crate::error::ConfigError;
 use crate::geometry::MAX_CHANNELS;
 use ipc_types::MAX_TEMPERATURES;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// Lowest temperature the compensation model is evaluated at, °C.
 pub const MIN_TEMPERATURE_C: f64 = -55.0;
@@ -26,7 +26,7 @@ pub const DEFAULT_REFERENCE_TEMPERATURE_C: f64 = 25.0;
 
 /// Per-channel calibration. Every list is either empty or has one entry per channel; empty means
 /// zero bias, unit scale, no temperature dependence, temperature sensor 0.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ChannelCalibration {
     /// Bias at the reference temperature, SI units (rad/s or m/s²).

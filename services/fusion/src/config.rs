@@ -10,7 +10,7 @@ use crate::fdi::{FdiConfig, FdiSettings};
 use crate::geometry::{Geometry, GeometryConfig, MAX_CHANNELS};
 use crate::kalman::{FusionMethod, KalmanConfig};
 use ipc_types::SensorType;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// Default gyro channel noise σ: 0.01 °/s/√Hz over a 1 kHz bandwidth, in rad/s.
 pub fn default_gyro_sigma_rps() -> f64 {
@@ -23,7 +23,7 @@ pub fn default_accel_sigma_mps2() -> f64 {
 }
 
 /// One value per sensor type.
-#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PerSensor<T> {
     /// The gyros' value.
@@ -33,7 +33,7 @@ pub struct PerSensor<T> {
 }
 
 /// White-noise standard deviation of each channel at the sample rate, SI units.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(untagged)]
 pub enum ChannelNoise {
     /// The same σ for every channel.
@@ -93,7 +93,7 @@ impl ChannelNoise {
 }
 
 /// Channel noise of both sensor types.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct NoiseConfig {
     /// Gyro channel σ, rad/s.
@@ -125,7 +125,7 @@ pub const MAX_REST_BIAS_S: f64 = 600.0;
 /// Fusion configuration. Defaults: the four-axis pyramid (n = 4, α = 28.7°, β0 = 45°) for both types,
 /// the default channel noise, identity calibration, the default fault detection settings, WLS,
 /// a 1 s rest-bias window at 1 kHz.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct FusionConfig {
     /// Sensitive axes of each sensor type (`[fusion.geometry.gyro]`, `[fusion.geometry.accel]`).

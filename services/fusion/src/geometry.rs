@@ -12,7 +12,7 @@
 use crate::error::ConfigError;
 use crate::linalg::{normal_matrix, reciprocal_condition};
 use nalgebra::Rotation3;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// Most channels per sensor type (the IPC payloads are sized for this many).
 pub const MAX_CHANNELS: usize = ipc_types::MAX_CHANNELS;
@@ -23,7 +23,7 @@ pub const MIN_CHANNELS: usize = 3;
 pub const MIN_RECIPROCAL_CONDITION: f64 = 1e-6;
 
 /// Configured layout of the sensitive axes, in the body frame (FRD).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
 pub enum GeometryConfig {
     /// n axes on a cone: `h_i = [cos α cos β_i, cos α sin β_i, sin α]`, `β_i = β0 + i·360°/n`.

@@ -57,7 +57,7 @@ use crate::error::ConfigError;
 use crate::geometry::Geometry;
 use crate::wls::{WlsError, WlsSolver};
 use nalgebra::{Matrix3, Matrix6, SMatrix, Vector3, Vector6};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// Default white-jerk PSD of the gyro side, (rad/s³)²/Hz: f_n ≈ 22 Hz with the default noise.
 pub const DEFAULT_GYRO_PROCESS_NOISE: f64 = 10.0;
@@ -69,7 +69,7 @@ pub const DEFAULT_SAMPLE_PERIOD_S: f64 = 0.001;
 pub const SAMPLE_PERIOD_RANGE_S: std::ops::RangeInclusive<f64> = 1e-5..=1.0;
 
 /// How the redundant channels of one sensor type become a 3-axis estimate.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum FusionMethod {
     /// Per-sample weighted least squares: no memory, no lag.
@@ -80,7 +80,7 @@ pub enum FusionMethod {
 }
 
 /// White-jerk PSD q per sensor type.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct KalmanProcessNoise {
     /// Gyro side, (rad/s³)²/Hz.
@@ -99,7 +99,7 @@ impl Default for KalmanProcessNoise {
 }
 
 /// Settings of the Kalman fusion method.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct KalmanConfig {
     /// White-jerk PSD per sensor type.

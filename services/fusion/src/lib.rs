@@ -9,6 +9,7 @@
 //! - [`rest_bias`]: per-channel gyro biases from a start-up window at rest.
 //! - [`config`]: the `[fusion]` table and its checks.
 //! - [`fuser`]: the gyro and accelerometer sides together, with their fault monitors.
+//! - [`readmit_probation`]: the answer to a re-admission, once the channel stayed clean.
 
 pub mod calibration;
 pub mod capability;
@@ -19,6 +20,7 @@ pub mod fuser;
 pub mod geometry;
 pub mod kalman;
 mod linalg;
+pub mod readmit_probation;
 pub mod rest_bias;
 pub mod service;
 pub mod wls;

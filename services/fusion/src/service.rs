@@ -3,17 +3,18 @@
 use std::time::Duration;
 
 use ipc_types::{
-    ChannelState, FusedImu, FusionControl, Health, PAYLOAD_VERSION, RawImu, SensorType,
-    ServiceKind, Stage, fused_flags, names,
+    ChannelState, FusedImu, FusionControl, FusionReply, Health, PAYLOAD_VERSION, RawImu,
+    ReadmitOutcome, SensorType, ServiceKind, Stage, fused_flags, names,
 };
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::input_watch::{InputChange, InputWatch};
-use rins_runtime::ipc::IpcError;
+use rins_runtime::ipc::{IpcError, TopicPublisher};
 use rins_runtime::service::{Service, ServiceContext};
 use rins_runtime::stage_io::StageInput;
 use rins_runtime::stage_loop::{PipelineStage, StageLoop, StageTopics, Step};
 
 use crate::fuser::{ACCEL_MASK_SHIFT, Fused, ImuFuser};
+use crate::readmit_probation::{ReadmitProbation, ReadmitResult};
 
 // The wire's valid mask and the fuser agree on where the accelerometer bits start.
 const _: () = assert!(ACCEL_MASK_SHIFT == 16);
@@ -90,29 +91,43 @@ fn log_events(fused: &Fused, device_time_us: u64) {
     }
 }
 
-/// Applies a re-admission command: the only way an excluded channel returns.
-fn readmit(fuser: &mut ImuFuser, cmd: &FusionControl) {
-    let Some(sensor) = SensorType::from_u8(cmd.sensor) else {
-        tracing::warn!(
-            sensor = cmd.sensor,
-            "re-admission for an unknown sensor type ignored"
-        );
-        return;
-    };
-    match fuser.readmit(sensor, usize::from(cmd.channel)) {
-        Ok(true) => tracing::warn!(
-            sensor = sensor.name(),
-            channel = cmd.channel,
-            "channel re-admitted by command"
-        ),
-        Ok(false) => tracing::info!(
-            sensor = sensor.name(),
-            channel = cmd.channel,
-            "re-admission: channel was not excluded"
-        ),
-        Err(e) => {
-            tracing::warn!(sensor = sensor.name(), channel = cmd.channel, error = %e, "re-admission refused")
+/// Applies a re-admission command (the only way an excluded channel returns) and logs it; the
+/// answer follows from [`ReadmitProbation`].
+fn readmit(fuser: &mut ImuFuser, sensor: SensorType, channel: usize) -> ReadmitResult {
+    match fuser.readmit(sensor, channel) {
+        Ok(true) => {
+            tracing::warn!(
+                sensor = sensor.name(),
+                channel,
+                "channel re-admitted by command, on probation"
+            );
+            ReadmitResult::Readmitted
         }
+        Ok(false) => {
+            tracing::info!(
+                sensor = sensor.name(),
+                channel,
+                "re-admission: channel was not excluded"
+            );
+            ReadmitResult::NotExcluded
+        }
+        Err(e) => {
+            tracing::warn!(sensor = sensor.name(), channel, error = %e, "re-admission refused");
+            ReadmitResult::NoSuchChannel
+        }
+    }
+}
+
+/// Logs the answers that are not plain successes, so that the log says what the operator was told.
+fn log_reply(reply: &FusionReply) {
+    let outcome = ReadmitOutcome::from_u8(reply.outcome);
+    if outcome == Some(ReadmitOutcome::FaultStillPresent) {
+        tracing::warn!(
+            sensor = reply.sensor,
+            channel = reply.channel,
+            reason = ipc_types::FaultReason::from_u8(reply.reason).map_or("?", |r| r.name()),
+            "re-admitted channel excluded again during its probation: fault still present"
+        );
     }
 }
 
@@ -127,6 +142,8 @@ pub fn input_deadline(sample_rate_hz: f64) -> Duration {
 struct FusionStage {
     fuser: ImuFuser,
     control: StageInput<FusionControl>,
+    replies: TopicPublisher<FusionReply>,
+    probation: ReadmitProbation,
     n_gyro: usize,
     n_accel: usize,
     last_seq: Option<u64>,
@@ -159,8 +176,19 @@ impl PipelineStage for FusionStage {
     type Output = FusedImu;
 
     fn before_input(&mut self, counters: &mut Health) -> Result<(), IpcError> {
-        let fuser = &mut self.fuser;
-        self.control.drain(counters, |cmd| readmit(fuser, &cmd))
+        let (fuser, probation) = (&mut self.fuser, &mut self.probation);
+        self.control.drain(counters, |cmd| {
+            probation.on_request(&cmd, |sensor, channel| readmit(fuser, sensor, channel))
+        })?;
+        let mut result = Ok(());
+        let replies = &self.replies;
+        self.probation.take_replies(|reply| {
+            log_reply(&reply);
+            if result.is_ok() {
+                result = replies.publish(reply);
+            }
+        });
+        result
     }
 
     fn received(&mut self, raw: &RawImu, counters: &mut Health) {
@@ -180,7 +208,9 @@ impl PipelineStage for FusionStage {
         if !fused.events.is_empty() {
             log_events(&fused, raw.header.origin_device_time_us);
         }
-        Step::Publish(fused_message(raw, &fused, self.n_gyro, self.n_accel))
+        let msg = fused_message(raw, &fused, self.n_gyro, self.n_accel);
+        self.probation.on_fused(&msg);
+        Step::Publish(msg)
     }
 
     fn other_version(&mut self, raw: &RawImu) -> Option<FusedImu> {
@@ -216,6 +246,9 @@ pub struct FusionService {
     pub fuser: ImuFuser,
     /// How long fusion waits for raw IMU before it reports acquisition stale ([`input_deadline`]).
     pub input_deadline: Duration,
+    /// Fused samples a channel re-admitted by command stays on probation before the command is
+    /// answered ([`ReadmitProbation`]).
+    pub readmit_probation_samples: u32,
 }
 
 impl Service for FusionService {
@@ -234,6 +267,8 @@ impl Service for FusionService {
             n_accel: self.fuser.accel_geometry().n(),
             fuser: self.fuser,
             control: StageInput::new(&node, names::FUSION_CONTROL)?,
+            replies: TopicPublisher::new(&node, names::FUSION_REPLY)?,
+            probation: ReadmitProbation::new(self.readmit_probation_samples, std::process::id()),
             last_seq: None,
             mismatch_reported: false,
             deadline: self.input_deadline,

@@ -1,7 +1,8 @@
 //! Simulator configuration (the `[sim]` section of the product configuration).
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
+use crate::calibration_config::CalibrationConfig;
 use crate::error::{SimError, check_positive, check_range};
 use crate::sensor_model::mag::EarthField;
 use crate::sensor_model::{Environment, SensorModelConfig};
@@ -13,7 +14,7 @@ pub const MAX_IMU_RATE_HZ: f64 = 100_000.0;
 pub const MAX_ABS_LATITUDE_DEG: f64 = 85.0;
 
 /// Local Earth magnetic field as configured.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct EarthFieldConfig {
     /// Total intensity, µT.
@@ -46,7 +47,7 @@ impl EarthFieldConfig {
 }
 
 /// Everything the simulator needs besides the sensor geometry and the seed.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SimConfig {
     /// Motion to simulate.
@@ -69,8 +70,8 @@ pub struct SimConfig {
     pub origin_altitude_m: f64,
     /// Initial heading, degrees clockwise from true north.
     pub initial_heading_deg: f64,
-    /// UAV and walk scenarios: time at rest, level, before moving, s (the window a navigator's
-    /// static alignment needs).
+    /// UAV, walk and calibrate scenarios: time at rest, level, before moving, s (the window a
+    /// navigator's static alignment needs).
     pub static_s: f64,
     /// UAV scenario: length of the whole flight, s (parking, take-off, circuits, landing); the
     /// pair of circuits repeats as many times as fit. Unset: one pair (about 615 s), then parked.
@@ -81,12 +82,14 @@ pub struct SimConfig {
     pub earth_field: EarthFieldConfig,
     /// Sensor error model.
     pub sensors: SensorModelConfig,
+    /// Calibrate scenario: the turns and the magnetometer's hard and soft iron.
+    pub calibration: CalibrationConfig,
 }
 
 impl Default for SimConfig {
     fn default() -> Self {
         Self {
-            scenario: Scenario::Static,
+            scenario: Scenario::Uav,
             seed: 1,
             imu_rate_hz: 1000.0,
             baro_rate_hz: 50.0,
@@ -101,6 +104,7 @@ impl Default for SimConfig {
             qnh_pa: 101_325.0,
             earth_field: EarthFieldConfig::default(),
             sensors: SensorModelConfig::default(),
+            calibration: CalibrationConfig::default(),
         }
     }
 }
@@ -198,7 +202,17 @@ impl SimConfig {
             180.0,
             "must be within -180..=180",
         )?;
+        self.calibration.validate()?;
         self.sensors.validate()
+    }
+
+    /// The sensor error model the simulator runs: `sensors`, with the calibrate scenario's
+    /// magnetometer distortion in that scenario.
+    pub fn sensor_model(&self) -> SensorModelConfig {
+        match self.scenario {
+            Scenario::Calibrate => self.calibration.distort(&self.sensors),
+            _ => self.sensors.clone(),
+        }
     }
 
     /// Gyro ADC resolution: rad/s per count (same scale the fusion side must use).
@@ -220,6 +234,7 @@ impl SimConfig {
             heading_rad: self.initial_heading_deg.to_radians(),
             static_s: self.static_s,
             uav_flight_s: self.uav_flight_s,
+            calibration_sweep_s: self.calibration.sweep_s,
         }
     }
 

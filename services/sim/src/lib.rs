@@ -6,6 +6,7 @@
 //! The Earth is modelled as non-rotating with constant standard gravity
 //! ([`rins_earth::STANDARD_GRAVITY`]); see [`trajectory`].
 
+pub mod calibration_config;
 pub mod config;
 pub mod device_fault;
 pub mod error;
@@ -20,6 +21,7 @@ pub mod sim_command;
 pub mod simulator;
 pub mod trajectory;
 
+pub use calibration_config::CalibrationConfig;
 pub use config::{EarthFieldConfig, SimConfig};
 pub use error::SimError;
 pub use fault_parse_error::FaultParseError;

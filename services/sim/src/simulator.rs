@@ -115,7 +115,7 @@ impl Simulator {
     ) -> Result<Self, SimError> {
         config.validate()?;
         let sensors = SensorModel::new(
-            &config.sensors,
+            &config.sensor_model(),
             &config.environment(),
             gyro_axes,
             accel_axes,

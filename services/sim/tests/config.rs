@@ -10,7 +10,7 @@ use rins_test_support::pyramid::optimal_pyramid_axes;
 fn defaults_are_the_documented_mems_block() {
     let c = SimConfig::default();
     c.validate().unwrap();
-    assert_eq!(c.scenario, Scenario::Static);
+    assert_eq!(c.scenario, Scenario::Uav);
     assert_eq!(
         (c.imu_rate_hz, c.baro_rate_hz, c.mag_rate_hz, c.aux_rate_hz),
         (1000.0, 50.0, 100.0, 100.0)

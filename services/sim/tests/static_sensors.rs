@@ -116,7 +116,10 @@ fn averaged_counts_match_projection_plus_true_errors_within_noise_bounds() {
 /// projection — 5σ of turn-on bias, bias instability, temperature term and scale error.
 #[test]
 fn averaged_counts_match_ideal_projection_within_model_tolerance() {
-    let config = SimConfig::default();
+    let config = SimConfig {
+        scenario: Scenario::Static,
+        ..SimConfig::default()
+    };
     let axes = block_pyramid_axes();
     let s = &config.sensors;
     let mg = 1e-3 * STANDARD_GRAVITY;
@@ -174,6 +177,7 @@ fn per_sample_noise_scales_with_root_rate() {
     let axes = optimal_pyramid_axes();
     for rate in [1000.0, 4000.0] {
         let config = SimConfig {
+            scenario: Scenario::Static,
             imu_rate_hz: rate,
             ..SimConfig::default()
         };

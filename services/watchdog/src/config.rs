@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 use std::time::Duration;
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::restart_policy::{GiveUp, MAX_RESTARTS_LIMIT, RestartPolicy};
 
@@ -18,7 +18,7 @@ pub const SUPERVISED: [&str; 6] = [
 ];
 
 /// Per-service restart settings; what is not given comes from `[watchdog]`.
-#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ServiceRestartConfig {
     /// First restart delay, ms.
@@ -36,7 +36,7 @@ pub struct ServiceRestartConfig {
 }
 
 /// `[watchdog]` of the configuration: restarts, the checks that find a hung child, the status line.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct WatchdogConfig {
     /// First restart delay, ms.

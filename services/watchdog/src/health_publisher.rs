@@ -9,6 +9,7 @@ use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{IpcNode, TopicPublisher};
 
 use crate::health_report::{ProcessView, build_report};
+use crate::link::link_report;
 use crate::monitor::{HeartbeatSeen, Monitor};
 use crate::supervisor::Supervisor;
 
@@ -88,12 +89,16 @@ impl HealthPublisher {
                 self.last_outputs[kind as usize] = n;
             }
         }
-        let report = build_report(
-            monotonic_ns(),
+        let now_ns = monotonic_ns();
+        let mut report = build_report(
+            now_ns,
             self.started.elapsed().as_millis() as u64,
             &views,
             u64::try_from(self.silent_after.as_nanos()).unwrap_or(u64::MAX),
         );
+        report.redundancy = monitor.redundancy_report(now_ns);
+        report.nav = monitor.nav_report(now_ns);
+        report.link = link_report(monitor);
         self.publisher.publish(report)?;
         Ok(Some(report))
     }

@@ -3,15 +3,18 @@
 
 use anyhow::Result;
 use ipc_types::{
-    Altitude, FaultApplied, FusedImu, Health, Integrity, NavMode, NavState, RawBaro, RawImu,
-    RawMag, ServiceKind, Truth, names,
+    Altitude, FaultApplied, FusedImu, Health, Integrity, NavMode, NavReport, NavState, RawBaro,
+    RawImu, RawMag, RedundancyReport, ServiceKind, Truth, names,
 };
+use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{IpcNode, TopicSubscriber};
 use rins_runtime::nav_subscriber::NavSubscriber;
 
 use crate::accuracy::Accuracy;
 use crate::fault_tracking::FaultTracker;
 use crate::horizontal::Position;
+use crate::link::LinkRate;
+use crate::redundancy_view::{nav_of, redundancy_of};
 use crate::seq_gaps::SeqGaps;
 
 /// Truth is kept this many IMU frames back, to meet the navigation output that comes later.
@@ -52,6 +55,12 @@ pub struct DeviceCounters {
     pub resync_bytes: u64,
     /// Times the device was reopened.
     pub reconnects: u64,
+    /// Bytes read from the device.
+    pub bytes_received: u64,
+    /// Frames with a valid CRC and sane content (published, or withheld as duplicate or late).
+    pub valid_frames: u64,
+    /// [`ipc_types::LinkError`] as u8 of the last refusal.
+    pub last_decode_error: u8,
 }
 
 impl DeviceCounters {
@@ -67,10 +76,14 @@ impl DeviceCounters {
             time_rebases: h.time_rebases,
             resync_bytes: h.resync_bytes,
             reconnects: h.reconnects,
+            bytes_received: h.bytes_received,
+            valid_frames: h.valid_frames,
+            last_decode_error: h.last_decode_error,
         }
     }
 
-    /// The sum of two processes' counters.
+    /// The sum of two processes' counters; the last refusal is `o`'s (the later process) when it
+    /// has one.
     pub fn plus(&self, o: &Self) -> Self {
         Self {
             crc_errors: self.crc_errors + o.crc_errors,
@@ -82,6 +95,13 @@ impl DeviceCounters {
             time_rebases: self.time_rebases + o.time_rebases,
             resync_bytes: self.resync_bytes + o.resync_bytes,
             reconnects: self.reconnects + o.reconnects,
+            bytes_received: self.bytes_received + o.bytes_received,
+            valid_frames: self.valid_frames + o.valid_frames,
+            last_decode_error: if o.last_decode_error != 0 {
+                o.last_decode_error
+            } else {
+                self.last_decode_error
+            },
         }
     }
 }
@@ -104,6 +124,12 @@ pub struct Monitor {
     pub nav_gaps: SeqGaps,
     /// The newest navigation sample.
     pub last_nav: Option<NavState>,
+    /// When the newest navigation sample was taken in (CLOCK_MONOTONIC ns).
+    pub last_nav_at_ns: u64,
+    /// The newest fused sample: the channel states the operator views show.
+    pub last_fused: Option<FusedImu>,
+    /// When the newest fused sample was taken in (CLOCK_MONOTONIC ns).
+    pub last_fused_at_ns: u64,
     /// Navigation error against the simulator's truth.
     pub accuracy: Accuracy,
     /// Navigation samples after alignment per integrity level (ok, degraded, invalid).
@@ -115,6 +141,8 @@ pub struct Monitor {
     acquisition: Vec<(u32, DeviceCounters)>,
     /// Last heartbeat per [`ServiceKind`].
     pub heartbeats: [Option<HeartbeatSeen>; ServiceKind::ALL.len()],
+    /// The serial line over acquisition's last two heartbeats.
+    pub link: LinkRate,
 }
 
 impl Monitor {
@@ -133,6 +161,9 @@ impl Monitor {
             totals: [0; COUNTED.len()],
             nav_gaps: SeqGaps::default(),
             last_nav: None,
+            last_nav_at_ns: 0,
+            last_fused: None,
+            last_fused_at_ns: 0,
             accuracy: Accuracy::default(),
             integrity_samples: [0; 3],
             faults: FaultTracker::new(),
@@ -147,6 +178,7 @@ impl Monitor {
             .into_boxed_slice(),
             acquisition: Vec::new(),
             heartbeats: [None; ServiceKind::ALL.len()],
+            link: LinkRate::default(),
         })
     }
 
@@ -202,6 +234,8 @@ impl Monitor {
         while let Some(f) = self.fused.receive()? {
             self.totals[3] += 1;
             self.faults.on_fused(&f);
+            self.last_fused = Some(f);
+            self.last_fused_at_ns = monotonic_ns();
         }
         self.totals[4] += drain_count(&self.alt)?;
         // Truth first, so a navigation sample finds the truth of its own frame.
@@ -211,6 +245,7 @@ impl Monitor {
         while let Some(nav) = self.nav.receive()? {
             self.totals[5] += 1;
             self.on_nav(nav);
+            self.last_nav_at_ns = monotonic_ns();
         }
         while let Some(h) = self.health.receive()? {
             self.on_health(&h);
@@ -264,10 +299,26 @@ impl Monitor {
             return;
         }
         let counters = DeviceCounters::from_heartbeat(h);
+        self.link.observe(h.pid, h.now_ns, &counters);
         match self.acquisition.iter_mut().find(|(pid, _)| *pid == h.pid) {
             Some(entry) => entry.1 = counters,
             None => self.acquisition.push((h.pid, counters)),
         }
+    }
+
+    /// The report's redundancy part from the newest fused sample, as of `now_ns` (not heard
+    /// before the first).
+    pub fn redundancy_report(&self, now_ns: u64) -> RedundancyReport {
+        self.last_fused.map_or_else(RedundancyReport::default, |f| {
+            redundancy_of(&f, age_ms(now_ns, self.last_fused_at_ns))
+        })
+    }
+
+    /// The report's navigation part from the newest navigation sample, as of `now_ns`.
+    pub fn nav_report(&self, now_ns: u64) -> NavReport {
+        self.last_nav.map_or_else(NavReport::default, |n| {
+            nav_of(&n, age_ms(now_ns, self.last_nav_at_ns))
+        })
     }
 
     /// Acquisition counters summed over every acquisition process seen.
@@ -276,6 +327,11 @@ impl Monitor {
             .iter()
             .fold(DeviceCounters::default(), |acc, (_, c)| acc.plus(c))
     }
+}
+
+/// Milliseconds from `then_ns` to `now_ns`, saturating.
+fn age_ms(now_ns: u64, then_ns: u64) -> u32 {
+    u32::try_from(now_ns.saturating_sub(then_ns) / 1_000_000).unwrap_or(u32::MAX)
 }
 
 fn drain_count<T: std::fmt::Debug + Copy + iceoryx2::prelude::ZeroCopySend>(

@@ -2,6 +2,7 @@
 
 use std::time::Duration;
 
+use crate::link::link_error_name;
 use crate::monitor::Monitor;
 use crate::restart_timing::RestartTiming;
 use crate::summary::Summary;
@@ -33,6 +34,14 @@ pub fn summarise(
         late_frames: device.late_frames,
         seq_jumps: device.seq_jumps,
         time_rebases: device.time_rebases,
+        bytes_received: device.bytes_received,
+        // Acquisition's count is as old as its last heartbeat (up to a second): the frames the
+        // watchdog saw published are valid frames too, and may be the fresher count.
+        valid_frames: device
+            .valid_frames
+            .max(monitor.totals[0] + monitor.totals[1] + monitor.totals[2]),
+        discarded_bytes: device.resync_bytes,
+        last_decode_error: link_error_name(device.last_decode_error),
         nav_samples: monitor.totals[5],
         restarts: supervisor.restarts(),
         restart_to_publish_ms_max: restart_worst.as_secs_f64() * 1e3,

@@ -1,16 +1,19 @@
 //! The once-a-second status line.
 
-use ipc_types::{Integrity, NavMode, NavState, integrity_reason};
+use ipc_types::{Integrity, NavMode, NavState, RedundancyReport, integrity_reason};
 pub use rins_earth::euler_deg;
 
 use crate::monitor::{COUNTED, DeviceCounters};
+use crate::redundancy_view::{nav_of, nav_summary, redundancy_summary};
 
-/// One status line: per-topic rates over the last period, losses, and the current solution.
+/// One status line: per-topic rates over the last period, losses, the redundant channels in use
+/// and why any is out, and the current solution with its mode, lane and aiding.
 pub fn status_line(
     elapsed_s: f64,
     rates_hz: &[f64; COUNTED.len()],
     dropped: u64,
     device: &DeviceCounters,
+    redundancy: &RedundancyReport,
     nav: Option<&NavState>,
 ) -> String {
     let mut line = format!("t={elapsed_s:6.1}s");
@@ -34,25 +37,18 @@ pub fn status_line(
             line.push_str(&format!(" {what} {n}"));
         }
     }
+    if redundancy.heard != 0 {
+        line.push_str(&format!(" | {}", redundancy_summary(redundancy)));
+    }
     match nav {
         Some(nav) => {
             let [r, p, y] = euler_deg(nav.quaternion);
             let mode = NavMode::from_u8(nav.mode);
-            // A mode this build does not know is named by its number.
-            let mode_name = mode.map_or_else(|| format!("mode {}", nav.mode), |m| m.name().into());
             line.push_str(&format!(
-                " | {mode_name} roll {r:6.2} pitch {p:6.2} yaw {y:7.2} alt {:7.1} m",
+                " | {} | roll {r:6.2} pitch {p:6.2} yaw {y:7.2} alt {:7.1} m",
+                nav_summary(&nav_of(nav, 0)),
                 nav.altitude_m
             ));
-            // Say so when the filter coasts: a configured aiding source has gone quiet.
-            for (bit, what) in [
-                (ipc_types::aiding::BARO_STALE, "baro stale"),
-                (ipc_types::aiding::MAG_STALE, "mag stale"),
-            ] {
-                if nav.aiding & bit != 0 {
-                    line.push_str(&format!(" | {what}, coasting"));
-                }
-            }
             // An integrity that cannot be read is not to be trusted: shown as invalid.
             let integrity = Integrity::from_u8(nav.integrity).unwrap_or(Integrity::Invalid);
             if integrity != Integrity::Ok && mode != Some(NavMode::Aligning) {
@@ -94,6 +90,7 @@ mod tests {
             &[1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0],
             0,
             &DeviceCounters::default(),
+            &RedundancyReport::default(),
             Some(&nav),
         );
         for name in COUNTED {
@@ -113,9 +110,13 @@ mod tests {
             &[1000.0, 0.0, 100.0, 1000.0, 0.0, 1000.0],
             0,
             &DeviceCounters::default(),
+            &RedundancyReport::default(),
             Some(&coasting),
         );
-        assert!(line.contains("baro stale, coasting"), "{line}");
+        assert!(
+            line.contains("| navigating: baro stale, lane 0 |"),
+            "{line}"
+        );
         assert!(!line.contains("mag stale"), "{line}");
         assert!(!line.contains("integrity"), "{line}");
         let invalid = NavState {
@@ -129,10 +130,11 @@ mod tests {
             &[1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0],
             0,
             &DeviceCounters::default(),
+            &RedundancyReport::default(),
             Some(&invalid),
         );
         assert!(
-            line.contains("| invalid roll")
+            line.contains("| invalid, lane 0 | roll")
                 && line.contains("integrity INVALID: imu-unusable,covariance"),
             "{line}"
         );
@@ -151,19 +153,53 @@ mod tests {
             &[1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0],
             0,
             &DeviceCounters::default(),
+            &RedundancyReport::default(),
             Some(&unknown),
         );
         assert!(
-            line.contains("| mode 200 roll") && line.contains("integrity INVALID: "),
+            line.contains("| mode 200, lane 0 | roll") && line.contains("integrity INVALID: "),
             "{line}"
         );
         assert!(!line.contains("aligning"), "{line}");
     }
 
     #[test]
+    fn the_line_shows_the_channels_in_use_and_why_one_is_out() {
+        let mut fused = ipc_types::FusedImu {
+            n_gyro: 4,
+            n_accel: 4,
+            ..ipc_types::FusedImu::default()
+        };
+        fused.gyro_state[..4].fill(ipc_types::ChannelState::Ok as u8);
+        fused.accel_state[..4].fill(ipc_types::ChannelState::Ok as u8);
+        fused.gyro_state[2] = ipc_types::ChannelState::Excluded as u8;
+        fused.gyro_reason[2] = ipc_types::FaultReason::Missing as u8;
+        let nav = NavState {
+            mode: NavMode::Navigating as u8,
+            aiding: ipc_types::aiding::BARO | ipc_types::aiding::MAG,
+            ..NavState::default()
+        };
+        let line = status_line(
+            5.0,
+            &[1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0],
+            0,
+            &DeviceCounters::default(),
+            &crate::redundancy_view::redundancy_of(&fused, 0),
+            Some(&nav),
+        );
+        assert!(
+            line.contains(
+                "| gyro 3/4 (gyro2 missing) accel 4/4 | navigating, lane 0, aiding baro+mag | roll"
+            ),
+            "{line}"
+        );
+    }
+
+    #[test]
     fn rare_device_counters_appear_only_when_non_zero() {
         let rates = [1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0];
-        let quiet = status_line(4.0, &rates, 0, &DeviceCounters::default(), None);
+        let none = RedundancyReport::default();
+        let quiet = status_line(4.0, &rates, 0, &DeviceCounters::default(), &none, None);
         assert!(
             quiet.ends_with("| dropped 0 crc 0 lost 0 | no navigation output yet"),
             "{quiet}"
@@ -176,7 +212,7 @@ mod tests {
             time_rebases: 2,
             ..DeviceCounters::default()
         };
-        let line = status_line(4.0, &rates, 3, &device, None);
+        let line = status_line(4.0, &rates, 3, &device, &none, None);
         assert!(
             line.contains(
                 "| dropped 3 crc 1 lost 2 malformed 12000 late 3 time rebases 2 | no navigation"

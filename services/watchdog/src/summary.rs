@@ -26,7 +26,7 @@ impl From<[u64; 3]> for IntegritySamples {
 }
 
 /// What `rins up --json` prints at the end of a run.
-#[derive(Debug, Clone, Serialize, PartialEq)]
+#[derive(Debug, Clone, Default, Serialize, PartialEq)]
 pub struct Summary {
     /// Length of the run, s.
     pub duration_s: f64,
@@ -55,6 +55,16 @@ pub struct Summary {
     pub seq_jumps: u64,
     /// Device-clock discontinuities, re-based on the receive clock.
     pub time_rebases: u64,
+    /// Bytes read from the serial device.
+    pub bytes_received: u64,
+    /// Serial frames with a valid CRC and sane content (published, or withheld as duplicate or
+    /// late).
+    pub valid_frames: u64,
+    /// Bytes discarded while looking for frames.
+    pub discarded_bytes: u64,
+    /// Why the last undecodable bytes were refused: `none`, `no-sync`, `unknown-frame-type`,
+    /// `bad-length`, `crc-mismatch`, `bad-content`.
+    pub last_decode_error: String,
     /// Navigation samples of the merged stream.
     pub nav_samples: u64,
     /// Child restarts.

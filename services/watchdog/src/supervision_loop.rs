@@ -182,13 +182,18 @@ impl StatusLines {
         }
         self.last_totals = monitor.totals;
         self.last_at = Instant::now();
-        let line = status_line(
+        let mut line = status_line(
             started.elapsed().as_secs_f64(),
             &rates,
             monitor.nav_gaps.missing,
             &monitor.device_counters(),
+            &monitor.redundancy_report(rins_runtime::clock::monotonic_ns()),
             monitor.last_nav.as_ref(),
         );
+        // Only when the line is wrong, so the usual line keeps its width.
+        if let Some(note) = monitor.link.status_note() {
+            line.push_str(&format!(" | {note}"));
+        }
         if self.on_stderr {
             eprintln!("{line}");
         } else {

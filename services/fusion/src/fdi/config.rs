@@ -6,10 +6,10 @@ use super::chi2::{chi2_upper_quantile, regularized_gamma_p};
 use super::persistence::{MAX_PERSISTENCE_WINDOW, exceedance_probability};
 use super::stationary::StationarySettings;
 use crate::error::ConfigError;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// Which parity noise covariance the detector whitens with.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ParityNoise {
     /// `V R Vᵀ` from the configured channel noise.
@@ -21,7 +21,7 @@ pub enum ParityNoise {
 }
 
 /// What happens to latched exclusions when a sensor type has lost its solution.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ReadmitPolicy {
     /// With fewer than three channels in service, the excluded channels are re-tested and those
@@ -34,7 +34,7 @@ pub enum ReadmitPolicy {
 }
 
 /// Fault detection and isolation settings. Sample counts are at the IMU rate.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct FdiConfig {
     /// Probability that a fault-free sample raises a (persistent, k-of-n) parity alarm. The
@@ -91,6 +91,10 @@ pub struct FdiConfig {
     /// Samples in a row an excluded channel must be valid, off the converter rails, varying and
     /// consistent with the others before it returns by itself.
     pub readmit_after_samples: u32,
+    /// Fused samples a channel re-admitted by command must stay in the solution before the
+    /// command is answered `readmitted`; excluded again within them, the answer is
+    /// `fault-still-present`.
+    pub readmit_probation_samples: u32,
 }
 
 impl Default for FdiConfig {
@@ -119,6 +123,7 @@ impl Default for FdiConfig {
             timing_skew_s: 0.0,
             readmit: ReadmitPolicy::Auto,
             readmit_after_samples: 1_000,
+            readmit_probation_samples: 1_000,
         }
     }
 }
@@ -278,6 +283,11 @@ impl FdiConfig {
             ));
         }
         at_least("readmit_after_samples", self.readmit_after_samples, 10)?;
+        at_least(
+            "readmit_probation_samples",
+            self.readmit_probation_samples,
+            10,
+        )?;
         Ok(FdiSettings {
             readmit: self.readmit,
             readmit_after_samples: self.readmit_after_samples,

@@ -1,6 +1,6 @@
 //! Error-model parameters of the simulated sensor block (defaults: small-UAV MEMS block).
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::error::{SimError, check_positive, check_range};
 use rins_earth::STANDARD_GRAVITY;
@@ -14,7 +14,7 @@ pub const MAX_TEMPERATURE_SENSORS: u8 = ipc_types::MAX_TEMPERATURES as u8;
 
 /// Per-channel error model of gyros and accelerometers, module temperatures, barometer,
 /// magnetometer and foot-pressure noise. Units are in the field names; degrees and g only here.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SensorModelConfig {
     /// Gyro full scale: ±this maps to ±2048 counts, °/s. Not a key of `[sim.sensors]`: the simulated
@@ -237,24 +237,36 @@ impl SensorModelConfig {
             50.0,
             "must be -50..=50",
         )?;
-        for value in self.mag_hard_iron_ut {
-            check_range(
-                "sim.sensors.mag_hard_iron_ut",
-                value,
-                -1e4,
-                1e4,
-                "components must be finite, |x| <= 10000",
-            )?;
-        }
-        for value in self.mag_soft_iron.iter().flatten() {
-            check_range(
-                "sim.sensors.mag_soft_iron",
-                *value,
-                -10.0,
-                10.0,
-                "components must be finite, |x| <= 10",
-            )?;
-        }
-        Ok(())
+        check_mag_distortion(
+            ("sim.sensors.mag_hard_iron_ut", &self.mag_hard_iron_ut),
+            ("sim.sensors.mag_soft_iron", &self.mag_soft_iron),
+        )
     }
+}
+
+/// Checks a magnetometer's hard iron (µT) and soft-iron matrix, each given with its field name:
+/// finite, and small enough that the readings stay far inside the frame's i32 nanotesla.
+pub(crate) fn check_mag_distortion(
+    hard_iron_ut: (&'static str, &[f64; 3]),
+    soft_iron: (&'static str, &[[f64; 3]; 3]),
+) -> Result<(), SimError> {
+    for value in hard_iron_ut.1 {
+        check_range(
+            hard_iron_ut.0,
+            *value,
+            -1e4,
+            1e4,
+            "components must be finite, |x| <= 10000",
+        )?;
+    }
+    for value in soft_iron.1.iter().flatten() {
+        check_range(
+            soft_iron.0,
+            *value,
+            -10.0,
+            10.0,
+            "components must be finite, |x| <= 10",
+        )?;
+    }
+    Ok(())
 }

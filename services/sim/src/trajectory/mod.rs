@@ -1,7 +1,8 @@
 //! Deterministic truth trajectory, sampled at device time t (seconds).
 //!
-//! Two motion generators share the conventions below: a vehicle moved by smooth schedules (the
-//! static and UAV scenarios, [`flight`]) and a foot-mounted sensor on a walking person ([`walk`]).
+//! Three motion generators share the conventions below: a vehicle moved by smooth schedules (the
+//! static and UAV scenarios, [`flight`]), a foot-mounted sensor on a walking person ([`walk`]) and
+//! the block turned on the spot through every orientation ([`calibration`]).
 //! Each gives Euler angles and their rates, velocity and acceleration in closed form; then
 //! - attitude q = R_z(ψ) R_y(θ) R_x(φ) (body FRD → NED);
 //! - body rate from the exact Euler-rate relation, so it is the true derivative of q;
@@ -11,6 +12,7 @@
 //! force has no Coriolis or centripetal terms. Gravity is the constant [`STANDARD_GRAVITY`]. Altitude is
 //! above mean sea level, the origin altitude being ground level.
 
+pub mod calibration;
 pub mod flight;
 pub mod gait;
 pub mod geodesy;
@@ -19,23 +21,28 @@ pub mod uav_profile;
 pub mod walk;
 
 use nalgebra::{UnitQuaternion, Vector3};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
+use calibration::CalibrationPath;
 use flight::FlightPath;
 use rins_earth::STANDARD_GRAVITY;
 use walk::WalkPath;
 
 /// Which motion the simulator produces.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Scenario {
     /// Parked level at the origin, fixed heading.
-    #[default]
     Static,
     /// Take-off, climb, cruise circuits with banked turns, descent and landing (see [`uav_profile`]).
+    /// The default: something moves as soon as the pipeline runs.
+    #[default]
     Uav,
     /// A foot-mounted sensor walked once round a 50 m × 12.9 m rectangle (see [`walk`]).
     Walk,
+    /// Turned on the spot through every orientation, over and over, with the magnetometer's hard
+    /// and soft iron of `[sim.calibration]`: what `rins calibrate mag` needs (see [`calibration`]).
+    Calibrate,
 }
 
 /// Where and how the trajectory starts, and how long the UAV flies.
@@ -54,6 +61,8 @@ pub struct TrajectoryStart {
     /// UAV scenario: the flight (parking included) lasts up to this long, its circuits repeated
     /// as many times as fit; `None`: one pair of circuits. Ignored by the other scenarios.
     pub uav_flight_s: Option<f64>,
+    /// Calibrate scenario: time of one full yaw turn, s (> 0). Ignored by the other scenarios.
+    pub calibration_sweep_s: f64,
 }
 
 /// The true state at one instant.
@@ -94,7 +103,7 @@ pub struct Landmarks {
     pub lift_off_s: f64,
     /// The vehicle touches down; in the walk, the foot's last heel strike (∞ if it never flies).
     pub touchdown_s: f64,
-    /// At rest for good from here on (0 if it never moves).
+    /// At rest for good from here on (0 if it never moves, ∞ if it never stops).
     pub end_s: f64,
 }
 
@@ -103,6 +112,7 @@ pub struct Landmarks {
 enum Motion {
     Flight(FlightPath),
     Walk(WalkPath),
+    Calibration(CalibrationPath),
 }
 
 /// A deterministic trajectory; sampling is allocation-free.
@@ -132,6 +142,10 @@ impl Trajectory {
                 let landmarks = path.landmarks();
                 (Motion::Walk(path), landmarks)
             }
+            Scenario::Calibrate => {
+                let (path, landmarks) = CalibrationPath::new(start, start.calibration_sweep_s);
+                (Motion::Calibration(path), landmarks)
+            }
         };
         Self {
             start,
@@ -141,7 +155,7 @@ impl Trajectory {
     }
 
     /// Time after which the vehicle (or the walker) stays at rest for good (0 for the static
-    /// scenario), s.
+    /// scenario, ∞ for the calibrate scenario, which never stops), s.
     pub fn end_s(&self) -> f64 {
         self.landmarks.end_s
     }
@@ -169,6 +183,7 @@ impl Trajectory {
         match &self.motion {
             Motion::Flight(path) => path.sample(t),
             Motion::Walk(path) => path.sample(t),
+            Motion::Calibration(path) => path.sample(t),
         }
     }
 }

@@ -165,7 +165,8 @@ impl McConfig {
             Scenario::Uav | Scenario::Walk => {
                 Trajectory::new(self.sim.scenario, self.sim.trajectory_start()).end_s()
             }
-            Scenario::Static => 600.0,
+            // Neither ever stops: ten minutes, as long as one uav flight.
+            Scenario::Static | Scenario::Calibrate => 600.0,
         };
         let duration_s = self.duration_s.unwrap_or(full_flight_s);
         if !(duration_s.is_finite() && duration_s > 0.0 && duration_s <= 86_400.0) {
@@ -198,7 +199,7 @@ impl McConfig {
 
         let gyro_channel_bias_ticks = if self.calibrate_gyro_channels_at_rest {
             let parked_s = match self.sim.scenario {
-                Scenario::Uav | Scenario::Walk => self.sim.static_s,
+                Scenario::Uav | Scenario::Walk | Scenario::Calibrate => self.sim.static_s,
                 Scenario::Static => f64::INFINITY,
             };
             if parked_s < navigator.align_s {

@@ -1,4 +1,4 @@
-//! The comparison report as Markdown tables (for the README): the fault-free errors with their
+//! The comparison report as Markdown tables (for docs/fault-tolerance.md): the fault-free errors with their
 //! ratios beside the published ones, then the kill experiment.
 
 use std::fmt::Write;
@@ -7,7 +7,7 @@ use super::report::{KillStats, McReport, PUBLISHED_CLAIMS, WindowStats};
 use crate::stats::Stat;
 
 impl McReport {
-    /// The comparison as Markdown tables (for the README): the fault-free errors with their
+    /// The comparison as Markdown tables (for docs/fault-tolerance.md): the fault-free errors with their
     /// ratios beside the published ones, then the kill experiment.
     pub fn to_table(&self) -> String {
         let mut s = String::new();
