@@ -102,7 +102,11 @@ fn with_a_pipeline_each_tool_takes_its_files_with_it() {
     // The pipeline opens its last services a moment after the first navigation sample: what is
     // new after a tool must be the tool's.
     settle(&ipc);
-    for tool in TOOLS {
+    // The operator's sequence: kill a channel, clear the fault, re-admit the channel (fusion
+    // refuses while the fault is present).
+    let clear: &[&str] = &["inject", "gyro2", "clear"];
+    let live = [TOOLS[0], TOOLS[1], TOOLS[2], TOOLS[3], clear, TOOLS[4]];
+    for tool in live {
         let shm_before: BTreeSet<String> = ipc.shm_entries().into_iter().collect();
         let root_before = files_under(&ipc.root);
         let out = ipc.run_with_timeout(tool, LIMIT);
