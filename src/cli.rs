@@ -64,6 +64,10 @@ pub enum Command {
         /// Comma-separated values with a header line, instead of one JSON object per line.
         #[arg(long)]
         csv: bool,
+        /// Print the wire form: padding, unused channel slots, enums and bit sets as numbers, no
+        /// derived angles (by default: channels in use, names, roll/pitch/yaw and degrees).
+        #[arg(long)]
+        raw: bool,
         /// Fail when no sample arrives for this many seconds (0: wait for ever).
         #[arg(long, allow_negative_numbers = true, default_value_t = 10.0)]
         timeout: f64,
@@ -307,7 +311,8 @@ pub struct UpArgs {
     /// time (the message names the port and what the line carried).
     #[arg(long, allow_negative_numbers = true)]
     pub duration: Option<f64>,
-    /// With --duration: print a JSON summary as the last line.
+    /// Print the run's summary as one JSON object, the only thing on stdout (the status lines go
+    /// to stderr). Without it, a run with --duration ends with the summary as text.
     #[arg(long)]
     pub json: bool,
     /// Configuration file (default: the built-in configuration).
@@ -438,6 +443,9 @@ pub struct SoakArgs {
     /// readmit it), disconnect (unplug the serial device for 0.2-1 s).
     #[arg(long, default_value = "kill,sensor")]
     pub faults: String,
+    /// Print the summary as one JSON object on stdout (progress stays on stderr).
+    #[arg(long)]
+    pub json: bool,
 }
 
 impl From<SoakArgs> for rins_soak::SoakArgs {
@@ -448,6 +456,7 @@ impl From<SoakArgs> for rins_soak::SoakArgs {
             min_interval_s: a.min_interval_s,
             max_interval_s: a.max_interval_s,
             faults: a.faults,
+            json: a.json,
         }
     }
 }

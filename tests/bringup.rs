@@ -29,7 +29,8 @@ fn garbage_device() -> FakeDevice {
     })
 }
 
-/// `rins up ARGS` in the background, stdout piped (status lines and summary), stderr to `log`.
+/// `rins up ARGS` in the background, stdout piped (the status lines, or with --json the summary
+/// alone), stderr (logs, and with --json the status lines) to `log`.
 fn spawn_up_logging(ipc: &Isolated, args: &[&str], log: &std::path::Path) -> Child {
     let file = File::create(log).expect("log file");
     ipc.command()
@@ -96,7 +97,6 @@ fn garbage_on_the_line_shows_in_status_summary_and_one_warning() {
     let out = stop_up_output(&ipc, up);
     drop(device);
     let summary = common::last_json(&out);
-    let stdout = String::from_utf8_lossy(&out.stdout);
     let log = std::fs::read_to_string(&log).expect("stderr log");
     assert_eq!(count(&log, "no valid frame from"), 1, "{log}");
     assert!(
@@ -104,10 +104,10 @@ fn garbage_on_the_line_shows_in_status_summary_and_one_warning() {
             && log.contains("wrong baud rate or not a rins device?"),
         "{log}"
     );
-    // The status line says it only in this case.
+    // The status line (on stderr with --json) says it only in this case.
     assert!(
-        stdout.contains("B/s discarded (no-sync)") && stdout.contains("| no valid frame: "),
-        "{stdout}"
+        log.contains("B/s discarded (no-sync)") && log.contains("| no valid frame: "),
+        "{log}"
     );
     assert_eq!(summary["valid_frames"], 0, "{summary}");
     assert_eq!(summary["last_decode_error"], "no-sync", "{summary}");

@@ -184,7 +184,10 @@ fn up_rejects_bad_timed_faults_before_starting() {
 /// A `rins up` running in the background, its stdout lines forwarded to a channel.
 struct Pipeline {
     child: Child,
+    /// Stdout: with --json, the summary alone.
     lines: mpsc::Receiver<String>,
+    /// The status lines, on stderr with --json.
+    status: mpsc::Receiver<String>,
     seen: Vec<String>,
 }
 
@@ -194,8 +197,21 @@ impl Pipeline {
             .command()
             .args(args)
             .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
             .spawn()
             .expect("cannot start rins up");
+        let stderr = child.stderr.take().expect("piped stderr");
+        let (status_tx, status) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+                if line.starts_with("t=") {
+                    let _ = status_tx.send(line);
+                } else {
+                    // Everything else still reaches the test's output.
+                    eprintln!("{line}");
+                }
+            }
+        });
         let stdout = child.stdout.take().expect("piped stdout");
         let (tx, lines) = mpsc::channel();
         std::thread::spawn(move || {
@@ -208,6 +224,7 @@ impl Pipeline {
         Self {
             child,
             lines,
+            status,
             seen: Vec::new(),
         }
     }
@@ -216,12 +233,9 @@ impl Pipeline {
     fn wait_running(&mut self, limit: Duration) {
         let deadline = Instant::now() + limit;
         while Instant::now() < deadline {
-            if let Ok(line) = self.lines.recv_timeout(Duration::from_millis(100)) {
-                let status = line.starts_with("t=");
+            if let Ok(line) = self.status.recv_timeout(Duration::from_millis(100)) {
                 self.seen.push(line);
-                if status {
-                    return;
-                }
+                return;
             }
         }
         panic!("no status line within {limit:?}: {:?}", self.seen);
@@ -252,7 +266,7 @@ impl Pipeline {
 /// Valid-mask bit of gyro `i` in the last of a few raw IMU frames.
 fn gyro_valid(ipc: &Isolated, i: u32) -> bool {
     let out = ipc.run_with_timeout(
-        &["echo", "raw-imu", "--count", "3"],
+        &["echo", "raw-imu", "--raw", "--count", "3"],
         Duration::from_secs(10),
     );
     assert!(out.status.success(), "echo failed:\n{}", stderr(&out));

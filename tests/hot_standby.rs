@@ -26,7 +26,7 @@ struct Sample {
 fn echo_nav(ipc: &Isolated) -> (Child, Receiver<Sample>) {
     let mut child = ipc
         .command()
-        .args(["echo", "nav", "--timeout", "60"])
+        .args(["echo", "nav", "--raw", "--timeout", "60"])
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .spawn()

@@ -86,4 +86,30 @@ fn pedestrian_profile_walks_with_zero_velocity_and_heading_updates() {
     common::assert_no_loss_beyond_the_line(&s);
     assert!(num(&s, "att_err_deg_max") < 3.0, "{s}");
     assert!(num(&s, "alt_err_m_rms") < 1.0, "{s}");
+    assert_walk_figures(&s);
+}
+
+/// The walk's horizontal figures: the distance is what the built-in walk covers in the run's
+/// device time (3 s standing, then one stride of 50/38 m every 1.05 s along the first side), and
+/// the share is the end-point error over that distance.
+fn assert_walk_figures(s: &serde_json::Value) {
+    use rins_sim::trajectory::walk::{COURSE_LENGTH_M, STRIDE_PERIOD_S, strides_per_side};
+    let distance = num(s, "distance_m");
+    let err = num(s, "horiz_end_err_m");
+    let pct = num(s, "horiz_end_err_pct");
+    assert!((pct - 100.0 * err / distance).abs() < 1e-9, "{s}");
+    let stride = COURSE_LENGTH_M / strides_per_side(COURSE_LENGTH_M) as f64;
+    // The simulator's device time lies between the frames the watchdog counted (1 kHz; it
+    // subscribed a little after the simulator began) and the run's wall time (the simulator
+    // started after the watchdog); a stride more on either side for the stride in progress and
+    // where the alignment ended.
+    let strides_by = |t: f64| (t - 3.0) / STRIDE_PERIOD_S;
+    let fewest = strides_by(num(s, "frames") / 1000.0).floor() - 1.0;
+    let most = strides_by(num(s, "duration_s")).ceil() + 1.0;
+    assert!(
+        distance > fewest * stride && distance < most * stride,
+        "{distance} m, expected {fewest}..{most} strides of {stride} m: {s}"
+    );
+    // A foot-mounted filter with ZUPT and HUPT: metres, not tens of metres, after ~20 m.
+    assert!(err < 5.0, "{s}");
 }

@@ -65,7 +65,7 @@ fn fly(name: &str, config: &TempFile, extra: &[&str]) -> Flight {
     let csv = File::create(&csv_path).expect("cannot create the nav record");
     let echo = ipc
         .command()
-        .args(["echo", "nav", "--csv", "--timeout", "0"])
+        .args(["echo", "nav", "--csv", "--raw", "--timeout", "0"])
         .stdout(csv)
         .stderr(Stdio::null())
         .spawn()

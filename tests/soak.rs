@@ -10,7 +10,7 @@ fn soak(test: &str, args: &[&str]) -> (Isolated, serde_json::Value) {
     let ipc = Isolated::new(test);
     let out = ipc
         .command()
-        .arg("soak")
+        .args(["soak", "--json"])
         .args(args)
         .output()
         .expect("cannot run rins soak");

@@ -184,7 +184,15 @@ fn fusion_says_when_acquisition_goes_quiet_and_when_it_is_back() {
             && a["state"] == "running"
             && service(r, "fusion")["input_stale"] == false
     });
-    let heartbeat = ipc.run(&["echo", "heartbeat", "--count", "20", "--timeout", "10"]);
+    let heartbeat = ipc.run(&[
+        "echo",
+        "heartbeat",
+        "--raw",
+        "--count",
+        "20",
+        "--timeout",
+        "10",
+    ]);
     assert!(heartbeat.status.success());
     let text = String::from_utf8_lossy(&heartbeat.stdout);
     let fusion_episodes = text

@@ -15,6 +15,10 @@ pub mod status {
     pub const DEVICE_ERROR: u32 = 1 << 0;
     /// At least one channel is saturated in this frame.
     pub const SATURATION: u32 = 1 << 1;
+
+    /// Every bit with its name as tools print it, in bit order.
+    pub const NAMES: [(u32, &str); 2] =
+        [(DEVICE_ERROR, "device-error"), (SATURATION, "saturation")];
 }
 
 /// One raw IMU frame: every gyro and accelerometer channel in 12-bit signed ADC counts, as

@@ -221,8 +221,9 @@ fn readmit_outcome() {
 
 #[test]
 fn every_flag_word_names_each_of_its_bits_once() {
-    use rins_ipc_types::{aiding, bit_names, fused_flags, integrity_reason};
+    use rins_ipc_types::{aiding, bit_names, fused_flags, integrity_reason, status};
     for names in [
+        &status::NAMES[..],
         &fused_flags::NAMES[..],
         &aiding::SOURCE_NAMES[..],
         &aiding::STALE_NAMES[..],
@@ -248,5 +249,14 @@ fn every_flag_word_names_each_of_its_bits_once() {
             &aiding::SOURCE_NAMES
         ),
         ["baro", "gravity"]
+    );
+}
+
+#[test]
+fn device_status_bits_by_name() {
+    use rins_ipc_types::{bit_names, status};
+    assert_eq!(
+        bit_names(status::DEVICE_ERROR | status::SATURATION, &status::NAMES),
+        ["device-error", "saturation"]
     );
 }

@@ -1,4 +1,5 @@
-//! `rins echo TOPIC`: print every sample of a topic, as JSON lines or CSV.
+//! `rins echo TOPIC`: print every sample of a topic, as JSON lines or CSV, in its readable form
+//! (see [`super::echo_readable`]) or, with `--raw`, exactly as it travels.
 
 use std::io::Write;
 use std::time::{Duration, Instant};
@@ -8,13 +9,17 @@ use ipc_types::{
     Altitude, FusedImu, Health, HealthReport, NavState, RawAux, RawBaro, RawImu, RawMag, Truth,
     names,
 };
-use rins_runtime::ipc::{IpcNode, SampleSource, TopicSubscriber, create_node};
+use rins_runtime::ipc::{IpcNode, SampleSource, TopicSubscriber};
 use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::shutdown::Shutdown;
-use serde::Serialize;
+use rins_runtime::tool_node::ToolNode;
 use serde_json::Value;
 
-/// Flattens nested objects and arrays into `a.b.0`-style columns.
+use super::echo_readable::{BIT_FIELDS, Readable};
+
+/// Flattens nested objects and arrays into `a.b.0`-style columns. A list of bit names (a field of
+/// [`BIT_FIELDS`]) is one cell, its names joined by `|`: its length changes from row to row, the
+/// columns must not.
 fn flatten(prefix: &str, value: &Value, out: &mut Vec<(String, String)>) {
     match value {
         Value::Object(map) => {
@@ -27,13 +32,44 @@ fn flatten(prefix: &str, value: &Value, out: &mut Vec<(String, String)>) {
                 flatten(&key, v, out);
             }
         }
+        Value::Array(items) if is_bit_field(prefix) => {
+            let names: Vec<String> = items
+                .iter()
+                .map(|v| v.as_str().map_or_else(|| v.to_string(), str::to_string))
+                .collect();
+            out.push((prefix.to_string(), names.join("|")));
+        }
         Value::Array(items) => {
             for (i, v) in items.iter().enumerate() {
                 flatten(&format!("{prefix}.{i}"), v, out);
             }
         }
+        // A name is written without JSON quotes; none contains a comma.
+        Value::String(text) => out.push((prefix.to_string(), text.clone())),
         other => out.push((prefix.to_string(), other.to_string())),
     }
+}
+
+/// Whether the column `path` (`a.b.c`) is a bit set listed by name.
+fn is_bit_field(path: &str) -> bool {
+    let last = path.rsplit('.').next().unwrap_or(path);
+    BIT_FIELDS.contains(&last)
+}
+
+/// The JSON object printed for `sample`: the wire form with `raw`, else the readable form.
+fn render<T: Readable>(sample: &T, raw: bool) -> serde_json::Result<Value> {
+    if raw {
+        serde_json::to_value(sample)
+    } else {
+        sample.readable()
+    }
+}
+
+/// The CSV columns of `value`: names for the header line, values for a row.
+fn csv_columns(value: &Value) -> Vec<(String, String)> {
+    let mut columns = Vec::new();
+    flatten("", value, &mut columns);
+    columns
 }
 
 /// What to print and when to give up.
@@ -41,13 +77,15 @@ fn flatten(prefix: &str, value: &Value, out: &mut Vec<(String, String)>) {
 struct EchoOptions {
     count: Option<u64>,
     csv: bool,
+    /// The wire form, padding and unused slots included, enums and bit sets as numbers.
+    raw: bool,
     /// Longest wait for the next sample; `None` waits for ever.
     timeout: Option<Duration>,
 }
 
 fn echo_topic<T>(name: &'static str, opts: EchoOptions) -> Result<()>
 where
-    T: std::fmt::Debug + Copy + Serialize + ReceivedAt + iceoryx2::prelude::ZeroCopySend + 'static,
+    T: std::fmt::Debug + Copy + Readable + ReceivedAt + iceoryx2::prelude::ZeroCopySend + 'static,
 {
     echo_from(name, opts, |node| TopicSubscriber::<T>::new(node, name))
 }
@@ -86,21 +124,22 @@ fn echo_from<T, S>(
     open: impl FnOnce(&IpcNode) -> Result<S, rins_runtime::ipc::IpcError>,
 ) -> Result<()>
 where
-    T: Serialize + ReceivedAt,
+    T: Readable + ReceivedAt,
     S: SampleSource<T>,
 {
     let started_ns = rins_runtime::clock::monotonic_ns();
     let shutdown = Shutdown::install()?;
-    let settings = rins_runtime::join_check::settings_to_join()?;
-    let node = create_node(&format!("echo-{}", std::process::id()), &settings)?;
-    let mut sub = open(&node)?;
+    // Ports are made after the tool node, so they are dropped before it cleans up.
+    let tool = ToolNode::join("echo")?;
+    let node = tool.node();
+    let mut sub = open(node)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     let mut printed = 0u64;
-    let mut columns = Vec::new();
     let EchoOptions {
         count,
         csv,
+        raw,
         timeout,
     } = opts;
     let mut last_sample = Instant::now();
@@ -120,10 +159,9 @@ where
                 continue;
             }
             last_sample = Instant::now();
-            let value = serde_json::to_value(sample)?;
+            let value = render(&sample, raw)?;
             if csv {
-                columns.clear();
-                flatten("", &value, &mut columns);
+                let columns = csv_columns(&value);
                 if printed == 0 {
                     let header: Vec<&str> = columns.iter().map(|(k, _)| k.as_str()).collect();
                     writeln!(out, "{}", header.join(","))?;
@@ -143,7 +181,9 @@ where
     Ok(())
 }
 
-pub fn run(topic: &str, count: Option<u64>, csv: bool, timeout_s: f64) -> Result<()> {
+/// Prints `topic` (its short name, e.g. `nav`) until `count` samples, a stop or `timeout_s`
+/// seconds without a sample (0: wait for ever); `raw` prints the wire form.
+pub fn run(topic: &str, count: Option<u64>, csv: bool, raw: bool, timeout_s: f64) -> Result<()> {
     if !(timeout_s.is_finite() && timeout_s >= 0.0) {
         bail!(
             "--timeout {timeout_s}: must be zero (wait for ever) or a positive number of seconds"
@@ -152,6 +192,7 @@ pub fn run(topic: &str, count: Option<u64>, csv: bool, timeout_s: f64) -> Result
     let opts = EchoOptions {
         count,
         csv,
+        raw,
         timeout: (timeout_s > 0.0).then(|| Duration::from_secs_f64(timeout_s)),
     };
     let Some((_, service)) = names::TOPICS.iter().find(|(short, _)| *short == topic) else {
@@ -188,5 +229,61 @@ mod tests {
         let keys: Vec<&str> = out.iter().map(|(k, _)| k.as_str()).collect();
         assert_eq!(keys, ["a", "b.c.0", "b.c.1"]);
         assert_eq!(out[2].1, "3");
+    }
+
+    fn four_gyro_fused() -> FusedImu {
+        let mut f = FusedImu {
+            n_gyro: 4,
+            n_accel: 4,
+            flags: ipc_types::fused_flags::GYRO_FAULT_DETECTED_NOT_ISOLATED
+                | ipc_types::fused_flags::GYRO_REST_BIAS_PENDING,
+            ..FusedImu::default()
+        };
+        f.gyro_state[..4].fill(ipc_types::ChannelState::Ok as u8);
+        f.accel_state[..4].fill(ipc_types::ChannelState::Ok as u8);
+        f.gyro_state[1] = ipc_types::ChannelState::Suspect as u8;
+        f
+    }
+
+    #[test]
+    fn csv_of_a_four_gyro_fused_sample_has_the_four_channels_by_name() {
+        let columns = csv_columns(&render(&four_gyro_fused(), false).unwrap());
+        let keys: Vec<&str> = columns.iter().map(|(k, _)| k.as_str()).collect();
+        let gyro_state: Vec<(&str, &str)> = columns
+            .iter()
+            .filter(|(k, _)| k.starts_with("gyro_state."))
+            .map(|(k, v)| (k.as_str(), v.as_str()))
+            .collect();
+        assert_eq!(
+            gyro_state,
+            [
+                ("gyro_state.0", "ok"),
+                ("gyro_state.1", "suspect"),
+                ("gyro_state.2", "ok"),
+                ("gyro_state.3", "ok"),
+            ]
+        );
+        for per_channel in ["gyro_reason", "accel_state", "accel_reason"] {
+            let n = keys.iter().filter(|k| k.starts_with(per_channel)).count();
+            assert_eq!(n, 4, "{per_channel}: {keys:?}");
+        }
+        assert!(!keys.iter().any(|k| k.contains("_pad")), "{keys:?}");
+        let flags = columns.iter().find(|(k, _)| k == "flags").unwrap();
+        assert_eq!(flags.1, "gyro-fault-not-isolated|gyro-rest-bias-pending");
+        assert!(keys.contains(&"header.stage_pub_ns.navigator"), "{keys:?}");
+        // 41 columns where the wire form has 89.
+        assert_eq!(columns.len(), 41, "{keys:?}");
+    }
+
+    #[test]
+    fn raw_keeps_the_wire_form() {
+        let f = four_gyro_fused();
+        let raw = render(&f, true).unwrap();
+        assert_eq!(raw, serde_json::to_value(f).unwrap());
+        assert_eq!(raw["gyro_state"].as_array().unwrap().len(), 16);
+        assert_eq!(raw["gyro_state"][1], ipc_types::ChannelState::Suspect as u8);
+        assert_eq!(raw["flags"], f.flags);
+        let columns = csv_columns(&raw);
+        assert_eq!(columns.len(), 89);
     }
 }

@@ -6,7 +6,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow, bail};
 use ipc_types::{FaultApplied, FaultOutcome, SimControl, names};
-use rins_runtime::ipc::{TopicSubscriber, create_node};
+use rins_runtime::ipc::TopicSubscriber;
+use rins_runtime::tool_node::ToolNode;
 use rins_sim::sim_command::SimCommand;
 
 use crate::cli::InjectArgs;
@@ -33,14 +34,15 @@ pub fn run(args: &InjectArgs) -> Result<()> {
         args.duration.as_deref(),
     )
     .map_err(|e| anyhow!("{e}"))?;
-    let settings = rins_runtime::join_check::settings_to_join()?;
-    let node = create_node(&format!("inject-{}", std::process::id()), &settings)?;
+    // Ports are made after the tool node, so they are dropped before it cleans up.
+    let tool = ToolNode::join("inject")?;
+    let (node, settings) = (tool.node(), tool.settings());
     // Subscribe to the confirmations before sending, so the answer cannot be missed.
-    let confirmations = TopicSubscriber::<FaultApplied>::new(&node, names::SIM_FAULT_APPLIED)?;
+    let confirmations = TopicSubscriber::<FaultApplied>::new(node, names::SIM_FAULT_APPLIED)?;
     let control = command.to_control();
     let _sent = control::send(
-        &node,
-        &settings,
+        node,
+        settings,
         names::SIM_CONTROL,
         "simulator",
         control,

@@ -6,9 +6,10 @@ use anyhow::{Result, bail};
 use hdrhistogram::Histogram;
 use ipc_types::{Altitude, Header, Stage, names};
 use rins_runtime::clock::monotonic_ns;
-use rins_runtime::ipc::{TopicSubscriber, create_node};
+use rins_runtime::ipc::TopicSubscriber;
 use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::shutdown::Shutdown;
+use rins_runtime::tool_node::ToolNode;
 use serde::Serialize;
 
 /// One measured hop: from one stamp to another, in nanoseconds.
@@ -66,11 +67,12 @@ pub fn run(seconds: f64, json: bool) -> Result<()> {
         bail!("--seconds {seconds}: must be a positive number");
     }
     let shutdown = Shutdown::install()?;
-    let settings = rins_runtime::join_check::settings_to_join()?;
-    let node = create_node(&format!("latency-{}", std::process::id()), &settings)?;
+    // Ports are made after the tool node, so they are dropped before it cleans up.
+    let tool = ToolNode::join("latency")?;
+    let (node, settings) = (tool.node(), tool.settings());
     // The stream consumers see: both navigator lanes through the lane selector.
-    let mut nav = NavSubscriber::new(&node)?;
-    let alt = TopicSubscriber::<Altitude>::new(&node, names::ALTITUDE)?;
+    let mut nav = NavSubscriber::new(node)?;
+    let alt = TopicSubscriber::<Altitude>::new(node, names::ALTITUDE)?;
     let mut hops = [
         Hop::new("serial rx -> acquisition published")?,
         Hop::new("acquisition -> fusion published")?,

@@ -3,6 +3,7 @@
 mod calibrate;
 mod control;
 mod echo;
+mod echo_readable;
 mod eval;
 mod fault_args;
 mod geometry;
@@ -41,8 +42,9 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             topic,
             count,
             csv,
+            raw,
             timeout,
-        } => echo::run(&topic, count, csv, timeout).map(|()| ExitCode::SUCCESS),
+        } => echo::run(&topic, count, csv, raw, timeout).map(|()| ExitCode::SUCCESS),
         Command::Soak(args) => rins_soak::run(&args.into()).map(|()| ExitCode::SUCCESS),
         Command::Status { json, timeout } => status::run(json, timeout).map(|()| ExitCode::SUCCESS),
         Command::Probe(args) => probe::run(&args).map(|()| ExitCode::SUCCESS),

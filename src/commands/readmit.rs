@@ -8,7 +8,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow, bail};
 use ipc_types::{FaultReason, FusionControl, FusionReply, PAYLOAD_VERSION, ReadmitOutcome, names};
-use rins_runtime::ipc::{TopicSubscriber, create_node};
+use rins_runtime::ipc::TopicSubscriber;
+use rins_runtime::tool_node::ToolNode;
 use rins_sim::fault_command::ChannelId;
 
 use crate::commands::control;
@@ -66,10 +67,11 @@ pub fn run(channel: &str, timeout_s: f64) -> Result<()> {
         bail!("--timeout {timeout_s}: must be a positive number of seconds");
     }
     let channel = ChannelId::parse(channel).map_err(|e| anyhow!("{e}"))?;
-    let settings = rins_runtime::join_check::settings_to_join()?;
-    let node = create_node(&format!("readmit-{}", std::process::id()), &settings)?;
+    // Ports are made after the tool node, so they are dropped before it cleans up.
+    let tool = ToolNode::join("readmit")?;
+    let (node, settings) = (tool.node(), tool.settings());
     // Subscribed before the request leaves, so the answer cannot pass by unseen.
-    let replies = TopicSubscriber::<FusionReply>::new(&node, names::FUSION_REPLY)?;
+    let replies = TopicSubscriber::<FusionReply>::new(node, names::FUSION_REPLY)?;
     let request_id = std::process::id();
     let command = FusionControl {
         version: PAYLOAD_VERSION,
@@ -78,8 +80,8 @@ pub fn run(channel: &str, timeout_s: f64) -> Result<()> {
         request_id,
     };
     let _sent = control::send(
-        &node,
-        &settings,
+        node,
+        settings,
         names::FUSION_CONTROL,
         "fusion process",
         command,

@@ -7,7 +7,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Result, bail};
 use ipc_types::{HealthReport, ServiceKind, ServiceState, names};
-use rins_runtime::ipc::{TopicSubscriber, create_node};
+use rins_runtime::ipc::TopicSubscriber;
+use rins_runtime::tool_node::ToolNode;
 use rins_watchdog::redundancy_view::{
     NavView, RedundancyView, SensorRow, nav_view, redundancy_view,
 };
@@ -143,9 +144,10 @@ pub fn run(json: bool, timeout_s: f64) -> Result<()> {
     if !(timeout_s.is_finite() && timeout_s > 0.0) {
         bail!("--timeout {timeout_s}: must be a positive number of seconds");
     }
-    let settings = rins_runtime::join_check::settings_to_join()?;
-    let node = create_node(&format!("status-{}", std::process::id()), &settings)?;
-    let sub = TopicSubscriber::<HealthReport>::new(&node, names::HEALTH)?;
+    // Ports are made after the tool node, so they are dropped before it cleans up.
+    let tool = ToolNode::join("status")?;
+    let (node, settings) = (tool.node(), tool.settings());
+    let sub = TopicSubscriber::<HealthReport>::new(node, names::HEALTH)?;
     let deadline = Instant::now() + Duration::from_secs_f64(timeout_s);
     let report = loop {
         sub.wait(Duration::from_millis(50))?;

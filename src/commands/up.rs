@@ -19,6 +19,7 @@ use rins_watchdog::restart_timing::RestartTiming;
 use rins_watchdog::run_summary::summarise;
 use rins_watchdog::sim_start::wait_for_path;
 use rins_watchdog::summary::Summary;
+use rins_watchdog::summary_text::summary_text;
 use rins_watchdog::supervision_loop::{Supervision, Watch, supervise};
 use rins_watchdog::supervisor::{ChildSpec, Supervisor};
 
@@ -145,6 +146,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
             shutdown: &shutdown,
             started,
             end: args.duration.map(|d| started + Duration::from_secs_f64(d)),
+            status_on_stderr: args.json,
         };
         supervise(
             &run,
@@ -177,6 +179,9 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     };
     if args.json {
         println!("{}", serde_json::to_string(&summary)?);
+    } else if args.duration.is_some() {
+        // A timed run ends with what it measured; one stopped by hand ends quietly.
+        print!("{}", summary_text(&summary));
     }
     // A timed run that never saw a frame did not do what was asked: a bring-up script must see it.
     if args.duration.is_some()

@@ -20,11 +20,12 @@ pub struct TopicStream {
 }
 
 impl TopicStream {
-    /// Follows `topic` (as `rins echo` names it) from now on.
+    /// Follows `topic` (as `rins echo` names it) from now on, in the wire form (`--raw`): the
+    /// tests compare codes and bits with the payload constants.
     pub fn start(ipc: &Isolated, topic: &str) -> Self {
         let mut child = ipc
             .command()
-            .args(["echo", topic, "--timeout", "0"])
+            .args(["echo", topic, "--raw", "--timeout", "0"])
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
             .spawn()

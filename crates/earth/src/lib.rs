@@ -1,10 +1,12 @@
-//! The Earth models every part of rins shares: the WGS84 ellipsoid ([`wgs84`]), gravity
+//! The Earth models every part of rins shares: attitude angles ([`attitude`]), the WGS84 ellipsoid ([`wgs84`]), gravity
 //! ([`gravity`]: the standard value and normal gravity) and the standard atmosphere ([`isa`]).
 //! Pure functions and constants.
 
+pub mod attitude;
 pub mod gravity;
 pub mod isa;
 pub mod wgs84;
 
+pub use attitude::euler_deg;
 pub use gravity::{STANDARD_GRAVITY, normal_gravity};
 pub use wgs84::{meridian_radius, prime_vertical_radius};

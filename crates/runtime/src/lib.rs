@@ -21,4 +21,5 @@ pub mod shm_cleanup;
 pub mod shutdown;
 pub mod stage_io;
 pub mod stage_loop;
+pub mod tool_node;
 pub mod user;

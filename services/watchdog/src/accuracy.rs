@@ -1,6 +1,9 @@
-//! Navigation error against simulator truth: attitude angle and altitude, RMS and maximum.
+//! Navigation error against simulator truth: attitude angle and altitude, RMS and maximum, and the
+//! horizontal track (distance travelled, end-point error).
 
 use nalgebra::{Quaternion, UnitQuaternion};
+
+use crate::horizontal::HorizontalTrack;
 
 /// RMS and largest of a stream of errors.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -54,6 +57,8 @@ pub struct Accuracy {
     pub attitude_deg: ErrorStats,
     /// Altitude error, m.
     pub altitude_m: ErrorStats,
+    /// Distance the truth travelled over the ground and the solution's horizontal error.
+    pub horizontal: HorizontalTrack,
 }
 
 impl Accuracy {

@@ -12,6 +12,7 @@ use rins_runtime::nav_subscriber::NavSubscriber;
 
 use crate::accuracy::Accuracy;
 use crate::fault_tracking::FaultTracker;
+use crate::horizontal::Position;
 use crate::link::LinkRate;
 use crate::redundancy_view::{nav_of, redundancy_of};
 use crate::seq_gaps::SeqGaps;
@@ -267,6 +268,18 @@ impl Monitor {
                     truth.altitude_m,
                     nav.quaternion,
                     nav.altitude_m,
+                );
+                self.accuracy.horizontal.push(
+                    Position {
+                        lat_rad: truth.latitude_rad,
+                        lon_rad: truth.longitude_rad,
+                        height_m: truth.altitude_m,
+                    },
+                    Position {
+                        lat_rad: nav.latitude_rad,
+                        lon_rad: nav.longitude_rad,
+                        height_m: nav.altitude_m,
+                    },
                 );
             }
         }

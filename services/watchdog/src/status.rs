@@ -1,17 +1,10 @@
 //! The once-a-second status line.
 
 use ipc_types::{Integrity, NavMode, NavState, RedundancyReport, integrity_reason};
-use nalgebra::{Quaternion, UnitQuaternion};
+pub use rins_earth::euler_deg;
 
 use crate::monitor::{COUNTED, DeviceCounters};
 use crate::redundancy_view::{nav_of, nav_summary, redundancy_summary};
-
-/// Roll, pitch, yaw in degrees (ZYX) of a body→NED quaternion [w, x, y, z].
-pub fn euler_deg(q: [f64; 4]) -> [f64; 3] {
-    let u = UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
-    let (r, p, y) = u.euler_angles();
-    [r.to_degrees(), p.to_degrees(), y.to_degrees()]
-}
 
 /// One status line: per-topic rates over the last period, losses, the redundant channels in use
 /// and why any is out, and the current solution with its mode, lane and aiding.
@@ -74,6 +67,7 @@ pub fn status_line(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::UnitQuaternion;
 
     #[test]
     fn euler_of_a_known_attitude() {

@@ -97,6 +97,17 @@ pub struct Summary {
     /// Largest altitude error, m (simulator only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub alt_err_m_max: Option<f64>,
+    /// Horizontal distance the truth travelled after alignment, m (simulator only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub distance_m: Option<f64>,
+    /// Horizontal position error of the last navigation sample against truth, m (simulator
+    /// only): a walk's end-point error.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub horiz_end_err_m: Option<f64>,
+    /// `horiz_end_err_m` as a percentage of `distance_m` (simulator only, and only once the truth
+    /// travelled a metre).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub horiz_end_err_pct: Option<f64>,
     /// Shared-memory entries of this deployment left after shutdown.
     pub shm_leaked: u64,
     /// Every fault injected (scheduled or at run time), with detection and isolation times.

@@ -36,6 +36,8 @@ pub struct Supervision<'a> {
     pub started: Instant,
     /// When a timed run ends (`rins up --duration`); none runs until stopped.
     pub end: Option<Instant>,
+    /// The status lines go to stderr: stdout carries one JSON document (`rins up --json`).
+    pub status_on_stderr: bool,
 }
 
 /// What the supervision loop drives.
@@ -62,7 +64,7 @@ pub fn supervise(run: &Supervision<'_>, watch: Watch<'_>) -> Result<()> {
     let cfg = run.config;
     let mut deadline = (cfg.output_deadline_s > 0.0)
         .then(|| OutputDeadline::new(Duration::from_secs_f64(cfg.output_deadline_s)));
-    let mut status = StatusLines::new(cfg.status_period_s, monitor);
+    let mut status = StatusLines::new(cfg.status_period_s, monitor, run.status_on_stderr);
     let mut events = Vec::new();
     while !run.shutdown.requested() && run.end.is_none_or(|e| Instant::now() < e) {
         monitor.drain()?;
@@ -151,16 +153,18 @@ struct StatusLines {
     next: Option<Instant>,
     last_totals: [u64; COUNTED.len()],
     last_at: Instant,
+    on_stderr: bool,
 }
 
 impl StatusLines {
-    fn new(period_s: f64, monitor: &Monitor) -> Self {
+    fn new(period_s: f64, monitor: &Monitor, on_stderr: bool) -> Self {
         let period = (period_s > 0.0).then(|| Duration::from_secs_f64(period_s));
         Self {
             period,
             next: period.map(|p| Instant::now() + p),
             last_totals: monitor.totals,
             last_at: Instant::now(),
+            on_stderr,
         }
     }
 
@@ -190,7 +194,11 @@ impl StatusLines {
         if let Some(note) = monitor.link.status_note() {
             line.push_str(&format!(" | {note}"));
         }
-        println!("{line}");
+        if self.on_stderr {
+            eprintln!("{line}");
+        } else {
+            println!("{line}");
+        }
         self.next = Some(due + period);
     }
 }

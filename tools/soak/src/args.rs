@@ -18,6 +18,8 @@ pub struct SoakArgs {
     pub max_interval_s: f64,
     /// Kinds of fault, comma-separated: kill, hang, sensor, disconnect.
     pub faults: String,
+    /// Print the summary as one JSON object (stdout holds nothing else) instead of text.
+    pub json: bool,
 }
 
 /// Checks the arguments (each error names the option and its value); returns the fault kinds asked for.

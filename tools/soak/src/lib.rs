@@ -236,7 +236,8 @@ fn recovery_allowance(kind: FaultKind) -> Duration {
 
 /// Runs a soak: starts `rins up` (the `uav` scenario), waits for navigation output, injects faults
 /// for `args.minutes` (or until the process is asked to stop), stops the pipeline and prints a
-/// [`SoakSummary`] as one JSON line on stdout (progress goes to stderr). Fails on invalid
+/// [`SoakSummary`]: as one JSON line on stdout with `args.json`, else as text (progress goes to
+/// stderr). Fails on invalid
 /// arguments, when `rins up` cannot be started, prints nothing or produces no navigation output
 /// within 120 s, or ends without its JSON summary.
 pub fn run(args: &SoakArgs) -> Result<()> {
@@ -254,23 +255,23 @@ pub fn run(args: &SoakArgs) -> Result<()> {
             "--json",
         ])
         .stdout(Stdio::piped())
-        .stderr(Stdio::null())
+        .stderr(Stdio::piped())
         .spawn()
         .context("cannot start rins up")?;
-    // The watchdog's stdout: a status line per second, the JSON summary last. Read on a thread so
-    // the pipe never fills.
+    // With --json the watchdog's stdout is its JSON summary alone; its stderr has a status line
+    // per second (and the children's logs). Both read on threads so that no pipe fills.
     let (lines_tx, lines) = std::sync::mpsc::channel::<String>();
     let stdout = up.stdout.take().context("rins up has no stdout")?;
-    let reader = std::thread::spawn(move || {
-        for line in std::io::BufRead::lines(std::io::BufReader::new(stdout)).map_while(Result::ok) {
-            if lines_tx.send(line).is_err() {
-                break;
-            }
-        }
+    let reader = std::thread::spawn(move || forward_lines(stdout, &lines_tx, |_| true));
+    let (status_tx, status_lines) = std::sync::mpsc::channel::<String>();
+    let stderr = up.stderr.take().context("rins up has no stderr")?;
+    let status_reader = std::thread::spawn(move || {
+        forward_lines(stderr, &status_tx, |l| l.starts_with("t="));
     });
-    // Join the deployment only once the watchdog runs: it refuses to start while another process
-    // holds a node on the prefix, and this one would be such a process.
-    if lines.recv_timeout(Duration::from_secs(120)).is_err() {
+    // Join the deployment only once the watchdog runs (its first status line): it refuses to
+    // start while another process holds a node on the prefix, and this one would be such a
+    // process.
+    if status_lines.recv_timeout(Duration::from_secs(120)).is_err() {
         // SAFETY: SIGTERM to our own child, not reaped yet.
         unsafe { libc::kill(up.id() as libc::pid_t, libc::SIGTERM) };
         let status = up.wait()?;
@@ -418,6 +419,8 @@ pub fn run(args: &SoakArgs) -> Result<()> {
     unsafe { libc::kill(up.id() as libc::pid_t, libc::SIGTERM) };
     let status = up.wait()?;
     let _ = reader.join();
+    drop(status_lines);
+    let _ = status_reader.join();
     let up_summary: serde_json::Value = lines
         .try_iter()
         .last()
@@ -438,6 +441,24 @@ pub fn run(args: &SoakArgs) -> Result<()> {
         faults: ledger.figures().clone(),
         shm_leaked: number("shm_leaked"),
     };
-    println!("{}", serde_json::to_string(&summary)?);
+    if args.json {
+        println!("{}", serde_json::to_string(&summary)?);
+    } else {
+        print!("{}", summary.to_text());
+    }
     Ok(())
+}
+
+/// Sends the lines of `from` that `keep` accepts on `to`, reading on to the end even after the
+/// receiver is gone, so that the writer never blocks on a full pipe.
+fn forward_lines(
+    from: impl std::io::Read,
+    to: &std::sync::mpsc::Sender<String>,
+    keep: impl Fn(&str) -> bool,
+) {
+    for line in std::io::BufRead::lines(std::io::BufReader::new(from)).map_while(Result::ok) {
+        if keep(&line) {
+            let _ = to.send(line);
+        }
+    }
 }

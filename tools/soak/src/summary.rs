@@ -35,3 +35,71 @@ pub struct SoakSummary {
     /// Shared-memory entries left after the pipeline stopped (from the watchdog's summary).
     pub shm_leaked: u64,
 }
+
+impl SoakSummary {
+    /// The summary as text for a person: the run, the navigation output, then one line per fault
+    /// kind.
+    pub fn to_text(&self) -> String {
+        let mut out = format!(
+            "soak: {:.1} min, {} kills, {} restarts, {} faults deferred, {} shared-memory entries left\n",
+            self.minutes, self.kills, self.restarts, self.faults_deferred, self.shm_leaked
+        );
+        out.push_str(&format!(
+            "navigation: {} samples, {} lost, longest gap {:.1} ms, {} not navigating, {} lane switches, {} filled from the other lane\n",
+            self.nav_samples,
+            self.lost_nav_samples,
+            self.max_gap_ms,
+            self.not_navigating_samples,
+            self.lane_switches,
+            self.lane_filled
+        ));
+        for (kind, f) in &self.faults {
+            let targets: Vec<String> = f.targets.iter().map(|(t, n)| format!("{t} ×{n}")).collect();
+            out.push_str(&format!(
+                "  {kind}: {} faults ({}), {} samples lost, longest gap {:.1} ms, {} failed, {} unrecovered\n",
+                f.count,
+                if targets.is_empty() { "none".to_string() } else { targets.join(", ") },
+                f.lost_nav_samples,
+                f.max_gap_ms,
+                f.failed,
+                f.unrecovered
+            ));
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn text_names_every_figure_and_each_kind() {
+        let mut summary = SoakSummary {
+            minutes: 2.0,
+            kills: 3,
+            restarts: 3,
+            nav_samples: 120_000,
+            lost_nav_samples: 7,
+            ..SoakSummary::default()
+        };
+        let mut kill = KindFigures {
+            count: 3,
+            lost_nav_samples: 7,
+            ..KindFigures::default()
+        };
+        kill.targets.insert("fusion".into(), 2);
+        kill.targets.insert("altimeter".into(), 1);
+        summary.faults.insert("kill", kill);
+        let text = summary.to_text();
+        assert!(
+            text.starts_with("soak: 2.0 min, 3 kills, 3 restarts"),
+            "{text}"
+        );
+        assert!(text.contains("120000 samples, 7 lost"), "{text}");
+        assert!(
+            text.contains("  kill: 3 faults (altimeter ×1, fusion ×2), 7 samples lost"),
+            "{text}"
+        );
+    }
+}

@@ -5,6 +5,7 @@
 mod env;
 mod error;
 mod node;
+pub mod own_ports;
 mod settings;
 mod topic;
 mod wait_set;

@@ -139,6 +139,7 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
                 topic: name,
                 source,
             })?;
+        super::own_ports::record_receiver(subscriber.id().value());
         let listener = open_event(node, name)?
             .listener_builder()
             .create()

@@ -1,0 +1,106 @@
+//! The node of a tool that joins a deployment for a moment (`rins echo`, `status`, `latency`,
+//! `inject`, `readmit`): when it is dropped it leaves nothing behind, whether a pipeline runs or
+//! not.
+//!
+//! Dropping an iceoryx2 node removes its own records, but the first node of a domain also creates
+//! the domain's management segment in /dev/shm and the record directories under the root, and the
+//! tool may have created the root itself: made by the tool when no pipeline runs, they would stay
+//! until the next `rins up` cleans them. So once the node is gone and no live node is left on the
+//! deployment, what is left on its prefix is a tool's and is removed, and the root too when this
+//! tool created it and it is empty. While a pipeline runs, its files are left alone but for the
+//! connection segments to the tool's own subscribers, which the pipeline's publishers may keep for
+//! a long time.
+
+use std::path::Path;
+
+use anyhow::Result;
+
+use crate::ipc::{IpcNode, IpcSettings, create_node, for_each_live_node, own_ports};
+use crate::{join_check, private_dir, shm_cleanup, user};
+
+/// A tool's node on the deployment of the environment's prefix and root (see
+/// [`join_check::settings_to_join`]); cleans up after itself when dropped. Create every port from
+/// [`ToolNode::node`] after the `ToolNode`, so that the ports are dropped before it.
+pub struct ToolNode {
+    // Fields drop in declaration order: the node first, then the clean-up that needs it gone.
+    node: IpcNode,
+    cleanup: Cleanup,
+}
+
+impl ToolNode {
+    /// Joins the deployment as the node `TOOL-PID` (e.g. `echo-1234`) once it is found to be the
+    /// expected user's.
+    pub fn join(tool: &str) -> Result<Self> {
+        let settings = join_check::settings_to_join()?;
+        let root = private_dir::without_trailing_slash(Path::new(&settings.root)).to_path_buf();
+        let root_existed = std::fs::symlink_metadata(&root).is_ok();
+        let node = create_node(&format!("{tool}-{}", std::process::id()), &settings);
+        // Made before the error is returned: a failed creation may have left the root and the
+        // domain's segment, and dropping the clean-up removes them.
+        let cleanup = Cleanup {
+            root_created: !root_existed && root.exists(),
+            settings,
+        };
+        Ok(Self {
+            node: node?,
+            cleanup,
+        })
+    }
+
+    /// The node to create the tool's ports from.
+    pub fn node(&self) -> &IpcNode {
+        &self.node
+    }
+
+    /// The deployment joined.
+    pub fn settings(&self) -> &IpcSettings {
+        &self.cleanup.settings
+    }
+}
+
+/// With a pipeline running: removes the connection segments from its publishers to this process's
+/// subscribers, which are gone (see [`own_ports`]); everything else there is the pipeline's.
+fn remove_connections_to_own_receivers(settings: &IpcSettings) {
+    let ours = own_ports::receivers();
+    let uid = user::effective_uid();
+    for entry in shm_cleanup::inspect(Path::new(shm_cleanup::SHM_DIR), &settings.prefix) {
+        if entry.belongs_to(uid)
+            && ours
+                .iter()
+                .any(|&id| own_ports::is_connection_to(&entry.name, id))
+        {
+            let _ = std::fs::remove_file(Path::new(shm_cleanup::SHM_DIR).join(&entry.name));
+        }
+    }
+}
+
+/// What a [`ToolNode`] removes once its node is gone.
+struct Cleanup {
+    settings: IpcSettings,
+    /// The root did not exist before the tool joined.
+    root_created: bool,
+}
+
+impl Drop for Cleanup {
+    fn drop(&mut self) {
+        // Only the owner's deployment is ever cleaned: a tool that joined another user's (with
+        // RINS_IPC_OWNER) removes nothing of it.
+        if self.settings.owner != user::effective_uid() {
+            return;
+        }
+        let mut alive = 0usize;
+        if for_each_live_node(&self.settings, |_| alive += 1).is_err() {
+            return;
+        }
+        if alive > 0 {
+            remove_connections_to_own_receivers(&self.settings);
+            return;
+        }
+        let removed = shm_cleanup::remove_all(&self.settings, self.root_created);
+        tracing::debug!(
+            removed,
+            prefix = self.settings.prefix,
+            "no pipeline on the deployment: removed what this tool left"
+        );
+    }
+}

@@ -1,0 +1,126 @@
+//! The run's summary as text, what `rins up --duration S` prints at the end without `--json`.
+
+use crate::summary::Summary;
+
+/// A few lines for a person: the run and its losses, then, in simulator mode, the navigation
+/// error against truth (attitude, altitude, and the horizontal end-point error as a share of the
+/// distance travelled), then the faults.
+pub fn summary_text(s: &Summary) -> String {
+    let mut out = format!(
+        "summary: {:.1} s, {} IMU frames, {} dropped, {} lost on the line, {} CRC errors, {} restarts, {} shared-memory entries left\n",
+        s.duration_s, s.frames, s.dropped, s.lost_frames, s.crc_errors, s.restarts, s.shm_leaked
+    );
+    if let (Some(rms), Some(max)) = (s.att_err_deg_rms, s.att_err_deg_max) {
+        out.push_str(&format!(
+            "  attitude error after alignment: RMS {rms:.2}°, max {max:.2}°\n"
+        ));
+    }
+    if let (Some(rms), Some(max)) = (s.alt_err_m_rms, s.alt_err_m_max) {
+        out.push_str(&format!(
+            "  altitude error after alignment: RMS {rms:.2} m, max {max:.2} m\n"
+        ));
+    }
+    if let (Some(err), Some(distance)) = (s.horiz_end_err_m, s.distance_m) {
+        let share = s
+            .horiz_end_err_pct
+            .map_or_else(String::new, |pct| format!(" ({pct:.2} % of"));
+        let of = if share.is_empty() {
+            format!(", {distance:.1} m travelled")
+        } else {
+            format!("{share} {distance:.1} m travelled)")
+        };
+        out.push_str(&format!("  horizontal end-point error: {err:.2} m{of}\n"));
+    }
+    if !s.faults.is_empty() || s.false_alarms > 0 {
+        let isolated = s
+            .faults
+            .iter()
+            .filter(|f| f.isolated_at_s.is_some())
+            .count();
+        out.push_str(&format!(
+            "  faults: {} injected, {isolated} isolated, {} false alarms\n",
+            s.faults.len(),
+            s.false_alarms
+        ));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn summary() -> Summary {
+        Summary {
+            duration_s: 112.0,
+            frames: 112_000,
+            baro_frames: 0,
+            mag_frames: 0,
+            dropped: 0,
+            crc_errors: 0,
+            malformed_frames: 0,
+            lost_frames: 0,
+            duplicate_frames: 0,
+            late_frames: 0,
+            seq_jumps: 0,
+            time_rebases: 0,
+            bytes_received: 0,
+            valid_frames: 0,
+            discarded_bytes: 0,
+            last_decode_error: "none".into(),
+            nav_samples: 0,
+            restarts: 0,
+            restart_to_publish_ms_max: 0.0,
+            restart_measurements: 0,
+            restart_to_publish_ms_by_service: Vec::new(),
+            nav_lane_samples: [0, 0],
+            nav_lane_switches: 0,
+            nav_lane_filled: 0,
+            nav_integrity_samples: Default::default(),
+            att_err_deg_rms: Some(1.5),
+            att_err_deg_max: Some(2.38),
+            alt_err_m_rms: None,
+            alt_err_m_max: None,
+            distance_m: Some(125.8),
+            horiz_end_err_m: Some(1.11),
+            horiz_end_err_pct: Some(0.882),
+            shm_leaked: 0,
+            faults: Vec::new(),
+            false_alarms: 0,
+        }
+    }
+
+    #[test]
+    fn a_walk_reads_its_end_point_error_and_distance() {
+        let text = summary_text(&summary());
+        assert!(
+            text.starts_with("summary: 112.0 s, 112000 IMU frames"),
+            "{text}"
+        );
+        assert!(
+            text.contains("attitude error after alignment: RMS 1.50°, max 2.38°"),
+            "{text}"
+        );
+        assert!(!text.contains("altitude"), "{text}");
+        assert!(
+            text.contains("horizontal end-point error: 1.11 m (0.88 % of 125.8 m travelled)"),
+            "{text}"
+        );
+        assert!(!text.contains("faults"), "{text}");
+    }
+
+    #[test]
+    fn standing_still_gives_the_error_without_a_share() {
+        let s = Summary {
+            distance_m: Some(0.0),
+            horiz_end_err_m: Some(0.2),
+            horiz_end_err_pct: None,
+            ..summary()
+        };
+        let text = summary_text(&s);
+        assert!(
+            text.contains("horizontal end-point error: 0.20 m, 0.0 m travelled"),
+            "{text}"
+        );
+    }
+}

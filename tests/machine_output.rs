@@ -1,0 +1,32 @@
+//! Output meant for programs: with `--json`, stdout is exactly one JSON document and everything
+//! for a person (status lines, progress, logs) goes to stderr.
+
+mod common;
+
+use common::{Isolated, stderr};
+
+#[test]
+fn up_json_prints_one_json_document_and_the_status_lines_on_stderr() {
+    let ipc = Isolated::new("upjson");
+    let out = ipc.run(&["up", "--scenario", "static", "--duration", "3", "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    // The whole of stdout, not its last line: one document and nothing else.
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!(
+            "stdout is not one JSON document ({e}):\n{}",
+            String::from_utf8_lossy(&out.stdout)
+        )
+    });
+    assert!(
+        summary["frames"].as_u64().is_some_and(|n| n > 0),
+        "{summary}"
+    );
+    // The once-a-second status lines are still there, on stderr.
+    let err = stderr(&out);
+    assert!(
+        err.lines()
+            .any(|l| l.starts_with("t=") && l.contains(" imu ")),
+        "no status line on stderr:\n{err}"
+    );
+    assert_eq!(ipc.shm_entries(), Vec::<String>::new());
+}
