@@ -60,13 +60,15 @@ fn a_killed_gyro_is_seen_excluded_and_readmit_reports_its_outcome() {
         }
     });
 
-    // Every channel in use, the solution navigating on the primary lane.
+    // Every channel in use, the solution navigating.
     let healthy = ipc.status_until(Duration::from_secs(120), |r| {
         r["navigation"]["mode"] == "navigating" && r["redundancy"]["gyro"]["in_use"] == 4
     });
     assert_eq!(healthy["redundancy"]["accel"]["in_use"], 4, "{healthy}");
     assert_eq!(healthy["redundancy"]["summary"], "gyro 4/4 accel 4/4");
-    assert_eq!(healthy["navigation"]["lane"], 0, "{healthy}");
+    // Either lane may be the one in use: both run the same filter, the first to align serves.
+    let lane = healthy["navigation"]["lane"].as_u64().expect("a lane");
+    assert!(lane <= 1, "{healthy}");
     assert_eq!(channel(&healthy, "gyro2")["state"], "ok");
     wait_for_line(
         &lines,
