@@ -1,0 +1,32 @@
+//! MAVLink 2 messages from the navigation solution: what an on-board INS streams to an autopilot or a
+//! ground station (attitude, global and local position, odometry with its covariance), built by pure
+//! functions from the rins payloads, so that a sender around them stays thin.
+//!
+//! - [`local_frame`]: the local NED frame the local position and odometry are expressed in.
+//! - [`attitude`]: the ATTITUDE_QUATERNION message.
+//! - [`position`]: the GLOBAL_POSITION_INT and LOCAL_POSITION_NED messages.
+//! - [`odometry`]: the ODOMETRY message with the covariance diagonal, the reset counter and the quality.
+//! - [`heartbeat`]: the HEARTBEAT message of the on-board profile and of the bench display profile.
+//!
+//! Every message carries the measurement's time, not the send time: the receive time of the serial
+//! frame the solution comes from, on the avionics computer's CLOCK_MONOTONIC (time since boot).
+
+pub mod attitude;
+pub mod heartbeat;
+pub mod local_frame;
+pub mod odometry;
+pub mod position;
+
+pub use mavlink::dialects::common as dialect;
+
+use ipc_types::NavState;
+
+/// Time of the measurement behind `nav`, µs since boot (CLOCK_MONOTONIC).
+pub fn time_usec(nav: &NavState) -> u64 {
+    nav.header.origin_rx_ns / 1_000
+}
+
+/// [`time_usec`] in ms, wrapped as MAVLink's 32-bit `time_boot_ms` wraps (every 49.7 days).
+pub fn time_boot_ms(nav: &NavState) -> u32 {
+    (nav.header.origin_rx_ns / 1_000_000) as u32
+}
