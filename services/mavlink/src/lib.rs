@@ -7,6 +7,9 @@
 //! - [`position`]: the GLOBAL_POSITION_INT and LOCAL_POSITION_NED messages.
 //! - [`odometry`]: the ODOMETRY message with the covariance diagonal, the reset counter and the quality.
 //! - [`heartbeat`]: the HEARTBEAT message of the on-board profile and of the bench display profile.
+//! - [`sys_status`]: the SYS_STATUS message with the gyro, accelerometer and AHRS health bits.
+//! - [`status_text`]: the STATUSTEXT messages of channel exclusions, returns, lane switches and
+//!   restarts.
 //!
 //! Every message carries the measurement's time, not the send time: the receive time of the serial
 //! frame the solution comes from, on the avionics computer's CLOCK_MONOTONIC (time since boot).
@@ -16,6 +19,8 @@ pub mod heartbeat;
 pub mod local_frame;
 pub mod odometry;
 pub mod position;
+pub mod status_text;
+pub mod sys_status;
 
 pub use mavlink::dialects::common as dialect;
 

@@ -9,7 +9,7 @@ use rins_mavlink::dialect::{MavMessage, MavType};
 use rins_mavlink::heartbeat::{Profile, heartbeat};
 use rins_mavlink::local_frame::LocalOrigin;
 use rins_mavlink::odometry::{ResetCounter, odometry};
-use rins_mavlink::{attitude, position};
+use rins_mavlink::{attitude, position, status_text, sys_status};
 
 fn flying() -> NavState {
     let mut nav = NavState {
@@ -70,6 +70,17 @@ fn every_message_reads_back_as_written() {
             [0.1, 0.2, -0.3],
             [1e-6; 3],
             reset_counter,
+        )),
+        MavMessage::SYS_STATUS(sys_status::sys_status(
+            Some(&ipc_types::FusedImu::default()),
+            Some(&nav),
+            87,
+        )),
+        MavMessage::STATUSTEXT(status_text::channel_event(
+            ipc_types::SensorType::Gyro,
+            1,
+            ipc_types::ChannelState::Excluded,
+            ipc_types::FaultReason::Parity,
         )),
     ];
     for msg in messages {
