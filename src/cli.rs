@@ -32,6 +32,9 @@ pub enum Command {
         /// Serial device for acquisition (overrides acquisition.port).
         #[arg(long)]
         port: Option<String>,
+        /// MAVLink endpoint for the mavlink service (overrides mavlink.endpoints).
+        #[arg(long, value_name = "ENDPOINT")]
+        mavlink: Option<String>,
     },
     /// Run the device simulator on a pseudo-terminal.
     Sim(SimArgs),
@@ -272,6 +275,8 @@ pub enum ServiceName {
     Navigator,
     /// The hot-standby navigator lane.
     NavigatorStandby,
+    /// The MAVLink 2 output over UDP (`[mavlink]`).
+    Mavlink,
 }
 
 impl ServiceName {
@@ -283,6 +288,7 @@ impl ServiceName {
             ServiceName::Altimeter => ipc_types::ServiceKind::Altimeter,
             ServiceName::Navigator => ipc_types::ServiceKind::Navigator,
             ServiceName::NavigatorStandby => ipc_types::ServiceKind::NavigatorStandby,
+            ServiceName::Mavlink => ipc_types::ServiceKind::Mavlink,
         }
     }
 }
@@ -324,6 +330,10 @@ pub struct UpArgs {
     /// Simulator random seed (overrides sim.seed).
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Stream MAVLink 2 to this endpoint (`udpout:HOST:PORT` or `udpin:ADDR:PORT`), enabling the
+    /// MAVLink output whatever the configuration says.
+    #[arg(long, value_name = "ENDPOINT")]
+    pub mavlink: Option<String>,
     /// Faults for the simulator to apply.
     #[command(flatten)]
     pub faults: FaultArgs,

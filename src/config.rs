@@ -7,6 +7,7 @@ use anyhow::{Result, anyhow};
 use rins_acquisition::config::AcquisitionConfig;
 use rins_altimeter::AltimeterConfig;
 use rins_fusion::FusionConfig;
+use rins_mavlink::config::MavlinkConfig;
 use rins_navigator::config::NavigatorConfig;
 use rins_runtime::bounded_file;
 use rins_sim::SimConfig;
@@ -127,6 +128,8 @@ pub struct RinsConfig {
     pub watchdog: WatchdogConfig,
     /// `[deployment]`: which processes `rins up` runs.
     pub deployment: DeploymentConfig,
+    /// `[mavlink]`: the MAVLink 2 output over UDP.
+    pub mavlink: MavlinkConfig,
 }
 
 impl RinsConfig {
@@ -156,6 +159,7 @@ impl RinsConfig {
         self.navigator.validate().map_err(|e| e.to_string())?;
         self.watchdog.validate()?;
         self.deployment.validate()?;
+        self.mavlink.validate()?;
         Ok(())
     }
 

@@ -39,6 +39,14 @@ fn unit_is_hardened_and_keeps_shared_memory_with_the_watchdog() {
     // A private /dev would hide the service's /dev/shm segments from operators' tools.
     assert_eq!(directive("PrivateDevices"), None);
     assert_eq!(directive("DevicePolicy"), Some("closed"));
+    // The network is the MAVLink output's UDP socket and nothing else.
+    assert_eq!(
+        directive("RestrictAddressFamilies"),
+        Some("AF_UNIX AF_INET AF_INET6")
+    );
+    assert_eq!(directive("SocketBindAllow"), Some("udp"));
+    assert_eq!(directive("SocketBindDeny"), Some("any"));
+    assert_eq!(directive("IPAddressDeny"), Some("any"));
 }
 
 /// The value the unit gives the environment variable `key`.

@@ -23,6 +23,8 @@ wire_enum! {
         Watchdog = 5 => "watchdog",
         /// The hot-standby navigator lane (lane 1).
         NavigatorStandby = 6 => "navigator-standby",
+        /// The MAVLink output, when enabled.
+        Mavlink = 7 => "mavlink",
     }
 }
 

@@ -148,6 +148,7 @@ fn service_kind() {
             (Navigator, 4, "navigator"),
             (Watchdog, 5, "watchdog"),
             (NavigatorStandby, 6, "navigator-standby"),
+            (Mavlink, 7, "mavlink"),
         ]
     );
     assert_eq!(

@@ -31,9 +31,12 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             rins_runtime::logging::init("watchdog");
             up::run(&args)
         }
-        Command::Service { name, config, port } => {
-            service::run(name, config.as_deref(), port).map(|()| ExitCode::SUCCESS)
-        }
+        Command::Service {
+            name,
+            config,
+            port,
+            mavlink,
+        } => service::run(name, config.as_deref(), port, mavlink).map(|()| ExitCode::SUCCESS),
         Command::Sim(args) => {
             rins_runtime::logging::init("sim");
             sim::run(&args).map(|()| ExitCode::SUCCESS)

@@ -11,13 +11,23 @@ use crate::cli::ServiceName;
 use crate::config;
 
 /// Runs service `name` with the configuration at `config_path` (the built-in one when none) and,
-/// for acquisition, the serial device `port`.
-pub fn run(name: ServiceName, config_path: Option<&Path>, port: Option<String>) -> Result<()> {
+/// for acquisition, the serial device `port`; for the MAVLink output, the endpoint `mavlink`.
+pub fn run(
+    name: ServiceName,
+    config_path: Option<&Path>,
+    port: Option<String>,
+    mavlink: Option<String>,
+) -> Result<()> {
     let process = name.kind().name();
     rins_runtime::logging::init(process);
     let mut cfg = config::load(config_path)?;
     if let Some(port) = port {
         cfg.acquisition.port = Some(port);
+    }
+    if let Some(endpoint) = mavlink {
+        cfg.mavlink.endpoints = vec![endpoint];
+        cfg.validate()
+            .map_err(|e| anyhow::anyhow!("--mavlink: {e}"))?;
     }
     let built = cfg.build_services()?;
     let shutdown = Shutdown::install()?;
@@ -47,6 +57,10 @@ pub fn run(name: ServiceName, config_path: Option<&Path>, port: Option<String>) 
             }
             .run(ctx)
         }
+        ServiceName::Mavlink => rins_mavlink::service::MavlinkService {
+            config: cfg.mavlink,
+        }
+        .run(ctx),
     };
     tracing::info!(service = %process, ok = result.is_ok(), "stopped");
     result

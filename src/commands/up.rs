@@ -49,6 +49,12 @@ fn apply_overrides(cfg: &mut RinsConfig, args: &UpArgs) -> Result<()> {
         }
         cfg.acquisition.port = Some(port.to_string_lossy().into_owned());
     }
+    if let Some(endpoint) = &args.mavlink {
+        rins_mavlink::endpoint::Endpoint::parse(endpoint)
+            .map_err(|why| anyhow::anyhow!("--mavlink {endpoint:?}: {why}"))?;
+        cfg.mavlink.enabled = true;
+        cfg.mavlink.endpoints = vec![endpoint.clone()];
+    }
     if !args.faults.is_empty() {
         if args.port.is_some() {
             bail!("--inject and --faults need the simulator: they cannot be used with --port");
@@ -112,7 +118,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     let mut health = HealthPublisher::new(&node, started, silent_after)?;
     let mut timing = RestartTiming::default();
     let outcome = (|| -> Result<()> {
-        for kind in pipeline_services(cfg.deployment.navigator_lanes) {
+        for kind in pipeline_services(cfg.deployment.navigator_lanes, cfg.mavlink.enabled) {
             if shutdown.requested() {
                 return Ok(());
             }
@@ -121,6 +127,11 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
             child_args.extend(config_args.iter().cloned());
             if kind == ServiceKind::Acquisition {
                 child_args.extend(["--port".to_string(), port.clone()]);
+            }
+            if kind == ServiceKind::Mavlink
+                && let Some(endpoint) = &args.mavlink
+            {
+                child_args.extend(["--mavlink".to_string(), endpoint.clone()]);
             }
             supervisor.start(ChildSpec {
                 name: name.to_string(),

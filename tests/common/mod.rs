@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 pub mod device;
+pub mod python;
 pub mod topic_stream;
 
 use rins_test_support::signal::{Signal, send_signal};

@@ -9,18 +9,34 @@
 //! - [`heartbeat`]: the HEARTBEAT message of the on-board profile and of the bench display profile.
 //! - [`sys_status`]: the SYS_STATUS message with the gyro, accelerometer and AHRS health bits.
 //! - [`status_text`]: the STATUSTEXT messages of channel exclusions, returns, lane switches and
-//!   restarts.
+//!   restarts; [`events`] finds them in the inputs.
+//! - [`highres_imu`], [`vibration`]: the fused IMU and how much it shakes.
+//! - [`timesync`], [`command`]: what rins answers on the link (TIMESYNC, a channel re-admission).
+//! - [`stream`]: all of it as one state machine paced by [`rate_gate`]; [`link`] moves the messages
+//!   to the network on its own threads; [`service`] is the process around them, [`config`] its
+//!   `[mavlink]` table and [`endpoint`] its addresses.
 //!
 //! Every message carries the measurement's time, not the send time: the receive time of the serial
 //! frame the solution comes from, on the avionics computer's CLOCK_MONOTONIC (time since boot).
 
 pub mod attitude;
+pub mod command;
+pub mod config;
+pub mod endpoint;
+pub mod events;
 pub mod heartbeat;
+pub mod highres_imu;
+pub mod link;
 pub mod local_frame;
 pub mod odometry;
 pub mod position;
+pub mod rate_gate;
+pub mod service;
 pub mod status_text;
+pub mod stream;
 pub mod sys_status;
+pub mod timesync;
+pub mod vibration;
 
 pub use mavlink::dialects::common as dialect;
 

@@ -200,7 +200,7 @@ impl Monitor {
             ServiceKind::Altimeter => topic("alt"),
             ServiceKind::Navigator => Some(self.nav.lane_totals()[0]),
             ServiceKind::NavigatorStandby => Some(self.nav.lane_totals()[1]),
-            ServiceKind::Simulator | ServiceKind::Watchdog => None,
+            ServiceKind::Simulator | ServiceKind::Watchdog | ServiceKind::Mavlink => None,
         }
     }
 
@@ -212,7 +212,10 @@ impl Monitor {
             ServiceKind::Fusion => topic("imu"),
             ServiceKind::Altimeter => topic("baro"),
             ServiceKind::Navigator | ServiceKind::NavigatorStandby => topic("fused"),
-            ServiceKind::Acquisition | ServiceKind::Simulator | ServiceKind::Watchdog => None,
+            ServiceKind::Acquisition
+            | ServiceKind::Simulator
+            | ServiceKind::Watchdog
+            | ServiceKind::Mavlink => None,
         }
     }
 

@@ -4,10 +4,14 @@ use ipc_types::ServiceKind;
 
 /// The pipeline's services in start order: consumers first, so that no sample is published before
 /// its subscriber exists. The hot-standby navigator lane runs when the deployment asks for two
-/// navigator lanes. The simulator is not here: it replaces the serial device, and starts last,
-/// once acquisition waits for its terminal.
-pub fn pipeline_services(navigator_lanes: u8) -> Vec<ServiceKind> {
-    let mut kinds = vec![ServiceKind::Navigator];
+/// navigator lanes, the MAVLink output when it is enabled. The simulator is not here: it replaces
+/// the serial device, and starts last, once acquisition waits for its terminal.
+pub fn pipeline_services(navigator_lanes: u8, mavlink: bool) -> Vec<ServiceKind> {
+    let mut kinds = Vec::new();
+    if mavlink {
+        kinds.push(ServiceKind::Mavlink);
+    }
+    kinds.push(ServiceKind::Navigator);
     if navigator_lanes == 2 {
         kinds.push(ServiceKind::NavigatorStandby);
     }
@@ -26,7 +30,7 @@ mod tests {
     #[test]
     fn consumers_start_before_their_producers() {
         let names = |lanes| -> Vec<&str> {
-            pipeline_services(lanes)
+            pipeline_services(lanes, false)
                 .into_iter()
                 .map(ServiceKind::name)
                 .collect()
@@ -44,6 +48,13 @@ mod tests {
                 "fusion",
                 "acquisition"
             ]
+        );
+        assert_eq!(
+            pipeline_services(1, true)
+                .into_iter()
+                .map(ServiceKind::name)
+                .collect::<Vec<_>>(),
+            ["mavlink", "navigator", "altimeter", "fusion", "acquisition"]
         );
     }
 }

@@ -1,0 +1,205 @@
+"""End-to-end check of rins's MAVLink 2 output, as a ground station or companion computer sees it.
+
+Starts `rins up --mavlink udpout:127.0.0.1:PORT` (the simulator's uav flight), listens with
+pymavlink and checks: the message set and each stream's rate (±10 %), the attitude against
+`rins echo nav` for the same samples, the odometry covariance against the solution's, TIMESYNC
+answers, a STATUSTEXT after `rins inject gyro1 dead`, the reset counter and a lane-switch text after
+the primary navigator lane is killed, and a COMMAND_LONG refused while commands are off.
+
+Usage: python mavlink_stream.py RINS_BINARY PORT   (RINS_IPC_PREFIX / RINS_IPC_ROOT isolate the run)
+Prints one JSON line of what it measured; exits non-zero on the first failed check.
+"""
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+
+os.environ["MAVLINK20"] = "1"  # MAVLink 2 framing and the extension fields (ODOMETRY quality)
+from pymavlink import mavutil  # noqa: E402
+
+RATES = {  # the configuration's defaults
+    "HEARTBEAT": 1.0,
+    "ATTITUDE_QUATERNION": 50.0,
+    "GLOBAL_POSITION_INT": 25.0,
+    "LOCAL_POSITION_NED": 30.0,
+    "ODOMETRY": 30.0,
+    "HIGHRES_IMU": 50.0,
+    "SYS_STATUS": 2.0,
+    "VIBRATION": 0.5,
+}
+COVARIANCE_DIAGONAL = [0, 6, 11, 15, 18, 20]
+
+
+def fail(why, measured):
+    measured["failed"] = why
+    print(json.dumps(measured))
+    sys.exit(1)
+
+
+def msg_time_s(m):
+    """The measurement time a message carries, s; None for those without one."""
+    if hasattr(m, "time_usec"):
+        return m.time_usec / 1e6
+    if hasattr(m, "time_boot_ms"):
+        return m.time_boot_ms / 1e3
+    return None
+
+
+class Listener:
+    def __init__(self, port):
+        self.conn = mavutil.mavlink_connection(f"udpin:127.0.0.1:{port}", source_system=255)
+
+    def recv(self, timeout):
+        return self.conn.recv_match(blocking=True, timeout=timeout)
+
+    def collect(self, seconds, keep=None):
+        """Every message for `seconds` of wall time."""
+        out = []
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            m = self.recv(0.2)
+            if m is None or m.get_type() == "BAD_DATA":
+                continue
+            out.append((time.monotonic(), m))
+            if keep is not None and keep(m):
+                break
+        return out
+
+    def wait_for(self, seconds, pred):
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            m = self.recv(0.2)
+            if m is not None and m.get_type() != "BAD_DATA" and pred(m):
+                return m
+        return None
+
+
+def run(rins, *args, timeout=30):
+    return subprocess.run([rins, *args], capture_output=True, text=True, timeout=timeout)
+
+
+def main():
+    rins, port = sys.argv[1], int(sys.argv[2])
+    measured = {}
+    listener = Listener(port)
+    up = subprocess.Popen(
+        [rins, "up", "--scenario", "uav", "--duration", "120", "--json",
+         "--mavlink", f"udpout:127.0.0.1:{port}"],
+        stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
+    )
+    try:
+        check(rins, listener, measured)
+    finally:
+        if up.poll() is None:
+            up.send_signal(signal.SIGINT)
+        try:
+            up.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            up.kill()
+    print(json.dumps(measured))
+
+
+def check(rins, listener, measured):
+    # 1. A heartbeat of an onboard controller, then a solution of full quality.
+    hb = listener.wait_for(30, lambda m: m.get_type() == "HEARTBEAT")
+    if hb is None:
+        fail("no HEARTBEAT within 30 s", measured)
+    if hb.type != mavutil.mavlink.MAV_TYPE_ONBOARD_CONTROLLER or \
+            hb.autopilot != mavutil.mavlink.MAV_AUTOPILOT_INVALID or hb.get_srcComponent() != 197:
+        fail(f"heartbeat type {hb.type} autopilot {hb.autopilot} comp {hb.get_srcComponent()}", measured)
+    nav = listener.wait_for(90, lambda m: m.get_type() == "ODOMETRY" and m.quality == 100)
+    if nav is None:
+        fail("no ODOMETRY of quality 100 within 90 s", measured)
+
+    # 2. The message set and the rates, over 12 s, from the measurement times.
+    window = listener.collect(12.0)
+    by_type = {}
+    for t, m in window:
+        by_type.setdefault(m.get_type(), []).append((t, m))
+    rates = {}
+    for name, hz in RATES.items():
+        got = by_type.get(name, [])
+        if len(got) < 3:
+            fail(f"{name}: {len(got)} messages in 12 s", measured)
+        times = [msg_time_s(m) for _, m in got]
+        if times[0] is None:  # no timestamp: the receive times
+            times = [t for t, _ in got]
+        rate = (len(times) - 1) / (times[-1] - times[0])
+        rates[name] = round(rate, 3)
+        if abs(rate - hz) > 0.1 * hz:
+            fail(f"{name}: {rate:.3f} Hz, configured {hz}", measured)
+    measured["rates_hz"] = rates
+
+    # 3. The attitude and covariance of ODOMETRY against `rins echo nav` for the same samples.
+    echo = subprocess.Popen([rins, "echo", "nav", "--raw", "--count", "1000"],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    odo = [m for _, m in listener.collect(1.5) if m.get_type() == "ODOMETRY"]
+    out, _ = echo.communicate(timeout=30)
+    samples = {}
+    for line in out.splitlines():
+        s = json.loads(line)
+        samples[s["header"]["origin_rx_ns"] // 1000] = s
+    matched = 0
+    for m in odo:
+        s = samples.get(m.time_usec)
+        if s is None:
+            continue
+        matched += 1
+        for a, b in zip(m.q, s["quaternion"]):
+            if abs(a - b) > 1e-6:
+                fail(f"ODOMETRY q {list(m.q)} differs from nav {s['quaternion']}", measured)
+        p = s["covariance_diag"]
+        expected = [p[6], p[7], p[8], p[0], p[1], p[2]]
+        for i, e in zip(COVARIANCE_DIAGONAL, expected):
+            if not math.isclose(m.pose_covariance[i], e, rel_tol=1e-6, abs_tol=1e-30):
+                fail(f"pose covariance [{i}] {m.pose_covariance[i]} != {e}", measured)
+    if matched < 10:
+        fail(f"only {matched} ODOMETRY samples matched `rins echo nav`", measured)
+    measured["odometry_matched_echo"] = matched
+
+    # 4. TIMESYNC is answered with our ts1 and rins's clock.
+    listener.conn.mav.timesync_send(0, 123456789)
+    ts = listener.wait_for(5, lambda m: m.get_type() == "TIMESYNC" and m.ts1 == 123456789)
+    if ts is None or ts.tc1 <= 0:
+        fail("TIMESYNC not answered", measured)
+    measured["timesync_tc1_ns"] = ts.tc1
+
+    # 5. Commands are refused while the configuration does not accept them.
+    listener.conn.mav.command_long_send(1, 197, mavutil.mavlink.MAV_CMD_USER_1, 0, 0, 1, 0, 0, 0, 0, 0)
+    ack = listener.wait_for(5, lambda m: m.get_type() == "COMMAND_ACK")
+    if ack is None or ack.result != mavutil.mavlink.MAV_RESULT_DENIED:
+        fail(f"COMMAND_LONG: expected DENIED, got {ack}", measured)
+
+    # 6. A dead gyro is announced.
+    r = run(rins, "inject", "gyro1", "dead")
+    if r.returncode != 0:
+        fail(f"rins inject: {r.stderr}", measured)
+    text = listener.wait_for(10, lambda m: m.get_type() == "STATUSTEXT" and "gyro1 excluded" in m.text)
+    if text is None:
+        fail("no STATUSTEXT 'gyro1 excluded' within 10 s of the injection", measured)
+    measured["statustext_fault"] = text.text
+
+    # 7. The primary lane killed: the consumers switch, the reset counter moves, the covariance stays.
+    before = listener.wait_for(5, lambda m: m.get_type() == "ODOMETRY")
+    status = json.loads(run(rins, "status", "--json").stdout.strip().splitlines()[-1])
+    pid = next(s["pid"] for s in status["services"] if s["service"] == "navigator")
+    os.kill(pid, signal.SIGKILL)
+    switch = listener.wait_for(10, lambda m: m.get_type() == "STATUSTEXT" and "switched to lane" in m.text)
+    if switch is None:
+        fail("no lane-switch STATUSTEXT within 10 s of killing the navigator", measured)
+    after = listener.wait_for(5, lambda m: m.get_type() == "ODOMETRY")
+    if after is None or after.reset_counter == before.reset_counter:
+        fail(f"reset counter {before.reset_counter} unchanged after the lane switch", measured)
+    diag = [after.pose_covariance[i] for i in COVARIANCE_DIAGONAL]
+    if not all(math.isfinite(v) and v > 0 for v in diag) or after.quality < 0:
+        fail(f"after the switch: covariance {diag}, quality {after.quality}", measured)
+    measured["reset_counter"] = [before.reset_counter, after.reset_counter]
+    measured["statustext_switch"] = switch.text
+
+
+if __name__ == "__main__":
+    main()

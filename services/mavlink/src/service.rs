@@ -1,0 +1,210 @@
+//! The MAVLink process: the merged navigation stream, the fused IMU and the watchdog's report in;
+//! MAVLink 2 over UDP out through the [`Link`]'s network thread; re-admission commands from the
+//! link carried to fusion and acknowledged with fusion's answer.
+
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use ipc_types::{FusedImu, FusionControl, FusionReply, HealthReport, ServiceKind, names};
+use rins_runtime::clock::monotonic_ns;
+use rins_runtime::ipc::{TopicPublisher, TopicSubscriber};
+use rins_runtime::nav_subscriber::NavSubscriber;
+use rins_runtime::service::{Service, ServiceContext};
+use rins_runtime::service_loop::ServiceLoop;
+
+use crate::command::{Decision, ack, decide, result_of};
+use crate::config::MavlinkConfig;
+use crate::dialect::{MavCmd, MavMessage, MavResult};
+use crate::endpoint::Endpoint;
+use crate::link::{InboundCommand, Link, LinkCounters};
+use crate::stream::MavlinkStream;
+
+/// The longest sleep waiting for a solution: how often the heartbeat, the commands and the stop
+/// flag are served when none comes.
+const WAIT: Duration = Duration::from_millis(20);
+/// How long a re-admission may take before it is acknowledged as failed: the probation (about a
+/// second at the block's rate) and the way there, with a wide margin.
+const COMMAND_TIMEOUT: Duration = Duration::from_secs(10);
+/// Re-admissions waiting for fusion's answer at once; more are answered "temporarily rejected".
+const MAX_PENDING: usize = 8;
+/// Request ids of this service have the top bit set: `rins readmit` uses its process id.
+const REQUEST_ID_BASE: u32 = 1 << 31;
+
+/// The MAVLink process, built from `[mavlink]`.
+pub struct MavlinkService {
+    /// The validated configuration.
+    pub config: MavlinkConfig,
+}
+
+/// A re-admission sent to fusion, waiting for its answer.
+#[derive(Debug, Clone, Copy)]
+struct Pending {
+    request: FusionControl,
+    peer: (u8, u8),
+    command: MavCmd,
+    deadline: Instant,
+}
+
+/// The commands from the link and the re-admissions they started.
+struct Commands {
+    control: TopicPublisher<FusionControl>,
+    replies: TopicSubscriber<FusionReply>,
+    pending: Vec<Pending>,
+    next_id: u32,
+    own: (u8, u8),
+    accept: bool,
+}
+
+impl Commands {
+    /// Takes one command from the link: answered at once, or sent to fusion.
+    fn on_command(&mut self, c: &InboundCommand, link: &Link) -> Result<()> {
+        let id = REQUEST_ID_BASE | (self.next_id & !REQUEST_ID_BASE);
+        self.next_id = self.next_id.wrapping_add(1);
+        let answer = |result| {
+            link.queue(MavMessage::COMMAND_ACK(ack(
+                c.command.command,
+                result,
+                c.from,
+            )));
+        };
+        match decide(&c.command, self.own, self.accept, id) {
+            Decision::Ignore => {}
+            Decision::Answer(result) => answer(result),
+            Decision::Readmit(_) if self.pending.len() >= MAX_PENDING => {
+                answer(MavResult::MAV_RESULT_TEMPORARILY_REJECTED);
+            }
+            Decision::Readmit(request) => {
+                self.control.publish(request)?;
+                tracing::info!(
+                    sensor = request.sensor,
+                    channel = request.channel,
+                    from_system = c.from.0,
+                    "re-admission requested over MAVLink"
+                );
+                self.pending.push(Pending {
+                    request,
+                    peer: c.from,
+                    command: c.command.command,
+                    deadline: Instant::now() + COMMAND_TIMEOUT,
+                });
+                answer(MavResult::MAV_RESULT_IN_PROGRESS);
+            }
+        }
+        Ok(())
+    }
+
+    /// Acknowledges the re-admissions fusion answered, and those it left unanswered too long.
+    fn on_replies(&mut self, link: &Link) -> Result<()> {
+        while let Some(reply) = self.replies.receive()? {
+            let Some(i) = self.pending.iter().position(|p| {
+                p.request.request_id == reply.request_id
+                    && p.request.sensor == reply.sensor
+                    && p.request.channel == reply.channel
+            }) else {
+                continue;
+            };
+            let p = self.pending.swap_remove(i);
+            link.queue(MavMessage::COMMAND_ACK(ack(
+                p.command,
+                result_of(&reply),
+                p.peer,
+            )));
+        }
+        let now = Instant::now();
+        self.pending.retain(|p| {
+            let waiting = now < p.deadline;
+            if !waiting {
+                link.queue(MavMessage::COMMAND_ACK(ack(
+                    p.command,
+                    MavResult::MAV_RESULT_FAILED,
+                    p.peer,
+                )));
+            }
+            waiting
+        });
+        Ok(())
+    }
+}
+
+/// The link's counters into the heartbeat's: messages queued are published, messages the queue
+/// could not take are lost, undecodable datagrams are malformed.
+fn copy_counters(link: &LinkCounters, counters: &mut ipc_types::Health) {
+    use std::sync::atomic::Ordering::Relaxed;
+    counters.published = link.queued.load(Relaxed);
+    counters.lost = link.dropped.load(Relaxed);
+    counters.malformed = link.undecodable.load(Relaxed);
+    counters.rejected = link.commands_dropped.load(Relaxed);
+}
+
+impl Service for MavlinkService {
+    fn run(self, ctx: ServiceContext) -> Result<()> {
+        let config = self.config;
+        let endpoints = config
+            .endpoints
+            .iter()
+            .map(|e| {
+                Endpoint::parse(e).map_err(|why| anyhow::anyhow!("mavlink endpoint {e:?}: {why}"))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let node = ctx.create_node(ServiceKind::Mavlink)?;
+        let mut lp = ServiceLoop::new(&node, ServiceKind::Mavlink, &ctx.shutdown)?;
+        let mut nav = NavSubscriber::new(&node)?;
+        let fused = TopicSubscriber::<FusedImu>::new(&node, names::FUSED_IMU)?;
+        let health = TopicSubscriber::<HealthReport>::new(&node, names::HEALTH)?;
+        let own = (config.system_id, config.speaking_component());
+        let mut commands = Commands {
+            control: TopicPublisher::new(&node, names::FUSION_CONTROL)?,
+            replies: TopicSubscriber::new(&node, names::FUSION_REPLY)?,
+            pending: Vec::with_capacity(MAX_PENDING),
+            next_id: 0,
+            own,
+            accept: config.accept_commands,
+        };
+        let link = Link::start(&endpoints, own, config.queue_capacity)
+            .context("cannot open the MAVLink endpoints")?;
+        tracing::info!(
+            endpoints = %config.endpoints.join(","),
+            system = own.0,
+            component = own.1,
+            profile = %config.profile,
+            accept_commands = config.accept_commands,
+            "streaming MAVLink 2"
+        );
+        let mut stream = MavlinkStream::new(&config);
+        while lp.running() {
+            nav.wait(WAIT)?;
+            let mut emit = |m: MavMessage| link.queue(m);
+            while let Some(f) = fused.receive()? {
+                lp.counters.received += 1;
+                stream.on_fused(&f, &mut emit);
+            }
+            while let Some(n) = nav.receive()? {
+                lp.counters.received += 1;
+                stream.on_nav(&n, nav.switches().0, &mut emit);
+            }
+            while let Some(h) = health.receive()? {
+                stream.on_health(&h, &mut emit);
+            }
+            stream.on_clock(monotonic_ns(), &mut emit);
+            while let Ok(c) = link.commands.try_recv() {
+                commands.on_command(&c, &link)?;
+            }
+            commands.on_replies(&link)?;
+            copy_counters(&link.counters, &mut lp.counters);
+            lp.beat()?;
+        }
+        copy_counters(&link.counters, &mut lp.counters);
+        let c = &link.counters;
+        use std::sync::atomic::Ordering::Relaxed;
+        tracing::info!(
+            queued = c.queued.load(Relaxed),
+            dropped = c.dropped.load(Relaxed),
+            sent = c.sent.load(Relaxed),
+            send_errors = c.send_errors.load(Relaxed),
+            undecodable = c.undecodable.load(Relaxed),
+            timesync_answered = c.timesync_answered.load(Relaxed),
+            "MAVLink output stopped"
+        );
+        Ok(())
+    }
+}

@@ -1,0 +1,183 @@
+//! The MAVLink stream as a pure state machine: the latest fused sample, solution and health report
+//! go in, the messages due go out, each paced by its own rate. The service around it only moves
+//! samples in and messages out.
+
+use ipc_types::{FusedImu, HealthReport, Integrity, NavMode, NavState};
+
+use crate::attitude::attitude_quaternion;
+use crate::config::MavlinkConfig;
+use crate::dialect::MavMessage;
+use crate::events::EventWatch;
+use crate::heartbeat::{Profile, heartbeat};
+use crate::highres_imu::highres_imu;
+use crate::local_frame::LocalOrigin;
+use crate::odometry::{ResetCounter, odometry};
+use crate::position::{global_position_int, local_position_ned};
+use crate::rate_gate::RateGate;
+use crate::sys_status::sys_status;
+use crate::vibration::VibrationMeter;
+
+/// Each stream's pacing.
+#[derive(Debug, Clone)]
+struct Gates {
+    heartbeat: RateGate,
+    attitude: RateGate,
+    global_position: RateGate,
+    local_position: RateGate,
+    odometry: RateGate,
+    highres_imu: RateGate,
+    sys_status: RateGate,
+    vibration: RateGate,
+}
+
+/// The stream's state between samples.
+#[derive(Debug, Clone)]
+pub struct MavlinkStream {
+    profile: Profile,
+    gates: Gates,
+    /// The local frame's origin: the first usable solution's position.
+    origin: Option<LocalOrigin>,
+    resets: ResetCounter,
+    vibration: VibrationMeter,
+    events: EventWatch,
+    fused: Option<FusedImu>,
+    nav: Option<NavState>,
+}
+
+/// Whether `nav` may be shown as a solution: usable, integrity not invalid.
+fn trustworthy(nav: &NavState) -> bool {
+    NavMode::from_u8(nav.mode).is_some_and(NavMode::is_usable)
+        && Integrity::from_u8(nav.integrity).is_some_and(|i| i != Integrity::Invalid)
+}
+
+impl MavlinkStream {
+    /// The stream of `config` (its profile and rates; the caller has validated it).
+    pub fn new(config: &MavlinkConfig) -> Self {
+        let r = &config.rates;
+        Self {
+            profile: config.profile().unwrap_or(Profile::Onboard),
+            gates: Gates {
+                heartbeat: RateGate::new(r.heartbeat_hz),
+                attitude: RateGate::new(r.attitude_quaternion_hz),
+                global_position: RateGate::new(r.global_position_int_hz),
+                local_position: RateGate::new(r.local_position_ned_hz),
+                odometry: RateGate::new(r.odometry_hz),
+                highres_imu: RateGate::new(r.highres_imu_hz),
+                sys_status: RateGate::new(r.sys_status_hz),
+                vibration: RateGate::new(r.vibration_hz),
+            },
+            origin: None,
+            resets: ResetCounter::default(),
+            vibration: VibrationMeter::default(),
+            events: EventWatch::default(),
+            fused: None,
+            nav: None,
+        }
+    }
+
+    /// The local frame's origin, once a usable solution set it.
+    pub fn origin(&self) -> Option<&LocalOrigin> {
+        self.origin.as_ref()
+    }
+
+    /// A fused IMU sample: HIGHRES_IMU and VIBRATION when due, channel events.
+    pub fn on_fused(&mut self, f: &FusedImu, emit: &mut impl FnMut(MavMessage)) {
+        let t_ns = f.header.origin_rx_ns;
+        self.vibration.add(f);
+        self.events.on_fused(f, |m| emit(MavMessage::STATUSTEXT(m)));
+        if self.gates.highres_imu.due(t_ns) {
+            emit(MavMessage::HIGHRES_IMU(highres_imu(f)));
+        }
+        if self.gates.vibration.due(t_ns) {
+            emit(MavMessage::VIBRATION(self.vibration.take(t_ns / 1_000)));
+        }
+        self.fused = Some(*f);
+    }
+
+    /// A solution of the merged stream; `switches` is the lane selector's count of lane changes.
+    pub fn on_nav(&mut self, nav: &NavState, switches: u64, emit: &mut impl FnMut(MavMessage)) {
+        let t_ns = nav.header.origin_rx_ns;
+        self.events
+            .on_switches(switches, nav.lane, |m| emit(MavMessage::STATUSTEXT(m)));
+        let shown = trustworthy(nav);
+        if shown && self.origin.is_none() {
+            self.origin = Some(LocalOrigin::new(
+                nav.latitude_rad,
+                nav.longitude_rad,
+                nav.altitude_m,
+            ));
+        }
+        let reset_counter = self.resets.observe(nav);
+        // The body rate: the fused rate less the filter's bias estimate.
+        let (rate, rate_var) = match &self.fused {
+            Some(f) => (
+                [0, 1, 2].map(|i| f.rate_rps[i] - nav.gyro_bias_rps[i]),
+                f.rate_var,
+            ),
+            None => ([f64::NAN; 3], [f64::NAN; 3]),
+        };
+        if shown && self.gates.attitude.due(t_ns) {
+            emit(MavMessage::ATTITUDE_QUATERNION(attitude_quaternion(
+                nav, rate,
+            )));
+        }
+        if let (true, Some(origin)) = (shown, &self.origin) {
+            if self.gates.global_position.due(t_ns) {
+                emit(MavMessage::GLOBAL_POSITION_INT(global_position_int(
+                    nav, origin,
+                )));
+            }
+            if self.gates.local_position.due(t_ns) {
+                emit(MavMessage::LOCAL_POSITION_NED(local_position_ned(
+                    nav, origin,
+                )));
+            }
+        }
+        // Odometry goes out whatever the solution's state: its quality (−1) is how a receiver
+        // learns it must not use it.
+        if self.gates.odometry.due(t_ns) {
+            let mut m = match &self.origin {
+                Some(origin) => odometry(nav, origin, rate, rate_var, reset_counter),
+                None => odometry(
+                    nav,
+                    &LocalOrigin::new(0.0, 0.0, 0.0),
+                    rate,
+                    rate_var,
+                    reset_counter,
+                ),
+            };
+            if !shown {
+                // Nothing to show: unknown position and attitude, as the message defines them.
+                (m.x, m.y, m.z) = (f32::NAN, f32::NAN, f32::NAN);
+                m.q = [f32::NAN; 4];
+            }
+            emit(MavMessage::ODOMETRY(m));
+        }
+        self.nav = Some(*nav);
+    }
+
+    /// The watchdog's report: restarts become events.
+    pub fn on_health(&mut self, report: &HealthReport, emit: &mut impl FnMut(MavMessage)) {
+        self.events
+            .on_health(report, |m| emit(MavMessage::STATUSTEXT(m)));
+    }
+
+    /// HEARTBEAT and SYS_STATUS when due at `now_ns` (CLOCK_MONOTONIC): they say the stream is
+    /// alive, so they go on when no sample arrives.
+    pub fn on_clock(&mut self, now_ns: u64, emit: &mut impl FnMut(MavMessage)) {
+        if self.gates.heartbeat.due(now_ns) {
+            emit(MavMessage::HEARTBEAT(heartbeat(
+                self.profile,
+                self.nav.as_ref(),
+            )));
+        }
+        if self.gates.sys_status.due(now_ns) {
+            emit(MavMessage::SYS_STATUS(sys_status(
+                self.fused.as_ref(),
+                self.nav.as_ref(),
+                // rins has no single main loop whose load the field could mean: 0.
+                0,
+            )));
+        }
+    }
+}
