@@ -57,7 +57,7 @@ pub unsafe trait Recordable: Copy + 'static {
     }
 
     /// The payload whose bytes are `bytes`; `None` when the length is not `size_of::<Self>()`.
-    /// The version field is not checked here (a reader does, see [`crate::reader`]).
+    /// The version field is not checked here (a reader does, see [`crate::Messages`]).
     fn from_bytes(bytes: &[u8]) -> Option<Self> {
         if bytes.len() != size_of::<Self>() {
             return None;

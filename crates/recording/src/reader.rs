@@ -13,6 +13,7 @@
 //! of the file, which a killed recorder never wrote.
 
 use std::collections::HashMap;
+use std::collections::hash_map::Entry;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -263,19 +264,15 @@ impl Iterator for Messages<'_> {
                 Some(Ok(message)) => message,
             };
             let channel_id = message.channel.id;
-            if !self.channels.contains_key(&channel_id) {
-                match check_channel(&message.channel) {
-                    Ok(info) => {
-                        self.channels.insert(channel_id, info);
-                    }
+            let info = match self.channels.entry(channel_id) {
+                Entry::Occupied(entry) => entry.into_mut(),
+                Entry::Vacant(entry) => match check_channel(&message.channel) {
+                    Ok(info) => entry.insert(info),
                     Err(e) => {
                         self.done = true;
                         return Some(Err(e));
                     }
-                }
-            }
-            let Some(info) = self.channels.get(&channel_id) else {
-                continue;
+                },
             };
             let (topic, layout) = (Arc::clone(&info.topic), info.layout);
             let data = message.data;

@@ -465,11 +465,11 @@ fn write_fields(layout: &StructLayout, text: &mut String) {
 /// Nested types in first-use order, depth first, each once.
 fn collect_nested(layout: &StructLayout, out: &mut Vec<&'static StructLayout>) {
     for field in layout.fields {
-        if let FieldKind::Nested(inner) = field.kind {
-            if !out.iter().any(|l| core::ptr::eq(*l, inner)) {
-                out.push(inner);
-                collect_nested(inner, out);
-            }
+        if let FieldKind::Nested(inner) = field.kind
+            && !out.iter().any(|l| core::ptr::eq(*l, inner))
+        {
+            out.push(inner);
+            collect_nested(inner, out);
         }
     }
 }
@@ -578,7 +578,11 @@ mod tests {
         for payload in PAYLOADS {
             let mut end = 0;
             for prim in flatten(payload) {
-                assert_eq!(prim.offset, end, "{}: gap before {}", payload.ros_name, prim.path);
+                assert_eq!(
+                    prim.offset, end,
+                    "{}: gap before {}",
+                    payload.ros_name, prim.path
+                );
                 assert_eq!(
                     prim.offset % prim.prim.size(),
                     0,
@@ -628,7 +632,10 @@ mod tests {
         let ours: Vec<&str> = PAYLOADS.iter().map(|l| l.type_name).collect();
         assert_eq!(ours, expected);
         for layout in PAYLOADS {
-            assert_eq!(payload_by_type_name(layout.type_name).map(|l| l.size), Some(layout.size));
+            assert_eq!(
+                payload_by_type_name(layout.type_name).map(|l| l.size),
+                Some(layout.size)
+            );
         }
     }
 
@@ -684,8 +691,17 @@ uint64[4] stage_pub_ns
     fn nested_definitions_are_appended_once_each() {
         let text = ros2msg(&HEALTH_REPORT);
         assert!(text.contains("rins/ServiceHealth[8] services\n"));
-        for name in ["ServiceHealth", "LinkReport", "RedundancyReport", "NavReport"] {
-            assert_eq!(text.matches(&format!("MSG: rins/{name}\n")).count(), 1, "{name}");
+        for name in [
+            "ServiceHealth",
+            "LinkReport",
+            "RedundancyReport",
+            "NavReport",
+        ] {
+            assert_eq!(
+                text.matches(&format!("MSG: rins/{name}\n")).count(),
+                1,
+                "{name}"
+            );
         }
         let nav = ros2msg(&NAV_STATE);
         assert_eq!(nav.matches("MSG: rins/Header\n").count(), 1);

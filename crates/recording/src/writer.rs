@@ -255,15 +255,15 @@ impl Recorder {
         publish_time_ns: u64,
         payload: &T,
     ) -> Result<(), RecordError> {
-        if let Some((topic, layout)) = self.channel_info(channel) {
-            if !core::ptr::eq(layout, T::layout()) {
-                return Err(RecordError::WrongType {
-                    path: self.path.clone(),
-                    topic: topic.to_string(),
-                    expected: layout.type_name,
-                    found: T::layout().type_name,
-                });
-            }
+        if let Some((topic, layout)) = self.channel_info(channel)
+            && !core::ptr::eq(layout, T::layout())
+        {
+            return Err(RecordError::WrongType {
+                path: self.path.clone(),
+                topic: topic.to_string(),
+                expected: layout.type_name,
+                found: T::layout().type_name,
+            });
         }
         self.write(channel, log_time_ns, publish_time_ns, payload.as_bytes())
     }
@@ -275,12 +275,10 @@ impl Recorder {
 
     /// Writes the last chunk, the summary and the footer, and flushes the file to disk.
     pub fn finish(mut self) -> Result<RecordSummary, RecordError> {
-        self.writer
-            .finish()
-            .map_err(|source| RecordError::Mcap {
-                path: self.path.clone(),
-                source,
-            })?;
+        self.writer.finish().map_err(|source| RecordError::Mcap {
+            path: self.path.clone(),
+            source,
+        })?;
         let path = self.path;
         let io = |source: std::io::Error| RecordError::Io {
             path: path.clone(),

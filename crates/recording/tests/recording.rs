@@ -135,13 +135,15 @@ fn altitude(seq: u64) -> Altitude {
 /// what it wrote per topic, in order.
 fn write_sample_file(path: &Path) -> Vec<(String, u64, Vec<u8>)> {
     let mut recorder = Recorder::create(path, &RecordOptions::default()).unwrap();
-    let nav0 = recorder.channel_for::<NavState>(names::NAV_LANES[0]).unwrap();
-    let nav1 = recorder.channel_for::<NavState>(names::NAV_LANES[1]).unwrap();
+    let nav0 = recorder
+        .channel_for::<NavState>(names::NAV_LANES[0])
+        .unwrap();
+    let nav1 = recorder
+        .channel_for::<NavState>(names::NAV_LANES[1])
+        .unwrap();
     let fused_ch = recorder.channel_for::<FusedImu>(names::FUSED_IMU).unwrap();
     let raw_ch = recorder.channel_for::<RawImu>(names::RAW_IMU).unwrap();
-    let health_ch = recorder
-        .channel_for::<HealthReport>(names::HEALTH)
-        .unwrap();
+    let health_ch = recorder.channel_for::<HealthReport>(names::HEALTH).unwrap();
     let mut written = Vec::new();
     let mut put = |recorder: &mut Recorder, ch: ChannelId, topic: &str, t: u64, bytes: &[u8]| {
         recorder.write(ch, t, t - 100, bytes).unwrap();
@@ -149,12 +151,42 @@ fn write_sample_file(path: &Path) -> Vec<(String, u64, Vec<u8>)> {
     };
     for seq in 0..3u64 {
         let t = 1_000_000 * (seq + 1);
-        put(&mut recorder, raw_ch, names::RAW_IMU, t, raw_imu(seq).as_bytes());
-        put(&mut recorder, fused_ch, names::FUSED_IMU, t + 1, fused(seq).as_bytes());
-        put(&mut recorder, nav0, names::NAV_LANES[0], t + 2, nav(seq, 0).as_bytes());
-        put(&mut recorder, nav1, names::NAV_LANES[1], t + 3, nav(seq, 1).as_bytes());
+        put(
+            &mut recorder,
+            raw_ch,
+            names::RAW_IMU,
+            t,
+            raw_imu(seq).as_bytes(),
+        );
+        put(
+            &mut recorder,
+            fused_ch,
+            names::FUSED_IMU,
+            t + 1,
+            fused(seq).as_bytes(),
+        );
+        put(
+            &mut recorder,
+            nav0,
+            names::NAV_LANES[0],
+            t + 2,
+            nav(seq, 0).as_bytes(),
+        );
+        put(
+            &mut recorder,
+            nav1,
+            names::NAV_LANES[1],
+            t + 3,
+            nav(seq, 1).as_bytes(),
+        );
     }
-    put(&mut recorder, health_ch, names::HEALTH, 9_000_000, health_report().as_bytes());
+    put(
+        &mut recorder,
+        health_ch,
+        names::HEALTH,
+        9_000_000,
+        health_report().as_bytes(),
+    );
     let summary = recorder.finish().unwrap();
     assert_eq!(summary.samples_written, 13);
     assert_eq!(summary.samples_dropped, 0);
@@ -235,10 +267,16 @@ fn the_writer_thread_writes_ten_thousand_samples_compressed() {
     let file_bytes = std::fs::metadata(&path).unwrap().len();
     assert_eq!(summary.file_bytes, file_bytes);
     assert!(file_bytes > 0);
-    assert!(file_bytes < 10_000 * size_of::<Altitude>() as u64, "{file_bytes} bytes");
+    assert!(
+        file_bytes < 10_000 * size_of::<Altitude>() as u64,
+        "{file_bytes} bytes"
+    );
     let recording = read_file(&path).unwrap();
     assert_eq!(recording.messages.len(), 10_000);
-    assert_eq!(recording.messages[9_999].decode::<Altitude>(), Ok(altitude(9_999)));
+    assert_eq!(
+        recording.messages[9_999].decode::<Altitude>(),
+        Ok(altitude(9_999))
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -254,17 +292,32 @@ fn a_full_queue_drops_and_counts_without_blocking() {
     let (sender, receiver) = record_channel(recorder, 1);
     assert_eq!(sender.try_send_payload(alt, 1, 1, &altitude(1)), Ok(()));
     for seq in 0..5 {
-        assert_eq!(sender.try_send_payload(alt, 2, 2, &altitude(seq)), Err(Dropped::Full));
+        assert_eq!(
+            sender.try_send_payload(alt, 2, 2, &altitude(seq)),
+            Err(Dropped::Full)
+        );
     }
-    assert_eq!(sender.try_send_payload(nav_ch, 3, 3, &nav(0, 0)), Err(Dropped::Full));
-    assert_eq!(sender.try_send(ChannelId(7), 3, 3, &[0; 8]), Err(Dropped::UnknownChannel));
+    assert_eq!(
+        sender.try_send_payload(nav_ch, 3, 3, &nav(0, 0)),
+        Err(Dropped::Full)
+    );
+    assert_eq!(
+        sender.try_send(ChannelId(7), 3, 3, &[0; 8]),
+        Err(Dropped::UnknownChannel)
+    );
     assert_eq!(sender.dropped_total(), 6);
     drop(sender);
     let summary = receiver.run().unwrap();
     assert_eq!(summary.samples_written, 1);
     assert_eq!(summary.samples_dropped, 6);
-    assert_eq!((summary.topics[0].written, summary.topics[0].dropped), (1, 5));
-    assert_eq!((summary.topics[1].written, summary.topics[1].dropped), (0, 1));
+    assert_eq!(
+        (summary.topics[0].written, summary.topics[0].dropped),
+        (1, 5)
+    );
+    assert_eq!(
+        (summary.topics[1].written, summary.topics[1].dropped),
+        (0, 1)
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -279,7 +332,10 @@ fn a_slow_writer_loses_samples_only_as_counted_drops() {
     let (sender, handle) = spawn_writer(recorder, 1).unwrap();
     let mut refused = 0;
     for seq in 0..5_000 {
-        if sender.try_send_payload(alt, seq, seq, &altitude(seq)).is_err() {
+        if sender
+            .try_send_payload(alt, seq, seq, &altitude(seq))
+            .is_err()
+        {
             refused += 1;
         }
     }
@@ -287,7 +343,10 @@ fn a_slow_writer_loses_samples_only_as_counted_drops() {
     let summary = join_writer(handle).unwrap();
     assert_eq!(summary.samples_written + summary.samples_dropped, 5_000);
     assert_eq!(summary.samples_dropped, refused);
-    assert_eq!(read_file(&path).unwrap().messages.len() as u64, summary.samples_written);
+    assert_eq!(
+        read_file(&path).unwrap().messages.len() as u64,
+        summary.samples_written
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -314,7 +373,12 @@ fn an_existing_file_or_link_is_not_overwritten_unless_asked() {
     };
     Recorder::create(&link, &options).unwrap().finish().unwrap();
     assert_eq!(std::fs::read(&target).unwrap(), b"someone else's");
-    assert!(!std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    assert!(
+        !std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
 
     // Overwriting a file when asked.
     Recorder::create(&path, &options).unwrap().finish().unwrap();
@@ -414,12 +478,20 @@ fn a_channel_of_another_payload_version_is_refused_naming_the_topic() {
         other => panic!("unexpected {other}"),
     }
     let text = err.to_string();
-    assert!(text.contains(names::NAV_STATE) && text.contains('5'), "{text}");
+    assert!(
+        text.contains(names::NAV_STATE) && text.contains('5'),
+        "{text}"
+    );
 
     let meta = [("type_name", "rins::Nope"), ("payload_version", "6")];
     write_raw_channel(&dir.join("unknown.mcap"), &meta, &[]);
     // No message: the channel is never used, so nothing is refused.
-    assert!(read_file(dir.join("unknown.mcap")).unwrap().messages.is_empty());
+    assert!(
+        read_file(dir.join("unknown.mcap"))
+            .unwrap()
+            .messages
+            .is_empty()
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -434,8 +506,15 @@ fn damaged_messages_are_skipped_and_counted() {
     let mut old = nav(2, 0);
     old.version = PAYLOAD_VERSION - 1;
     let version = PAYLOAD_VERSION.to_string();
-    let meta = [("type_name", "rins::NavState"), ("payload_version", version.as_str())];
-    write_raw_channel(&path, &meta, &[short, good.clone(), not_cdr, cdr(old.as_bytes())]);
+    let meta = [
+        ("type_name", "rins::NavState"),
+        ("payload_version", version.as_str()),
+    ];
+    write_raw_channel(
+        &path,
+        &meta,
+        &[short, good.clone(), not_cdr, cdr(old.as_bytes())],
+    );
     let recording = read_file(&path).unwrap();
     assert_eq!(recording.messages.len(), 1);
     assert_eq!(recording.messages[0].decode::<NavState>(), Ok(nav(1, 0)));
@@ -499,12 +578,18 @@ fn python_reads_the_file() {
         let first = &topics[names::NAV_LANES[usize::from(lane)]]["first"];
         let expected = nav(0, lane);
         assert_eq!(first["quaternion"], serde_json::json!(expected.quaternion));
-        assert_eq!(first["velocity_ned_mps"], serde_json::json!(expected.velocity_ned_mps));
+        assert_eq!(
+            first["velocity_ned_mps"],
+            serde_json::json!(expected.velocity_ned_mps)
+        );
         assert_eq!(first["header.origin_seq"], expected.header.origin_seq);
         assert_eq!(first["mode"], expected.mode);
         assert_eq!(first["lane"], lane);
         assert_eq!(first["integrity_reasons"], expected.integrity_reasons);
-        assert_eq!(first["aiding_rejected"], serde_json::json!(expected.aiding_rejected));
+        assert_eq!(
+            first["aiding_rejected"],
+            serde_json::json!(expected.aiding_rejected)
+        );
     }
     let health = &topics[names::HEALTH]["first"];
     assert_eq!(health["services[0].pid"], 4242);
