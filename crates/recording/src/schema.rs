@@ -197,8 +197,7 @@ impl<T: FieldType, const N: usize> FieldType for [T; N] {
 
 /// Builds the [`Field`] of `S`'s field that `_get` reads; only the types matter, the function is
 /// never called: it lets the compiler infer the field's type from its name.
-#[doc(hidden)]
-pub const fn field_of<S, F: FieldType>(
+const fn field_of<S, F: FieldType>(
     name: &'static str,
     rust_name: &'static str,
     offset: usize,

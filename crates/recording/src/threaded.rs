@@ -38,8 +38,9 @@ pub enum Dropped {
     Full,
     /// The writer thread has ended (it failed; its join handle has the error).
     WriterGone,
-    /// The payload is longer than any payload ([`MAX_PAYLOAD`]).
-    TooLarge,
+    /// The payload's length is not the channel's payload size (a sample of another type), or is
+    /// larger than any payload ([`MAX_PAYLOAD`]).
+    WrongLength,
     /// The channel was not registered with the recorder.
     UnknownChannel,
 }
@@ -49,7 +50,13 @@ pub enum Dropped {
 #[derive(Clone)]
 pub struct RecordSender {
     tx: Sender<Sample>,
-    dropped: Arc<[AtomicU64]>,
+    slots: Arc<[Slot]>,
+}
+
+/// What the senders know of one channel: its payload size, and its drops.
+struct Slot {
+    size: usize,
+    dropped: AtomicU64,
 }
 
 impl std::fmt::Debug for RecordSender {
@@ -70,17 +77,19 @@ impl RecordSender {
         publish_time_ns: u64,
         payload: &[u8],
     ) -> Result<(), Dropped> {
-        let Some(dropped) = self.dropped.get(usize::from(channel.0)) else {
+        let Some(slot) = self.slots.get(usize::from(channel.0)) else {
             return Err(Dropped::UnknownChannel);
         };
-        let result = if payload.len() > MAX_PAYLOAD {
-            Err(Dropped::TooLarge)
+        // Checked here rather than by the writer, which would stop the whole recording on it.
+        // (A layout built outside this crate could be larger than any payload; it does not fit.)
+        let result = if payload.len() != slot.size || payload.len() > MAX_PAYLOAD {
+            Err(Dropped::WrongLength)
         } else {
             let mut sample = Sample {
                 channel,
                 log_time_ns,
                 publish_time_ns,
-                // Fits: at most MAX_PAYLOAD, checked above, which fits a u16 (checked at compile
+                // Fits: a payload size, at most MAX_PAYLOAD, which fits a u16 (checked at compile
                 // time).
                 len: payload.len() as u16,
                 bytes: [0; MAX_PAYLOAD],
@@ -92,7 +101,7 @@ impl RecordSender {
             })
         };
         if result.is_err() {
-            dropped.fetch_add(1, Ordering::Relaxed);
+            slot.dropped.fetch_add(1, Ordering::Relaxed);
         }
         result
     }
@@ -110,7 +119,10 @@ impl RecordSender {
 
     /// Samples dropped so far, all topics.
     pub fn dropped_total(&self) -> u64 {
-        self.dropped.iter().map(|d| d.load(Ordering::Relaxed)).sum()
+        self.slots
+            .iter()
+            .map(|s| s.dropped.load(Ordering::Relaxed))
+            .sum()
     }
 }
 
@@ -118,7 +130,7 @@ impl RecordSender {
 /// every sender is gone.
 pub struct RecordReceiver {
     rx: Receiver<Sample>,
-    dropped: Arc<[AtomicU64]>,
+    slots: Arc<[Slot]>,
     recorder: Recorder,
 }
 
@@ -144,8 +156,8 @@ impl RecordReceiver {
         }
         let mut summary = self.recorder.finish()?;
         // Every sender is gone, so the counts are final.
-        for (topic, dropped) in summary.topics.iter_mut().zip(self.dropped.iter()) {
-            topic.dropped = dropped.load(Ordering::Relaxed);
+        for (topic, slot) in summary.topics.iter_mut().zip(self.slots.iter()) {
+            topic.dropped = slot.dropped.load(Ordering::Relaxed);
         }
         summary.samples_dropped = summary.topics.iter().map(|t| t.dropped).sum();
         Ok(summary)
@@ -156,17 +168,20 @@ impl RecordReceiver {
 /// already. Run the receiver in the thread of your choice; [`spawn_writer`] does it in a new one.
 pub fn record_channel(recorder: Recorder, capacity: usize) -> (RecordSender, RecordReceiver) {
     let (tx, rx) = crossbeam_channel::bounded(capacity);
-    let channels = (0..)
+    let slots: Arc<[Slot]> = (0..=u16::MAX)
         .map_while(|i| recorder.channel_info(ChannelId(i)))
-        .count();
-    let dropped: Arc<[AtomicU64]> = (0..channels).map(|_| AtomicU64::new(0)).collect();
+        .map(|(_, layout)| Slot {
+            size: layout.size,
+            dropped: AtomicU64::new(0),
+        })
+        .collect();
     let sender = RecordSender {
         tx,
-        dropped: Arc::clone(&dropped),
+        slots: Arc::clone(&slots),
     };
     let receiver = RecordReceiver {
         rx,
-        dropped,
+        slots,
         recorder,
     };
     (sender, receiver)

@@ -235,12 +235,16 @@ impl Recorder {
             log_time: log_time_ns,
             publish_time: publish_time_ns,
         };
-        entry.sequence = entry.sequence.wrapping_add(1);
-        entry.written += 1;
         self.buf.clear();
         cdr::encode_into(payload, &mut self.buf);
-        let result = self.writer.write_to_known_channel(&header, &self.buf);
-        result.map_err(|source| self.mcap_error(source))?;
+        if let Err(source) = self.writer.write_to_known_channel(&header, &self.buf) {
+            return Err(RecordError::Mcap {
+                path: self.path.clone(),
+                source,
+            });
+        }
+        entry.sequence = entry.sequence.wrapping_add(1);
+        entry.written += 1;
         self.samples_written += 1;
         self.payload_bytes += payload.len() as u64;
         Ok(())

@@ -306,13 +306,19 @@ fn a_full_queue_drops_and_counts_without_blocking() {
         Err(Dropped::UnknownChannel)
     );
     assert_eq!(sender.dropped_total(), 6);
+    // A sample of another type is dropped at the sender, never stopping the writer.
+    assert_eq!(
+        sender.try_send_payload(alt, 4, 4, &nav(1, 0)),
+        Err(Dropped::WrongLength)
+    );
+    assert_eq!(sender.dropped_total(), 7);
     drop(sender);
     let summary = receiver.run().unwrap();
     assert_eq!(summary.samples_written, 1);
-    assert_eq!(summary.samples_dropped, 6);
+    assert_eq!(summary.samples_dropped, 7);
     assert_eq!(
         (summary.topics[0].written, summary.topics[0].dropped),
-        (1, 5)
+        (1, 6)
     );
     assert_eq!(
         (summary.topics[1].written, summary.topics[1].dropped),
@@ -347,6 +353,32 @@ fn a_slow_writer_loses_samples_only_as_counted_drops() {
         read_file(&path).unwrap().messages.len() as u64,
         summary.samples_written
     );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn a_payload_of_the_wrong_size_or_type_is_refused_naming_the_topic() {
+    let dir = scratch("wrong-payload");
+    let path = dir.join("wrong.mcap");
+    let mut recorder = Recorder::create(&path, &RecordOptions::default()).unwrap();
+    let ch = recorder.channel_for::<Altitude>(names::ALTITUDE).unwrap();
+    let err = recorder.write(ch, 1, 1, &[0; 3]).unwrap_err();
+    assert!(matches!(err, RecordError::WrongLength { .. }), "{err}");
+    assert!(err.to_string().contains(names::ALTITUDE), "{err}");
+    let err = recorder.write_payload(ch, 1, 1, &nav(0, 0)).unwrap_err();
+    assert!(matches!(err, RecordError::WrongType { .. }), "{err}");
+    let err = recorder
+        .channel_for::<NavState>(names::ALTITUDE)
+        .unwrap_err();
+    assert!(matches!(err, RecordError::TopicConflict { .. }), "{err}");
+    assert_eq!(
+        recorder.channel_for::<Altitude>(names::ALTITUDE).unwrap(),
+        ch
+    );
+    recorder.write_payload(ch, 2, 2, &altitude(2)).unwrap();
+    let summary = recorder.finish().unwrap();
+    assert_eq!(summary.samples_written, 1);
+    assert_eq!(read_file(&path).unwrap().messages[0].sequence, 0);
     std::fs::remove_dir_all(dir).unwrap();
 }
 
