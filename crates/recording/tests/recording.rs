@@ -22,7 +22,7 @@ fn scratch(test: &str) -> PathBuf {
 
 fn header(seq: u64) -> Header {
     Header {
-        origin_seq: seq,
+        origin_seq: 0x0123_4567_89ab + seq,
         origin_device_time_us: 1_000_000 + seq * 1000,
         origin_rx_ns: 5_000_000_000 + seq * 1_000_000,
         stage_pub_ns: [11 + seq, 22 + seq, 33 + seq, 44 + seq],
@@ -599,6 +599,8 @@ fn python_reads_the_file() {
         "{}",
         String::from_utf8_lossy(&output.stderr)
     );
+    // Shown on failure: what Python decoded.
+    println!("{}", String::from_utf8_lossy(&output.stdout));
     let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
     let topics = &json["topics"];
     assert_eq!(topics[names::NAV_LANES[0]]["count"], 3);
@@ -623,6 +625,21 @@ fn python_reads_the_file() {
             serde_json::json!(expected.aiding_rejected)
         );
     }
+    let fused_first = &topics[names::FUSED_IMU]["first"];
+    assert_eq!(
+        fused_first["header.stage_pub_ns"],
+        serde_json::json!([11, 22, 33, 44])
+    );
+    assert_eq!(fused_first["gyro_test_statistic"], 3.5);
+    let raw_first = &topics[names::RAW_IMU]["first"];
+    assert_eq!(
+        raw_first["gyro_counts"],
+        serde_json::json!(raw_imu(0).gyro_counts)
+    );
+    assert_eq!(
+        raw_first["temperature_c"],
+        serde_json::json!(raw_imu(0).temperature_c)
+    );
     let health = &topics[names::HEALTH]["first"];
     assert_eq!(health["services[0].pid"], 4242);
     assert_eq!(health["link.crc_errors"], 17);

@@ -25,6 +25,8 @@ FIELDS = {
         "integrity_reasons",
         "aiding_rejected",
     ],
+    "rins/msg/FusedImu": ["header.stage_pub_ns", "gyro_test_statistic"],
+    "rins/msg/RawImu": ["gyro_counts", "temperature_c"],
     "rins/msg/HealthReport": ["count", "services[0].pid", "link.crc_errors"],
 }
 
