@@ -77,6 +77,9 @@ pub enum Command {
     },
     /// Inject a fault into one channel of the running simulator ("kill a sensor").
     Inject(InjectArgs),
+    /// Join the running deployment and record its topics into an MCAP file (Foxglove opens it;
+    /// `rins plot` draws it); stops on Ctrl-C or after --duration.
+    Record(RecordArgs),
     /// Return a channel that fusion excluded to service and wait for fusion's answer: readmitted
     /// once it stayed in the solution through its probation, or refused (fault still present, no
     /// such channel); exits non-zero unless it is in the solution.
@@ -334,6 +337,10 @@ pub struct UpArgs {
     /// MAVLink output whatever the configuration says.
     #[arg(long, value_name = "ENDPOINT")]
     pub mavlink: Option<String>,
+    /// Record every topic into this MCAP file from the start (replaced if it exists), as
+    /// `rins record` does.
+    #[arg(long, value_name = "FILE")]
+    pub record: Option<PathBuf>,
     /// Faults for the simulator to apply.
     #[command(flatten)]
     pub faults: FaultArgs,
@@ -492,4 +499,28 @@ mod tests {
         Cli::command().debug_assert();
         check(&Cli::command(), "rins");
     }
+}
+
+/// `rins record FILE`.
+#[derive(Debug, Args)]
+pub struct RecordArgs {
+    /// The MCAP file to write (refused if it exists, unless --overwrite).
+    pub file: PathBuf,
+    /// Comma-separated short names of the topics to record (default: all): raw-imu, raw-baro,
+    /// raw-mag, raw-aux, fused-imu, altitude, nav, nav-standby, truth, health, heartbeat, fault,
+    /// sim-control, fusion-control, fusion-reply.
+    #[arg(long, value_delimiter = ',')]
+    pub topics: Vec<String>,
+    /// Stop after this many seconds.
+    #[arg(long, allow_negative_numbers = true)]
+    pub duration: Option<f64>,
+    /// Replace FILE if it exists (a symbolic link is replaced, never followed).
+    #[arg(long)]
+    pub overwrite: bool,
+    /// Print one JSON summary object as the last line (`samples_written`, `samples_dropped`, ...).
+    #[arg(long)]
+    pub json: bool,
+    /// Create this file once every topic is subscribed (for `rins up --record`).
+    #[arg(long, hide = true)]
+    pub ready_file: Option<PathBuf>,
 }

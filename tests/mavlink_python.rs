@@ -31,6 +31,11 @@ fn pymavlink_receives_the_stream_a_pipeline_sends() {
     let measured: serde_json::Value =
         serde_json::from_str(stdout.lines().last().unwrap_or("{}")).expect("a JSON line");
     eprintln!("{measured}");
-    assert!(measured["odometry_matched_echo"].as_u64().unwrap_or(0) >= 10);
+    assert!(
+        measured["odometry_exact_of_matched"][1]
+            .as_u64()
+            .unwrap_or(0)
+            >= 10
+    );
     assert!(ipc.shm_entries().is_empty(), "{:?}", ipc.shm_entries());
 }

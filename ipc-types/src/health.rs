@@ -64,7 +64,8 @@ pub struct Health {
     /// Serial frames whose sequence number was received before, not published (acquisition).
     pub duplicates: u64,
     /// Serial frames that arrived after a later one of their type (reordered), not published and
-    /// not counted in `lost` (acquisition).
+    /// not counted in `lost` (acquisition); aiding readings that arrived after their place in the
+    /// IMU stream had passed (navigator).
     pub late: u64,
     /// Device sequence-counter discontinuities, re-based without counting losses (acquisition).
     pub seq_jumps: u64,

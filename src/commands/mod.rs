@@ -13,6 +13,7 @@ mod mc;
 mod probe;
 mod progress;
 mod readmit;
+mod record;
 mod service;
 mod sim;
 mod status;
@@ -52,6 +53,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Status { json, timeout } => status::run(json, timeout).map(|()| ExitCode::SUCCESS),
         Command::Probe(args) => probe::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Inject(args) => inject::run(&args).map(|()| ExitCode::SUCCESS),
+        Command::Record(args) => record::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Readmit { channel, timeout } => {
             readmit::run(&channel, timeout).map(|()| ExitCode::SUCCESS)
         }

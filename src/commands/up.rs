@@ -117,6 +117,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     };
     let mut health = HealthPublisher::new(&node, started, silent_after)?;
     let mut timing = RestartTiming::default();
+    let mut recorder: Option<std::process::Child> = None;
     let outcome = (|| -> Result<()> {
         for kind in pipeline_services(cfg.deployment.navigator_lanes, cfg.mavlink.enabled) {
             if shutdown.requested() {
@@ -139,6 +140,15 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
                 args: child_args,
                 policy: cfg.watchdog.policy_for(name),
             })?;
+        }
+        if let Some(file) = &args.record {
+            recorder = Some(start_recorder(
+                &exe,
+                file,
+                &run_dir,
+                &mut supervisor,
+                &shutdown,
+            )?);
         }
         if simulate {
             supervisor.start(ChildSpec {
@@ -171,6 +181,10 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     })();
 
     supervisor.stop_all(Duration::from_millis(cfg.watchdog.stop_grace_ms));
+    // The recorder last: it writes what the services published while stopping.
+    if let Some(child) = recorder {
+        stop_recorder(child);
+    }
     // Drain what the children published while stopping, then release our own ports.
     let _ = monitor.drain();
     let summary = summarise(&monitor, &supervisor, &timing, started.elapsed(), simulate);
@@ -202,6 +216,51 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
         bail!("{why}");
     }
     Ok(std::process::ExitCode::SUCCESS)
+}
+
+/// Starts `rins record FILE` on this deployment and waits until it has subscribed to every topic,
+/// so that the recording starts with the first sample.
+fn start_recorder(
+    exe: &Path,
+    file: &Path,
+    run_dir: &Path,
+    supervisor: &mut Supervisor,
+    shutdown: &Shutdown,
+) -> Result<std::process::Child> {
+    let ready = run_dir.join("recorder-ready");
+    let _ = std::fs::remove_file(&ready);
+    let mut child = std::process::Command::new(exe)
+        .arg("record")
+        .arg(file)
+        .args(["--overwrite", "--json", "--ready-file"])
+        .arg(&ready)
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .with_context(|| format!("cannot start the recorder for {}", file.display()))?;
+    let waited = wait_for_path(&ready, supervisor, shutdown);
+    let _ = std::fs::remove_file(&ready);
+    if let Err(e) = waited {
+        let _ = child.kill();
+        let _ = child.wait();
+        return Err(e.context("the recorder did not start"));
+    }
+    Ok(child)
+}
+
+/// Stops the recorder (SIGINT: it finishes the file) and reports what it wrote on stderr.
+fn stop_recorder(child: std::process::Child) {
+    if let Ok(pid) = i32::try_from(child.id()) {
+        // SAFETY: kill(2) on our own child's pid with a valid signal number.
+        unsafe { libc::kill(pid, libc::SIGINT) };
+    }
+    match child.wait_with_output() {
+        Ok(out) if out.status.success() => {
+            let text = String::from_utf8_lossy(&out.stdout);
+            eprintln!("recording: {}", text.lines().last().unwrap_or_default());
+        }
+        Ok(out) => eprintln!("recording failed: {}", out.status),
+        Err(e) => eprintln!("recording: cannot collect the recorder: {e}"),
+    }
 }
 
 /// The simulator's command line: the scenario, seed and faults of this run, and its terminal link.

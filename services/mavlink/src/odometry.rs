@@ -13,23 +13,30 @@ use crate::time_usec;
 /// major): rows start at 0, 6, 11, 15, 18, 20.
 pub const COVARIANCE_DIAGONAL: [usize; 6] = [0, 6, 11, 15, 18, 20];
 
-/// Counts the resets of the published estimate: a lane switch (the consumers follow another
-/// filter) or a new solution in the same lane (a new alignment, a state taken over from the other
-/// lane). The receiver re-bases its own fusion when the counter changes.
+/// Counts the resets of the published estimate: a lane switch of the consumer's selector (it
+/// follows another filter from now on) or a new solution in a lane (a new alignment, a state taken
+/// over from the other lane). A single sample the selector took from the other lane to fill a
+/// hole is not a reset: both lanes run the same filter on the same samples. The receiver re-bases
+/// its own fusion when the counter changes.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct ResetCounter {
     count: u8,
-    last: Option<(u8, u64)>,
+    /// The selector's switch count at the last sample.
+    switches: u64,
+    /// The solution each lane delivered last (its first sample's sequence number).
+    solutions: [Option<u64>; 2],
 }
 
 impl ResetCounter {
-    /// The counter for `nav`, advanced when its lane or solution differs from the last one seen.
-    pub fn observe(&mut self, nav: &NavState) -> u8 {
-        let solution = (nav.lane, nav.solution_start_seq);
-        if self.last.is_some_and(|last| last != solution) {
+    /// The counter for `nav`, delivered after `switches` lane switches of the selector.
+    pub fn observe(&mut self, nav: &NavState, switches: u64) -> u8 {
+        let lane = usize::from(nav.lane.min(1));
+        let new_solution = self.solutions[lane].is_some_and(|s| s != nav.solution_start_seq);
+        if new_solution || switches != self.switches {
             self.count = self.count.wrapping_add(1);
         }
-        self.last = Some(solution);
+        self.solutions[lane] = Some(nav.solution_start_seq);
+        self.switches = switches;
         self.count
     }
 }
@@ -232,17 +239,21 @@ mod tests {
     fn the_reset_counter_moves_on_a_lane_switch_or_a_new_solution_only() {
         let mut c = ResetCounter::default();
         let nav = navigating();
-        assert_eq!(c.observe(&nav), 0);
-        assert_eq!(c.observe(&nav), 0);
-        assert_eq!(c.observe(&NavState { lane: 1, ..nav }), 1);
-        assert_eq!(c.observe(&NavState { lane: 1, ..nav }), 1);
-        assert_eq!(
-            c.observe(&NavState {
-                lane: 1,
-                solution_start_seq: 99,
-                ..nav
-            }),
-            2
-        );
+        assert_eq!(c.observe(&nav, 0), 0);
+        assert_eq!(c.observe(&nav, 0), 0);
+        // A hole filled from the other lane: no reset.
+        assert_eq!(c.observe(&NavState { lane: 1, ..nav }, 0), 0);
+        assert_eq!(c.observe(&nav, 0), 0);
+        // The selector switched.
+        assert_eq!(c.observe(&NavState { lane: 1, ..nav }, 1), 1);
+        assert_eq!(c.observe(&NavState { lane: 1, ..nav }, 1), 1);
+        // The lane started a new solution.
+        let new = NavState {
+            lane: 1,
+            solution_start_seq: 99,
+            ..nav
+        };
+        assert_eq!(c.observe(&new, 1), 2);
+        assert_eq!(c.observe(&new, 1), 2);
     }
 }

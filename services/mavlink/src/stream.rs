@@ -107,7 +107,7 @@ impl MavlinkStream {
                 nav.altitude_m,
             ));
         }
-        let reset_counter = self.resets.observe(nav);
+        let reset_counter = self.resets.observe(nav, switches);
         // The body rate: the fused rate less the filter's bias estimate.
         let (rate, rate_var) = match &self.fused {
             Some(f) => (

@@ -50,8 +50,8 @@ fn every_message_reads_back_as_written() {
     let nav = flying();
     let origin = LocalOrigin::new(0.82, 0.1395, 480.0);
     let mut resets = ResetCounter::default();
-    resets.observe(&nav);
-    let reset_counter = resets.observe(&NavState { lane: 0, ..nav });
+    resets.observe(&nav, 0);
+    let reset_counter = resets.observe(&NavState { lane: 1, ..nav }, 1);
     assert_eq!(reset_counter, 1);
     let messages = [
         MavMessage::HEARTBEAT(heartbeat(Profile::Onboard, Some(&nav))),

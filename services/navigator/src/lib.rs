@@ -4,6 +4,7 @@
 //! Pure functions and small structs, no I/O. Frames: NED navigation, FRD body; quaternions rotate
 //! body → NED (Hamilton, scalar first); SI units inside, degrees only in [`NavigatorConfig`].
 
+pub mod aiding_queue;
 pub mod alignment;
 pub mod attitude;
 pub mod attitude_recovery;

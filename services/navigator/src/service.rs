@@ -14,6 +14,7 @@ use rins_runtime::service::{Service, ServiceContext};
 use rins_runtime::stage_io::StageInput;
 use rins_runtime::stage_loop::{PipelineStage, StageLoop, StageTopics, Step};
 
+use crate::aiding_queue::{AidingQueue, Reading};
 use crate::ekf::AidingSource;
 use crate::navigator::{Navigator, fused_sample_usable};
 use crate::takeover::Handover;
@@ -132,6 +133,23 @@ struct NavigatorStage {
     resets: [u64; AidingSource::COUNT],
     /// The last state published.
     last: NavState,
+    /// Aiding readings waiting for the IMU stream to reach their time.
+    aiding: AidingQueue,
+    /// Late readings already logged.
+    late_logged: u64,
+}
+
+/// Hands one held aiding reading to the filter.
+fn apply_reading(nav: &mut Navigator, r: Reading) {
+    let _ = match r {
+        Reading::Baro {
+            t_us,
+            height_m,
+            variance_m2,
+            valid,
+        } => nav.on_baro(t_us, height_m, variance_m2, valid),
+        Reading::Mag { t_us, field_ut } => nav.on_mag(t_us, field_ut),
+    };
 }
 
 impl PipelineStage for NavigatorStage {
@@ -139,21 +157,23 @@ impl PipelineStage for NavigatorStage {
     type Output = NavState;
 
     fn before_input(&mut self, counters: &mut Health) -> Result<(), IpcError> {
-        // Aiding first: it is older than (or as old as) the IMU sample that woke us.
-        let nav = &mut self.nav;
+        // Aiding is held, not applied: it meets the filter where the IMU stream passes its time.
+        let (nav, queue) = (&mut self.nav, &mut self.aiding);
         self.alt_in.drain(counters, |alt| {
-            let _ = nav.on_baro(
-                alt.header.origin_device_time_us,
-                alt.height_m,
-                alt.height_var,
-                alt.valid != 0,
-            );
+            let reading = Reading::Baro {
+                t_us: alt.header.origin_device_time_us,
+                height_m: alt.height_m,
+                variance_m2: alt.height_var,
+                valid: alt.valid != 0,
+            };
+            queue.push(reading, |r| apply_reading(nav, r));
         })?;
         self.mag_in.drain(counters, |mag| {
-            let _ = nav.on_mag(
-                mag.header.origin_device_time_us,
-                mag.field_ut.map(f64::from),
-            );
+            let reading = Reading::Mag {
+                t_us: mag.header.origin_device_time_us,
+                field_ut: mag.field_ut.map(f64::from),
+            };
+            queue.push(reading, |r| apply_reading(nav, r));
         })?;
         self.listening = self.peer_in.is_some() && self.nav.mode() == NavMode::Aligning;
         if let Some(peer_in) = self.peer_in.as_ref().filter(|_| self.listening) {
@@ -171,6 +191,9 @@ impl PipelineStage for NavigatorStage {
         {
             return Step::Skip;
         }
+        let nav = &mut self.nav;
+        self.aiding
+            .release(imu.header.origin_device_time_us, |r| apply_reading(nav, r));
         let taken_over = if self.listening && self.nav.mode() == NavMode::Aligning {
             self.handover.push_imu(*imu);
             take_over_if_ready(&mut self.nav, &mut self.handover, &mut self.last)
@@ -205,6 +228,16 @@ impl PipelineStage for NavigatorStage {
 
     fn after_input(&mut self, _received: u64, counters: &mut Health) {
         counters.lost = self.nav.rejected_imu_samples();
+        counters.late = self.aiding.late();
+        if self.aiding.late() != self.late_logged {
+            // Rare by design (the hold is long): each one means the lanes may differ slightly.
+            tracing::warn!(
+                late = self.aiding.late(),
+                hold_us = crate::aiding_queue::HOLD_US,
+                "aiding readings arrived after their place in the IMU stream"
+            );
+            self.late_logged = self.aiding.late();
+        }
     }
 }
 
@@ -258,6 +291,8 @@ impl Service for NavigatorService {
                 lane,
                 ..NavState::default()
             },
+            aiding: AidingQueue::default(),
+            late_logged: 0,
         };
         stage_loop.run(&mut stage)?;
         Ok(())
