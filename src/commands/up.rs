@@ -82,8 +82,11 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     refuse_foreign_entries(&settings)?;
     // Only a root this run created is removed at the end (and only when empty).
     let root_created = settings.ensure_root()?;
+    // The configuration file lets programs that are not rins (a Python consumer) join this
+    // deployment; it goes again at stop.
     let run_dir = ensure_no_live_deployment(&settings)
         .and_then(|()| Ok(settings.ensure_run_dir()?))
+        .and_then(|dir| Ok(settings.write_iceoryx_config_file().map(|_| dir)?))
         .inspect_err(|_| {
             if root_created {
                 let _ = std::fs::remove_dir(&settings.root);
@@ -171,6 +174,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     })();
 
     supervisor.stop_all(Duration::from_millis(cfg.watchdog.stop_grace_ms));
+    settings.remove_iceoryx_config_file();
     // Drain what the children published while stopping, then release our own ports.
     let _ = monitor.drain();
     let summary = summarise(&monitor, &supervisor, &timing, started.elapsed(), simulate);
