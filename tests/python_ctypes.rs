@@ -11,8 +11,8 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use ipc_types::names;
-use rins_recording::schema::{FieldKind, PAYLOADS, Prim, StructLayout};
 use rins_recording::TOPICS;
+use rins_recording::schema::{FieldKind, PAYLOADS, Prim, StructLayout};
 use rins_runtime::ipc;
 
 const BEGIN: &str = "# --- generated from the Rust layouts: do not edit ---\n";
@@ -230,7 +230,10 @@ fn render() -> String {
     out.push_str("}\n");
 
     for (constant, what, table) in flag_tables() {
-        let _ = writeln!(out, "\n#: Bits of {what}, with their names.\n{constant} = {{");
+        let _ = writeln!(
+            out,
+            "\n#: Bits of {what}, with their names.\n{constant} = {{"
+        );
         for (bit, text) in table {
             let _ = writeln!(out, "    0x{bit:x}: \"{text}\",");
         }

@@ -44,7 +44,12 @@ fn python_receives_the_navigation_stream_of_a_running_pipeline() {
         .join("iceoryx2.toml");
 
     // No deployment yet: a clear refusal, not a hang.
-    let out = run_script(&python, &ipc, "examples/python/echo_nav.py", &["--count", "1"]);
+    let out = run_script(
+        &python,
+        &ipc,
+        "examples/python/echo_nav.py",
+        &["--count", "1"],
+    );
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(
@@ -68,7 +73,11 @@ fn python_receives_the_navigation_stream_of_a_running_pipeline() {
     if let Some(rust) = rust {
         let text = String::from_utf8_lossy(&rust.stdout);
         assert!(rust.status.success(), "consume_nav: {rust:?}");
-        assert_eq!(text.lines().filter(|l| l.starts_with("seq ")).count(), 20, "{text}");
+        assert_eq!(
+            text.lines().filter(|l| l.starts_with("seq ")).count(),
+            20,
+            "{text}"
+        );
     }
     assert!(out.status.success(), "echo_nav.py failed:\n{stderr}");
     eprintln!("{}", stderr.trim());

@@ -38,9 +38,11 @@ fn install_global_config(settings: &IpcSettings, config: &Config) -> Result<(), 
         settings.prefix,
         std::process::id()
     ));
-    super::config_file::write_new_private_file(&file, text.as_bytes()).map_err(|source| IpcError::ConfigFile {
-        path: file.clone(),
-        source,
+    super::config_file::write_new_private_file(&file, text.as_bytes()).map_err(|source| {
+        IpcError::ConfigFile {
+            path: file.clone(),
+            source,
+        }
     })?;
     let loaded = FilePath::new(file.to_string_lossy().as_bytes())
         .map_err(|source| IpcError::ConfigPath {
