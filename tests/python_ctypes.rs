@@ -99,8 +99,11 @@ fn wire_enums() -> Vec<WireEnum> {
     )
 }
 
-/// Flag words: the Python name of the table and the Rust table of bit names.
-fn flag_tables() -> [(&'static str, &'static str, &'static [(u32, &'static str)]); 5] {
+/// A flag word's bit names, as `ipc_types` lists them.
+type BitNames = &'static [(u32, &'static str)];
+
+/// Flag words: the Python name of the table, the field it describes, and its bit names.
+fn flag_tables() -> [(&'static str, &'static str, BitNames); 5] {
     [
         (
             "INTEGRITY_REASONS",
