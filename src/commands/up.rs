@@ -1,6 +1,8 @@
 //! `rins up`: the watchdog. Starts every service (and the simulator unless a real port is given) as
 //! child processes, restarts children that exit, prints a status line per second, and on shutdown
-//! stops everything and removes the deployment's shared memory.
+//! stops everything and removes the deployment's shared memory. While it runs, the deployment's
+//! iceoryx2 configuration is in the run directory (`iceoryx2.toml`), for programs that are not rins
+//! (a Python consumer) to join with.
 
 use std::path::Path;
 use std::time::{Duration, Instant};

@@ -97,6 +97,20 @@ mod tests {
         settings.remove_iceoryx_config_file();
         assert!(!path.exists());
         settings.remove_iceoryx_config_file();
+
+        // Links planted at the file and at its temporary name are replaced, never written through.
+        let secret = base.join("secret");
+        std::fs::write(&secret, "secret").unwrap();
+        std::os::unix::fs::symlink(&secret, &path).unwrap();
+        std::os::unix::fs::symlink(&secret, settings.run_dir().join("iceoryx2.toml.tmp")).unwrap();
+        settings.write_iceoryx_config_file().unwrap();
+        assert_eq!(std::fs::read_to_string(&secret).unwrap(), "secret");
+        assert!(
+            std::fs::symlink_metadata(&path)
+                .unwrap()
+                .file_type()
+                .is_file()
+        );
         std::fs::remove_dir_all(&base).unwrap();
     }
 }
