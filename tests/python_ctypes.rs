@@ -3,7 +3,8 @@
 //! the Rust layouts (`rins_recording::schema`, offsets from `offset_of!`), and must equal the
 //! committed file. After a layout change, `RINS_BLESS=1 cargo test --test python_ctypes` rewrites
 //! it. With `RINS_PYTHON` set, the interpreter itself checks that `ctypes` lays every structure out
-//! as Rust does (size, alignment, every field's offset and size).
+//! as Rust does (size, alignment, every field's offset and size), and that the module finds a
+//! deployment's default prefix and root where rins puts them.
 
 mod common;
 
@@ -340,5 +341,42 @@ fn python_ctypes_lay_every_payload_out_as_rust_does() {
     assert!(
         stdout.contains(&format!("{checked} structures match")),
         "{stdout}"
+    );
+}
+
+#[test]
+fn python_finds_the_default_deployment_where_rins_puts_it() {
+    let Some(python) =
+        common::python::interpreter("python_finds_the_default_deployment_where_rins_puts_it")
+    else {
+        return;
+    };
+    let cases: Vec<serde_json::Value> = [
+        (1000, Some("/run/user/1000")),
+        (1000, Some("/run/user/1000/")),
+        (1000, Some("")),
+        (1000, None),
+        (0, Some("/run/user/0")),
+        (0, None),
+        (10, None),
+    ]
+    .into_iter()
+    .map(|(uid, xdg)| {
+        serde_json::json!({
+            "uid": uid,
+            "xdg": xdg,
+            "prefix": ipc::default_prefix(uid),
+            "root": ipc::default_root(uid, xdg),
+        })
+    })
+    .collect();
+    let ipc = common::Isolated::new("pydefaults");
+    let json = serde_json::Value::Array(cases).to_string();
+    let out = common::python::run_script(&python, &ipc, "python/tests/check_defaults.py", &[&json]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && stdout.contains("7 cases match"),
+        "check_defaults.py:\n{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
     );
 }
