@@ -1,6 +1,8 @@
 //! `rins up`: the watchdog. Starts every service (and the simulator unless a real port is given) as
 //! child processes, restarts children that exit, prints a status line per second, and on shutdown
-//! stops everything and removes the deployment's shared memory.
+//! stops everything and removes the deployment's shared memory. While it runs, the deployment's
+//! iceoryx2 configuration is in the run directory (`iceoryx2.toml`), for programs that are not rins
+//! (a Python consumer) to join with.
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -82,8 +84,11 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     refuse_foreign_entries(&settings)?;
     // Only a root this run created is removed at the end (and only when empty).
     let root_created = settings.ensure_root()?;
+    // The configuration file lets programs that are not rins (a Python consumer) join this
+    // deployment; it goes again at stop.
     let run_dir = ensure_no_live_deployment(&settings)
         .and_then(|()| Ok(settings.ensure_run_dir()?))
+        .and_then(|dir| Ok(settings.write_iceoryx_config_file().map(|_| dir)?))
         .inspect_err(|_| {
             if root_created {
                 let _ = std::fs::remove_dir(&settings.root);
@@ -185,6 +190,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     if let Some(child) = recorder {
         stop_recorder(child);
     }
+    settings.remove_iceoryx_config_file();
     // Drain what the children published while stopping, then release our own ports.
     let _ = monitor.drain();
     let summary = summarise(&monitor, &supervisor, &timing, started.elapsed(), simulate);

@@ -6,7 +6,7 @@ use std::time::Duration;
 use iceoryx2::node::NodeView;
 use iceoryx2::prelude::*;
 
-use super::error::{IpcError, OtherError};
+use super::error::IpcError;
 use super::settings::IpcSettings;
 
 /// A node of this deployment; every port of a process is made from it.
@@ -38,9 +38,11 @@ fn install_global_config(settings: &IpcSettings, config: &Config) -> Result<(), 
         settings.prefix,
         std::process::id()
     ));
-    write_new_private_file(&file, text.as_bytes()).map_err(|source| IpcError::ConfigFile {
-        path: file.clone(),
-        source,
+    super::config_file::write_new_private_file(&file, text.as_bytes()).map_err(|source| {
+        IpcError::ConfigFile {
+            path: file.clone(),
+            source,
+        }
     })?;
     let loaded = FilePath::new(file.to_string_lossy().as_bytes())
         .map_err(|source| IpcError::ConfigPath {
@@ -58,22 +60,6 @@ fn install_global_config(settings: &IpcSettings, config: &Config) -> Result<(), 
     let _ = std::fs::remove_file(&file);
     loaded?;
     GLOBAL_CONFIG_INSTALLED.store(true, std::sync::atomic::Ordering::Relaxed);
-    Ok(())
-}
-
-/// Writes `bytes` to a file that must not exist yet (a stale one of a dead process with our pid is
-/// unlinked first: unlink never follows a link), opened without following a link, mode 0600.
-fn write_new_private_file(path: &std::path::Path, bytes: &[u8]) -> Result<(), OtherError> {
-    use std::io::Write;
-    use std::os::unix::fs::OpenOptionsExt;
-    let _ = std::fs::remove_file(path);
-    let mut file = std::fs::OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .mode(0o600)
-        .custom_flags(libc::O_NOFOLLOW)
-        .open(path)?;
-    file.write_all(bytes)?;
     Ok(())
 }
 

@@ -18,11 +18,15 @@ use super::node::IpcNode;
 
 /// Queue depth of every subscriber: a consumer may sleep up to this many samples of a 1 kHz topic
 /// (plus margin at 8 kHz) before the oldest is overwritten.
-const SUBSCRIBER_BUFFER: usize = 512;
+pub const SUBSCRIBER_BUFFER: usize = 512;
 /// Publishers per topic: restarted services leave a dead publisher until it is cleaned up.
-const MAX_PUBLISHERS: usize = 16;
-const MAX_SUBSCRIBERS: usize = 16;
-const MAX_NODES: usize = 64;
+pub const MAX_PUBLISHERS: usize = 16;
+/// Subscribers per topic (the same numbers bound each topic's event service: notifiers and
+/// listeners). A program that opens a topic of a running deployment asks for no more than these,
+/// or iceoryx2 refuses it as incompatible.
+pub const MAX_SUBSCRIBERS: usize = 16;
+/// Nodes per topic.
+pub const MAX_NODES: usize = 64;
 
 /// Samples of the raw IMU topic its publisher keeps for subscribers that connect later: a fusion
 /// process restarted after a crash receives the frames it missed while it was down (up to 256 ms
@@ -30,7 +34,8 @@ const MAX_NODES: usize = 64;
 /// them wants what comes next, not what was.
 const RAW_IMU_HISTORY: usize = 256;
 
-fn history_size(name: &str) -> usize {
+/// Samples of topic `name` its publishers keep for subscribers that connect later.
+pub fn history_size(name: &str) -> usize {
     if name == ipc_types::names::RAW_IMU {
         RAW_IMU_HISTORY
     } else {
