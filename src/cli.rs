@@ -80,6 +80,10 @@ pub enum Command {
     /// Join the running deployment and record its topics into an MCAP file (Foxglove opens it;
     /// `rins plot` draws it); stops on Ctrl-C or after --duration.
     Record(RecordArgs),
+    /// Feed the raw sensor topics of a recording through a fresh deployment (fusion, altimeter and
+    /// navigator run live) and compare its navigation output with the recorded one, sample for
+    /// sample; `--offline` runs the same code in this process without IPC.
+    Replay(ReplayArgs),
     /// Return a channel that fusion excluded to service and wait for fusion's answer: readmitted
     /// once it stayed in the solution through its probation, or refused (fault still present, no
     /// such channel); exits non-zero unless it is in the solution.
@@ -341,6 +345,10 @@ pub struct UpArgs {
     /// `rins record` does.
     #[arg(long, value_name = "FILE")]
     pub record: Option<PathBuf>,
+    /// Start neither acquisition nor the simulator: another process publishes the raw topics
+    /// (`rins replay`).
+    #[arg(long, hide = true)]
+    pub external_source: bool,
     /// Faults for the simulator to apply.
     #[command(flatten)]
     pub faults: FaultArgs,
@@ -523,4 +531,31 @@ pub struct RecordArgs {
     /// Create this file once every topic is subscribed (for `rins up --record`).
     #[arg(long, hide = true)]
     pub ready_file: Option<PathBuf>,
+}
+
+/// `rins replay FILE`.
+#[derive(Debug, Args)]
+pub struct ReplayArgs {
+    /// The MCAP file (`rins record`, `rins up --record`).
+    pub file: PathBuf,
+    /// Replay at this multiple of the recorded pace (default 1).
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        conflicts_with = "as_fast_as_possible"
+    )]
+    pub speed: Option<f64>,
+    /// Replay as fast as the pipeline takes it (paced by its output, never losing a sample).
+    #[arg(long)]
+    pub as_fast_as_possible: bool,
+    /// Run the services' library code in this process, without IPC, for batch analysis.
+    #[arg(long)]
+    pub offline: bool,
+    /// Configuration file of the replaying deployment (default: the built-in configuration).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Print one JSON summary object as the last line (`nav_samples_compared`,
+    /// `nav_samples_different`, ...).
+    #[arg(long)]
+    pub json: bool,
 }

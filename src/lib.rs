@@ -4,3 +4,4 @@
 pub mod built_services;
 pub mod cli;
 pub mod config;
+pub mod replay;

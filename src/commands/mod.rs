@@ -14,6 +14,7 @@ mod probe;
 mod progress;
 mod readmit;
 mod record;
+mod replay;
 mod service;
 mod sim;
 mod status;
@@ -54,6 +55,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Probe(args) => probe::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Inject(args) => inject::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Record(args) => record::run(&args).map(|()| ExitCode::SUCCESS),
+        Command::Replay(args) => replay::run(&args),
         Command::Readmit { channel, timeout } => {
             readmit::run(&channel, timeout).map(|()| ExitCode::SUCCESS)
         }

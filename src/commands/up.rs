@@ -96,7 +96,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
         })?;
     // A new deployment numbers its frames afresh: the last one's resume point does not apply.
     let _ = std::fs::remove_file(rins_acquisition::resume_file::path_for(&settings));
-    let simulate = cfg.acquisition.port.is_none();
+    let simulate = cfg.acquisition.port.is_none() && !args.external_source;
     let link = run_dir.join("sim-tty");
     if simulate {
         let _ = std::fs::remove_file(&link);
@@ -125,6 +125,9 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     let mut recorder: Option<std::process::Child> = None;
     let outcome = (|| -> Result<()> {
         for kind in pipeline_services(cfg.deployment.navigator_lanes, cfg.mavlink.enabled) {
+            if args.external_source && kind == ServiceKind::Acquisition {
+                continue;
+            }
             if shutdown.requested() {
                 return Ok(());
             }

@@ -45,6 +45,14 @@ pub trait PipelineStage {
         Ok(())
     }
 
+    /// Before each input sample is read: side topics that must be taken in sample by sample (an
+    /// aiding reading published before the input sample's frame is then always in hand when the
+    /// sample is stepped, however the samples were batched).
+    fn before_sample(&mut self, counters: &mut Health) -> Result<(), IpcError> {
+        let _ = counters;
+        Ok(())
+    }
+
     /// Every input sample, whatever its payload version, before it is stepped.
     fn received(&mut self, input: &Self::Input, counters: &mut Health) {
         let _ = (input, counters);
@@ -125,6 +133,7 @@ where
             stage.before_input(counters)?;
             let mut received = 0;
             while let Some(sample) = self.input.receive(counters)? {
+                stage.before_sample(counters)?;
                 received += 1;
                 counters.received += 1;
                 stage.received(sample.payload(), counters);

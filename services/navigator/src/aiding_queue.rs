@@ -9,6 +9,10 @@
 
 use std::collections::VecDeque;
 
+use ipc_types::{Altitude, RawMag};
+
+use crate::navigator::Navigator;
+
 /// How far the IMU stream must be past a reading's device time before it is applied, µs: well
 /// beyond the few tens of µs the aiding paths take on a loaded two-core computer, and short
 /// against the time the filter takes to move (at 30 °/s, 0.3° of heading; at 2 m/s climb, 2 cm).
@@ -42,6 +46,37 @@ pub enum Reading {
 }
 
 impl Reading {
+    /// The altimeter's height.
+    pub fn from_altitude(alt: &Altitude) -> Self {
+        Self::Baro {
+            t_us: alt.header.origin_device_time_us,
+            height_m: alt.height_m,
+            variance_m2: alt.height_var,
+            valid: alt.valid != 0,
+        }
+    }
+
+    /// A raw magnetometer sample.
+    pub fn from_mag(mag: &RawMag) -> Self {
+        Self::Mag {
+            t_us: mag.header.origin_device_time_us,
+            field_ut: mag.field_ut.map(f64::from),
+        }
+    }
+
+    /// Hands the reading to the filter.
+    pub fn apply(self, nav: &mut Navigator) {
+        let _ = match self {
+            Self::Baro {
+                t_us,
+                height_m,
+                variance_m2,
+                valid,
+            } => nav.on_baro(t_us, height_m, variance_m2, valid),
+            Self::Mag { t_us, field_ut } => nav.on_mag(t_us, field_ut),
+        };
+    }
+
     /// Device time, µs.
     pub fn t_us(&self) -> u64 {
         match self {
@@ -115,6 +150,16 @@ impl AidingQueue {
                 apply(r);
             }
         }
+    }
+
+    /// [`AidingQueue::push`] for the navigator `nav`.
+    pub fn hold(&mut self, r: Reading, nav: &mut Navigator) {
+        self.push(r, |r| r.apply(nav));
+    }
+
+    /// [`AidingQueue::release`] into the navigator `nav`, before its IMU sample at `imu_t_us`.
+    pub fn release_to(&mut self, imu_t_us: u64, nav: &mut Navigator) {
+        self.release(imu_t_us, |r| r.apply(nav));
     }
 
     /// Readings that arrived after their place in the IMU stream had passed.

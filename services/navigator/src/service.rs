@@ -120,7 +120,7 @@ fn log_resets(before: [u64; AidingSource::COUNT], now: [u64; AidingSource::COUNT
 }
 
 /// The navigator as a stage of the pipeline: one navigation state per fused IMU sample, the
-/// aiding topics read before each batch, the peer lane listened to while aligning.
+/// aiding topics read before each sample, the peer lane listened to while aligning.
 struct NavigatorStage {
     nav: Navigator,
     alt_in: StageInput<Altitude>,
@@ -139,42 +139,23 @@ struct NavigatorStage {
     late_logged: u64,
 }
 
-/// Hands one held aiding reading to the filter.
-fn apply_reading(nav: &mut Navigator, r: Reading) {
-    let _ = match r {
-        Reading::Baro {
-            t_us,
-            height_m,
-            variance_m2,
-            valid,
-        } => nav.on_baro(t_us, height_m, variance_m2, valid),
-        Reading::Mag { t_us, field_ut } => nav.on_mag(t_us, field_ut),
-    };
-}
-
 impl PipelineStage for NavigatorStage {
     type Input = FusedImu;
     type Output = NavState;
 
-    fn before_input(&mut self, counters: &mut Health) -> Result<(), IpcError> {
+    fn before_sample(&mut self, counters: &mut Health) -> Result<(), IpcError> {
         // Aiding is held, not applied: it meets the filter where the IMU stream passes its time.
+        // Taken before every sample: a reading published before the sample's frame is in hand.
         let (nav, queue) = (&mut self.nav, &mut self.aiding);
         self.alt_in.drain(counters, |alt| {
-            let reading = Reading::Baro {
-                t_us: alt.header.origin_device_time_us,
-                height_m: alt.height_m,
-                variance_m2: alt.height_var,
-                valid: alt.valid != 0,
-            };
-            queue.push(reading, |r| apply_reading(nav, r));
+            queue.hold(Reading::from_altitude(&alt), nav)
         })?;
-        self.mag_in.drain(counters, |mag| {
-            let reading = Reading::Mag {
-                t_us: mag.header.origin_device_time_us,
-                field_ut: mag.field_ut.map(f64::from),
-            };
-            queue.push(reading, |r| apply_reading(nav, r));
-        })?;
+        self.mag_in
+            .drain(counters, |mag| queue.hold(Reading::from_mag(&mag), nav))?;
+        Ok(())
+    }
+
+    fn before_input(&mut self, _counters: &mut Health) -> Result<(), IpcError> {
         self.listening = self.peer_in.is_some() && self.nav.mode() == NavMode::Aligning;
         if let Some(peer_in) = self.peer_in.as_ref().filter(|_| self.listening) {
             while let Some(peer) = peer_in.receive()? {
@@ -191,9 +172,8 @@ impl PipelineStage for NavigatorStage {
         {
             return Step::Skip;
         }
-        let nav = &mut self.nav;
         self.aiding
-            .release(imu.header.origin_device_time_us, |r| apply_reading(nav, r));
+            .release_to(imu.header.origin_device_time_us, &mut self.nav);
         let taken_over = if self.listening && self.nav.mode() == NavMode::Aligning {
             self.handover.push_imu(*imu);
             take_over_if_ready(&mut self.nav, &mut self.handover, &mut self.last)

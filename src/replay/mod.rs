@@ -1,0 +1,8 @@
+//! Re-running a recording: the raw sensor topics of an MCAP file fed again through fusion, the
+//! altimeter and the navigator — live, through a fresh deployment (`rins replay FILE`), or
+//! in-process with the same library code (`rins replay FILE --offline`) — and the navigation output
+//! compared with the recorded one, sample for sample.
+
+pub mod compare;
+pub mod input;
+pub mod offline;
