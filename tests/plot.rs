@@ -36,7 +36,9 @@ fn write_recording(path: &Path, seconds: f64, rate_hz: f64, truth: bool, fused: 
     let nav_ch = rec.channel_for::<NavState>(names::NAV_LANES[0]).unwrap();
     let truth_ch = rec.channel_for::<Truth>(names::TRUTH).unwrap();
     let fused_ch = rec.channel_for::<FusedImu>(names::FUSED_IMU).unwrap();
-    let fault_ch = rec.channel_for::<FaultApplied>(names::SIM_FAULT_APPLIED).unwrap();
+    let fault_ch = rec
+        .channel_for::<FaultApplied>(names::SIM_FAULT_APPLIED)
+        .unwrap();
     let lat0 = 47.0f64.to_radians();
     let lon0 = 8.0f64.to_radians();
     let frames = (seconds * rate_hz) as u64;
@@ -89,13 +91,15 @@ fn write_recording(path: &Path, seconds: f64, rate_hz: f64, truth: bool, fused: 
             rec.write_payload(fused_ch, log_ns, log_ns, &f).unwrap();
             if t_us == fault_us {
                 let applied = FaultApplied {
+                    version: ipc_types::PAYLOAD_VERSION,
                     sensor: SensorType::Gyro as u8,
                     channel: 1,
                     fault: SimFault::Dead as u8,
                     device_time_us: fault_us,
                     ..FaultApplied::default()
                 };
-                rec.write_payload(fault_ch, log_ns, log_ns, &applied).unwrap();
+                rec.write_payload(fault_ch, log_ns, log_ns, &applied)
+                    .unwrap();
             }
         }
         header.stamp(Stage::Navigator, rx_ns + 250_000 + (i % 13) * 5_000);
@@ -134,6 +138,8 @@ fn plot(file: &Path, out: &Path) -> serde_json::Value {
         "{stdout}\n{}",
         String::from_utf8_lossy(&output.stderr)
     );
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("damaged"), "{stderr}");
     serde_json::from_str(stdout.lines().last().unwrap()).unwrap()
 }
 
@@ -144,7 +150,11 @@ fn names_of(list: &serde_json::Value, key: Option<&str>) -> Vec<String> {
         .map(|v| {
             let v = key.map_or(v, |k| &v[k]);
             let s = v.as_str().unwrap();
-            Path::new(s).file_name().unwrap().to_string_lossy().into_owned()
+            Path::new(s)
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .into_owned()
         })
         .collect()
 }

@@ -85,7 +85,11 @@ pub struct Hop {
 /// The hops measured, as (name, from stamp, to stamp); `None` is the serial receive time.
 pub const HOPS: [(&str, Option<Stage>, Stage); 4] = [
     ("serial rx → acquisition", None, Stage::Acquisition),
-    ("acquisition → fusion", Some(Stage::Acquisition), Stage::Fusion),
+    (
+        "acquisition → fusion",
+        Some(Stage::Acquisition),
+        Stage::Fusion,
+    ),
     ("fusion → navigator", Some(Stage::Fusion), Stage::Navigator),
     ("serial rx → navigator", None, Stage::Navigator),
 ];
@@ -230,9 +234,8 @@ impl Collector {
                     .next()
             })
             .map(|(lat, lon, alt)| LocalOrigin::new(lat, lon, alt));
-        let ned = |lat: f64, lon: f64, alt: f64| {
-            origin.map_or([f64::NAN; 3], |o| o.ned(lat, lon, alt))
-        };
+        let ned =
+            |lat: f64, lon: f64, alt: f64| origin.map_or([f64::NAN; 3], |o| o.ned(lat, lon, alt));
         let nav: Vec<NavPoint> = chosen
             .iter()
             .map(|s| NavPoint {
@@ -376,7 +379,10 @@ fn channel_rows(fused: &[(u64, FusedImu)], seconds: impl Fn(u64) -> f64) -> Vec<
                     (&f.accel_state, f.n_accel)
                 };
                 if channel < usize::from(fitted) {
-                    states.get(channel).copied().unwrap_or(ChannelState::Absent as u8)
+                    states
+                        .get(channel)
+                        .copied()
+                        .unwrap_or(ChannelState::Absent as u8)
                 } else {
                     ChannelState::Absent as u8
                 }

@@ -10,7 +10,7 @@ pub fn thin<T: Copy>(values: &[T], max: usize) -> Vec<T> {
     }
     let step = values.len().div_ceil(max - 1);
     let mut out: Vec<T> = values.iter().step_by(step).copied().collect();
-    if (values.len() - 1) % step != 0
+    if !(values.len() - 1).is_multiple_of(step)
         && let Some(last) = values.last()
     {
         out.push(*last);

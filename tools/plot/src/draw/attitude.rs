@@ -25,7 +25,10 @@ pub fn draw(path: &Path, data: &Extracted) -> Result<(), String> {
             Line::solid(
                 "estimate",
                 ESTIMATE,
-                data.nav.iter().map(|p| (p.t_s, p.euler_deg[axis])).collect(),
+                data.nav
+                    .iter()
+                    .map(|p| (p.t_s, p.euler_deg[axis]))
+                    .collect(),
             )
             .wrapping(180.0),
         ];

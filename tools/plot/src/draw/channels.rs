@@ -88,7 +88,14 @@ pub fn draw(path: &Path, data: &Extracted) -> Result<(), String> {
             .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 18, y + 5)], c.filled()));
     }
     draw_markers(&mut chart, &data.faults, FAULT, "fault injected", rows, top)?;
-    draw_markers(&mut chart, &data.lane_switches, LANE, "lane switch", rows, top)?;
+    draw_markers(
+        &mut chart,
+        &data.lane_switches,
+        LANE,
+        "lane switch",
+        rows,
+        top,
+    )?;
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::LowerRight)
@@ -115,9 +122,11 @@ fn draw_markers<DB: DrawingBackend>(
     }
     let bottom = -0.5;
     chart
-        .draw_series(markers.iter().map(|m| {
-            PathElement::new(vec![(m.t_s, bottom), (m.t_s, top)], colour.stroke_width(2))
-        }))
+        .draw_series(
+            markers.iter().map(|m| {
+                PathElement::new(vec![(m.t_s, bottom), (m.t_s, top)], colour.stroke_width(2))
+            }),
+        )
         .map_err(|e| format!("drawing failed: {e:?}"))?
         .label(legend)
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));

@@ -44,7 +44,11 @@ pub fn draw(path: &Path, data: &Extracted) -> Result<(), String> {
         for (s, b) in series.iter_mut().zip(att_bound.iter().chain(&pos_bound)) {
             s.bound.push((p.t_s, *b));
         }
-        if let Some(t) = data.truth_by_seq.get(&p.seq).and_then(|&i| data.truth.get(i)) {
+        if let Some(t) = data
+            .truth_by_seq
+            .get(&p.seq)
+            .and_then(|&i| data.truth.get(i))
+        {
             let att = attitude_error_deg(p.quaternion, t.quaternion);
             let pos = position_error_m(p.ned_m, t.ned_m);
             for (s, e) in series.iter_mut().zip(att.iter().chain(&pos)) {

@@ -42,7 +42,10 @@ fn draw_hop(area: &super::Area<'_>, hop: &Hop) -> Result<(), String> {
         percentile(&sorted, 99.0),
         percentile(&sorted, 99.9),
     ) else {
-        return note(area, &format!("{}: no sample carries both stamps", hop.name));
+        return note(
+            area,
+            &format!("{}: no sample carries both stamps", hop.name),
+        );
     };
     let hi = if p999 > lo { p999 } else { lo + 1.0 };
     let counts = histogram(&sorted, lo, hi, BINS);
@@ -68,10 +71,16 @@ fn draw_hop(area: &super::Area<'_>, hop: &Hop) -> Result<(), String> {
         .draw()
         .map_err(fail)?;
     chart
-        .draw_series(counts.iter().enumerate().filter(|(_, c)| **c > 0).map(|(i, c)| {
-            let x0 = lo + i as f64 * width;
-            Rectangle::new([(x0, floor), (x0 + width, *c as f64)], BAR.filled())
-        }))
+        .draw_series(
+            counts
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| **c > 0)
+                .map(|(i, c)| {
+                    let x0 = lo + i as f64 * width;
+                    Rectangle::new([(x0, floor), (x0 + width, *c as f64)], BAR.filled())
+                }),
+        )
         .map_err(fail)?;
     for (value, colour, name) in [(p50, P50, "p50"), (p99, P99, "p99")] {
         chart

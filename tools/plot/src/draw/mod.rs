@@ -110,9 +110,7 @@ pub fn panel(
     let all = || thinned.iter().flatten();
     let (x0, x1) = x_range.unwrap_or_else(|| padded(finite_bounds(all().map(|p| p.0))));
     let (y0, y1) = padded(finite_bounds(
-        all()
-            .filter(|p| p.0 >= x0 && p.0 <= x1)
-            .map(|p| p.1),
+        all().filter(|p| p.0 >= x0 && p.0 <= x1).map(|p| p.1),
     ));
     let mut chart = ChartBuilder::on(area)
         .caption(labels.caption, (FAMILY, 18))

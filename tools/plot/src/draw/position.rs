@@ -52,7 +52,10 @@ pub fn draw(path: &Path, data: &Extracted) -> Result<(), String> {
         track.push(Line::solid(
             "truth",
             TRUTH,
-            data.truth.iter().map(|p| (p.ned_m[1], p.ned_m[0])).collect(),
+            data.truth
+                .iter()
+                .map(|p| (p.ned_m[1], p.ned_m[0]))
+                .collect(),
         ));
     }
     let labels = Labels {
