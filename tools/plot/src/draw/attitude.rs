@@ -45,6 +45,8 @@ pub fn draw(path: &Path, data: &Extracted) -> Result<(), String> {
                 .wrapping(180.0),
             );
         }
+        // The estimate last: drawn over truth, it stays visible where the two agree.
+        lines.rotate_left(1);
         let y = format!("{} (deg)", axes[axis]);
         let labels = Labels {
             caption: axes[axis],

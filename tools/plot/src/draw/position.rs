@@ -35,6 +35,8 @@ pub fn draw(path: &Path, data: &Extracted) -> Result<(), String> {
                 data.truth.iter().map(|p| (p.t_s, p.ned_m[axis])).collect(),
             ));
         }
+        // The estimate last: drawn over truth, it stays visible where the two agree.
+        lines.rotate_left(1);
         let y = format!("{} (m)", axes[axis]);
         let labels = Labels {
             caption: axes[axis],
@@ -58,6 +60,7 @@ pub fn draw(path: &Path, data: &Extracted) -> Result<(), String> {
                 .collect(),
         ));
     }
+    track.rotate_left(1);
     let labels = Labels {
         caption: "top view",
         x: "east (m)",
