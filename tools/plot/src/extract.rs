@@ -466,6 +466,82 @@ mod tests {
         assert_eq!(fault_label(&f), "device dead (no-such-channel)");
     }
 
+    fn message<T: rins_recording::Recordable>(topic: &str, payload: &T) -> RecordedMessage {
+        RecordedMessage {
+            topic: topic.into(),
+            layout: T::layout(),
+            log_time_ns: 0,
+            publish_time_ns: 0,
+            sequence: 0,
+            payload: payload.as_bytes().to_vec(),
+        }
+    }
+
+    fn nav(seq: u64, lane: u8, mode: NavMode) -> NavState {
+        let mut header = Header {
+            origin_seq: seq,
+            origin_device_time_us: 1_000_000 + seq * 10_000,
+            origin_rx_ns: 7_000_000_000 + seq * 10_000_000,
+            ..Header::default()
+        };
+        header.stamp(Stage::Navigator, header.origin_rx_ns + 300_000);
+        NavState {
+            lane,
+            mode: mode as u8,
+            header,
+            latitude_rad: 0.8,
+            longitude_rad: 0.1,
+            altitude_m: 400.0,
+            ..NavState::default()
+        }
+    }
+
+    #[test]
+    fn lanes_merge_on_lane_0_while_usable_and_truth_matches_by_sequence() {
+        let mut c = Collector::default();
+        for seq in 0..10 {
+            let mode0 = if seq < 5 {
+                NavMode::Navigating
+            } else {
+                NavMode::Invalid
+            };
+            c.add(&message(names::NAV_LANES[0], &nav(seq, 0, mode0)));
+            c.add(&message(
+                names::NAV_LANES[1],
+                &nav(seq, 1, NavMode::Navigating),
+            ));
+        }
+        let truth = Truth {
+            header: Header {
+                origin_seq: 7,
+                origin_device_time_us: 1_070_000,
+                ..Header::default()
+            },
+            latitude_rad: 0.8,
+            longitude_rad: 0.1,
+            altitude_m: 390.0,
+            ..Truth::default()
+        };
+        c.add(&message(names::TRUTH, &truth));
+        let d = c.finish();
+        assert_eq!(d.nav.len(), 10);
+        assert_eq!(d.nav_unusable, 0);
+        let lanes: Vec<u8> = d.nav.iter().map(|p| p.lane).collect();
+        assert_eq!(lanes, [0, 0, 0, 0, 0, 1, 1, 1, 1, 1]);
+        assert_eq!(d.lane_switches.len(), 1);
+        assert_eq!(d.lane_switches[0].label, "lane 0 → 1");
+        assert!((d.lane_switches[0].t_s - 0.05).abs() < 1e-9);
+        assert_eq!(d.nav[0].t_s, 0.0);
+        assert_eq!(d.nav[0].ned_m, [0.0, 0.0, 0.0]);
+        let t = &d.truth[d.truth_by_seq[&7]];
+        assert!((t.t_s - 0.07).abs() < 1e-9);
+        assert!((t.ned_m[2] - 10.0).abs() < 1e-9, "{:?}", t.ned_m);
+        // Every navigation sample of both lanes is a latency sample of its hops.
+        assert_eq!(d.hops[3].values_us.len(), 20);
+        assert!(d.hops[3].values_us.iter().all(|v| *v == 300.0));
+        assert!(d.hops[0].values_us.is_empty());
+    }
+
     #[test]
     fn lane_changes_of_the_stream_are_switches() {
         let p = |t_s: f64, lane: u8| NavPoint {
