@@ -126,6 +126,17 @@ pub enum Command {
         #[command(subcommand)]
         what: CalibrateCommand,
     },
+    /// Plot a recording: attitude, position, errors against truth, channel states, latency (PNG).
+    Plot {
+        /// The MCAP recording.
+        file: PathBuf,
+        /// Directory the PNG files are written to (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// End with one JSON line: {"written": [...], "skipped": [...]}.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 /// The calibrations `rins calibrate` fits.

@@ -10,6 +10,7 @@ mod geometry;
 mod inject;
 mod latency;
 mod mc;
+mod plot;
 mod probe;
 mod progress;
 mod readmit;
@@ -75,5 +76,8 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Calibrate { what } => match what {
             CalibrateCommand::Mag(args) => calibrate::run_mag(&args).map(|()| ExitCode::SUCCESS),
         },
+        Command::Plot { file, out, json } => {
+            plot::run(&file, &out, json).map(|()| ExitCode::SUCCESS)
+        }
     }
 }

@@ -27,7 +27,6 @@ pub mod events;
 pub mod heartbeat;
 pub mod highres_imu;
 pub mod link;
-pub mod local_frame;
 pub mod odometry;
 pub mod position;
 pub mod rate_gate;
@@ -37,6 +36,9 @@ pub mod stream;
 pub mod sys_status;
 pub mod timesync;
 pub mod vibration;
+
+/// The local NED frame, shared with the other tools through `rins-earth`.
+pub use rins_earth::local_frame;
 
 pub use mavlink::dialects::common as dialect;
 

@@ -5,14 +5,9 @@ use std::path::Path;
 
 use anyhow::{Result, anyhow};
 use plotters::prelude::*;
-use plotters::style::FontStyle;
 
 use super::report::OperatingPoint;
 use super::roc::RocPoint;
-
-/// DejaVu Sans (Bitstream Vera licence, `assets/DejaVuSans-LICENSE.txt`): the drawing library
-/// renders text only with a font it is given, and a headless machine may have none.
-const FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
 const COLOURS: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
@@ -31,8 +26,7 @@ fn plot_error(e: impl std::fmt::Debug) -> anyhow::Error {
 
 /// Draws `points` (every configuration's curve) into `path`.
 pub fn draw_roc(path: &Path, points: &[RocPoint], operating: &[OperatingPoint]) -> Result<()> {
-    // Registering twice (a second plot in the same process) keeps the first copy: harmless.
-    let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+    rins_plot::font::register_font();
     let mut configurations: Vec<&'static str> = Vec::new();
     for p in points {
         if !configurations.contains(&p.configuration) {

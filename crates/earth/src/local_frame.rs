@@ -1,9 +1,9 @@
-//! The local NED frame of LOCAL_POSITION_NED and ODOMETRY: north, east, down in metres from an
-//! origin, the first usable solution's position. A tangent plane at the origin with the ellipsoid's
-//! radii of curvature there: for the few kilometres a small UAV flies, the error of the flat
+//! A local NED frame: north, east, down in metres from an origin (for the MAVLink local position
+//! and odometry, and for plots: the first usable solution's position). A tangent plane at the
+//! origin with the ellipsoid's radii of curvature there: for the few kilometres a small UAV flies, the error of the flat
 //! approximation (distance² / 2R, 0.08 m at 1 km) is below the solution's own.
 
-use rins_earth::wgs84::{meridian_radius, prime_vertical_radius};
+use crate::wgs84::{meridian_radius, prime_vertical_radius};
 
 /// The origin of the local frame, a geodetic position.
 #[derive(Debug, Clone, Copy, PartialEq)]
