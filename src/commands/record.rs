@@ -17,6 +17,7 @@ use rins_recording::{
 };
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{IpcNode, TopicSubscriber};
+use rins_runtime::payload::Stamped;
 use rins_runtime::shutdown::Shutdown;
 use rins_runtime::tool_node::ToolNode;
 use serde::Serialize;
@@ -82,29 +83,13 @@ macro_rules! choices {
     };
 }
 
-fn stamped<T: HasHeader>(s: &T) -> Option<u64> {
-    Some(s.origin_rx_ns())
+fn stamped<T: Stamped>(s: &T) -> Option<u64> {
+    Some(s.header().origin_rx_ns)
 }
 
 fn unstamped<T>(_: &T) -> Option<u64> {
     None
 }
-
-/// A payload with the common header.
-trait HasHeader {
-    fn origin_rx_ns(&self) -> u64;
-}
-
-macro_rules! has_header {
-    ($($t:ty),*) => {$(impl HasHeader for $t {
-        fn origin_rx_ns(&self) -> u64 {
-            self.header.origin_rx_ns
-        }
-    })*};
-}
-has_header!(
-    RawImu, RawBaro, RawMag, RawAux, FusedImu, Altitude, NavState, Truth
-);
 
 /// Every topic a recording can hold, in the order they are written to the file.
 fn all_choices() -> [TopicChoice; 15] {

@@ -21,6 +21,9 @@ pub trait Versioned {
 pub trait Stamped: Versioned {
     /// The header, for the publishing stage's stamp.
     fn header_mut(&mut self) -> &mut Header;
+
+    /// The header.
+    fn header(&self) -> &Header;
 }
 
 macro_rules! versioned {
@@ -39,6 +42,10 @@ macro_rules! stamped {
         impl Stamped for $payload {
             fn header_mut(&mut self) -> &mut Header {
                 &mut self.header
+            }
+
+            fn header(&self) -> &Header {
+                &self.header
             }
         }
     )*};
