@@ -1,12 +1,13 @@
 //! The MAVLink output as a ground station sees it: pymavlink receives the stream of a running
 //! pipeline and checks the message set, the rates, the attitude and covariance against the
 //! solution, TIMESYNC, a refused command, the STATUSTEXT of a dead gyro and the reset counter of a
-//! killed navigator lane (python/tests/mavlink_stream.py says how each is checked).
+//! killed navigator lane, and re-admission commands acknowledged with fusion's answer
+//! (python/tests/mavlink_stream.py says how each is checked).
 
 mod common;
 
 use common::python::{free_udp_port, interpreter, run_script};
-use common::{Isolated, PipelineSlot, RINS};
+use common::{Isolated, PipelineSlot, RINS, TempFile};
 
 #[test]
 fn pymavlink_receives_the_stream_a_pipeline_sends() {
