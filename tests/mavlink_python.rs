@@ -17,11 +17,16 @@ fn pymavlink_receives_the_stream_a_pipeline_sends() {
     let ipc = Isolated::new("mavpy");
     let _slot = PipelineSlot::take();
     let port = free_udp_port().to_string();
+    // The built-in configuration, taking commands from the link.
+    let accepting =
+        rins::config::BUILT_IN.replace("accept_commands = false", "accept_commands = true");
+    assert_ne!(accepting, rins::config::BUILT_IN);
+    let config = TempFile::new("mavpy", "toml", &accepting);
     let out = run_script(
         &python,
         &ipc,
         "python/tests/mavlink_stream.py",
-        &[RINS, &port],
+        &[RINS, &port, config.path()],
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
@@ -38,5 +43,9 @@ fn pymavlink_receives_the_stream_a_pipeline_sends() {
             .unwrap_or(0)
             >= 10
     );
+    // MAV_RESULT_IN_PROGRESS (5), then ACCEPTED (0) for a channel in service, FAILED (4) for one
+    // still dead.
+    assert_eq!(measured["readmit_in_service"], serde_json::json!([5, 0]));
+    assert_eq!(measured["readmit_dead"], serde_json::json!([5, 4]));
     assert!(ipc.shm_entries().is_empty(), "{:?}", ipc.shm_entries());
 }
