@@ -211,6 +211,11 @@ fn replay_live(
     lanes: u8,
 ) -> Result<[Vec<NavState>; 2]> {
     let shutdown = Shutdown::install()?;
+    // A replay into a running deployment would mix its samples with the live ones: refused, as
+    // `rins up` refuses a second deployment on one prefix.
+    let settings = rins_runtime::ipc::IpcSettings::from_env();
+    rins_watchdog::deployment_checks::ensure_no_live_deployment(&settings)
+        .context("rins replay starts a deployment of its own")?;
     let deployment = Deployment::start(args)?;
     let result = feed(input, speed, lanes, &shutdown);
     let stopped = deployment.stop();
