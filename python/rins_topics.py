@@ -136,13 +136,14 @@ def bit_names(bits: int, table: "dict[int, str]") -> "list[str]":
 # --- generated from the Rust layouts: do not edit ---
 
 #: Layout version every payload carries in `version`.
-PAYLOAD_VERSION = 6
+PAYLOAD_VERSION = 7
 
 # Topic names.
 RAW_IMU = "rins/raw/imu"
 RAW_BARO = "rins/raw/baro"
 RAW_MAG = "rins/raw/mag"
 RAW_AUX = "rins/raw/aux"
+GNSS = "rins/gnss"
 FUSED_IMU = "rins/fused/imu"
 ALTITUDE = "rins/altitude"
 NAV_STATE = "rins/nav/state"
@@ -162,6 +163,7 @@ SHORT_NAMES = {
     "raw-baro": "rins/raw/baro",
     "raw-mag": "rins/raw/mag",
     "raw-aux": "rins/raw/aux",
+    "gnss": "rins/gnss",
     "fused-imu": "rins/fused/imu",
     "altitude": "rins/altitude",
     "nav": "rins/nav/state",
@@ -241,6 +243,10 @@ class SimFault(enum.IntEnum):
     SATURATE = 6
     INTERMITTENT = 7
     DISCONNECT = 8
+    GNSS_OUTAGE = 9
+    GNSS_JUMP = 10
+    GNSS_FREEZE = 11
+    GNSS_DRIFT = 12
 
 
 class FaultOutcome(enum.IntEnum):
@@ -274,6 +280,7 @@ class ServiceKind(enum.IntEnum):
     WATCHDOG = 5
     NAVIGATOR_STANDBY = 6
     MAVLINK = 7
+    GNSS = 8
 
 
 class ServiceState(enum.IntEnum):
@@ -341,6 +348,10 @@ WIRE_NAMES = {
         6: "saturate",
         7: "intermittent",
         8: "disconnect",
+        9: "gnss-outage",
+        10: "gnss-jump",
+        11: "gnss-freeze",
+        12: "gnss-drift",
     },
     FaultOutcome: {
         0: "applied",
@@ -365,6 +376,7 @@ WIRE_NAMES = {
         5: "watchdog",
         6: "navigator-standby",
         7: "mavlink",
+        8: "gnss",
     },
     ServiceState: {
         0: "starting",
@@ -395,6 +407,7 @@ INTEGRITY_REASONS = {
     0x80: "recovering",
     0x100: "non-finite",
     0x200: "aiding-stale",
+    0x400: "gnss-inconsistent",
 }
 
 #: Bits of NavState.aiding (accepted sources), with their names.
@@ -404,12 +417,14 @@ AIDING_SOURCES = {
     0x4: "zupt",
     0x8: "hupt",
     0x10: "gravity",
+    0x20: "gnss",
 }
 
 #: Bits of NavState.aiding (stale sources), with their names.
 AIDING_STALE = {
     0x100: "baro",
     0x200: "mag",
+    0x400: "gnss",
 }
 
 #: Bits of FusedImu.flags, with their names.
@@ -522,6 +537,35 @@ class RawAux(ctypes.Structure):
         return "rins::RawAux"
 
 
+class GnssFix(ctypes.Structure):
+    """`rins::GnssFix`: 152 bytes, aligned to 8."""
+
+    _fields_ = [
+        ("version", ctypes.c_uint16),
+        ("fix_type", ctypes.c_uint8),
+        ("satellites", ctypes.c_uint8),
+        ("protocol", ctypes.c_uint8),
+        ("velocity_valid", ctypes.c_uint8),
+        ("accuracy_reported", ctypes.c_uint8),
+        ("_pad", ctypes.c_uint8 * 1),
+        ("header", Header),
+        ("receiver_time_us", ctypes.c_uint64),
+        ("latitude_rad", ctypes.c_double),
+        ("longitude_rad", ctypes.c_double),
+        ("altitude_m", ctypes.c_double),
+        ("velocity_ned_mps", ctypes.c_double * 3),
+        ("horizontal_accuracy_m", ctypes.c_double),
+        ("vertical_accuracy_m", ctypes.c_double),
+        ("speed_accuracy_mps", ctypes.c_double),
+        ("hdop", ctypes.c_double),
+    ]
+
+    @staticmethod
+    def type_name() -> str:
+        """The iceoryx2 type name of the Rust payload."""
+        return "rins::GnssFix"
+
+
 class FusedImu(ctypes.Structure):
     """`rins::FusedImu`: 232 bytes, aligned to 8."""
 
@@ -569,7 +613,7 @@ class Altitude(ctypes.Structure):
 
 
 class NavState(ctypes.Structure):
-    """`rins::NavState`: 368 bytes, aligned to 8."""
+    """`rins::NavState`: 376 bytes, aligned to 8."""
 
     _fields_ = [
         ("version", ctypes.c_uint16),
@@ -583,8 +627,8 @@ class NavState(ctypes.Structure):
         ("longitude_rad", ctypes.c_double),
         ("altitude_m", ctypes.c_double),
         ("covariance_diag", ctypes.c_double * 15),
-        ("aiding_accepted", ctypes.c_uint32 * 5),
-        ("aiding_rejected", ctypes.c_uint32 * 5),
+        ("aiding_accepted", ctypes.c_uint32 * 6),
+        ("aiding_rejected", ctypes.c_uint32 * 6),
         ("solution_start_seq", ctypes.c_uint64),
         ("gyro_bias_rps", ctypes.c_double * 3),
         ("accel_bias_mps2", ctypes.c_double * 3),
@@ -841,6 +885,7 @@ TOPIC_PAYLOADS = {
     RAW_BARO: RawBaro,
     RAW_MAG: RawMag,
     RAW_AUX: RawAux,
+    GNSS: GnssFix,
     FUSED_IMU: FusedImu,
     ALTITUDE: Altitude,
     NAV_STATE: NavState,

@@ -131,11 +131,12 @@ fn flag_tables() -> [(&'static str, &'static str, BitNames); 5] {
 }
 
 /// Every topic name, as the Python constant it becomes.
-const TOPIC_CONSTANTS: [(&str, &str); 15] = [
+const TOPIC_CONSTANTS: [(&str, &str); 16] = [
     ("RAW_IMU", names::RAW_IMU),
     ("RAW_BARO", names::RAW_BARO),
     ("RAW_MAG", names::RAW_MAG),
     ("RAW_AUX", names::RAW_AUX),
+    ("GNSS", names::GNSS),
     ("FUSED_IMU", names::FUSED_IMU),
     ("ALTITUDE", names::ALTITUDE),
     ("NAV_STATE", names::NAV_LANES[0]),

@@ -38,6 +38,16 @@ wire_enum! {
         /// port vanishes and comes back as a new one. Addresses no channel: [`SimControl::sensor`]
         /// is [`SimControl::WHOLE_DEVICE`] and `channel` 0.
         Disconnect = 8 => "disconnect",
+        /// The GNSS receiver loses its fix for `param` seconds (0: until cleared); it goes on
+        /// sending epochs without a position. Addresses [`SimControl::GNSS_RECEIVER`].
+        GnssOutage = 9 => "gnss-outage",
+        /// The GNSS position jumps `param` metres north and stays there until cleared.
+        GnssJump = 10 => "gnss-jump",
+        /// The GNSS receiver repeats its last fix for `param` seconds (0: until cleared).
+        GnssFreeze = 11 => "gnss-freeze",
+        /// The GNSS position drifts north at `param` m/s from now on (a spoofer pulling it away
+        /// slowly), until cleared; the reported velocity is left true.
+        GnssDrift = 12 => "gnss-drift",
     }
 }
 
@@ -65,6 +75,9 @@ impl SimControl {
     /// [`SimControl::sensor`] of a fault of the whole device ([`SimFault::Disconnect`]): no
     /// [`SensorType`], so that consumers of channel faults pass it by.
     pub const WHOLE_DEVICE: u8 = u8::MAX;
+    /// [`SimControl::sensor`] of a fault of the simulated GNSS receiver (the `Gnss*` faults, and
+    /// [`SimFault::Clear`] to end them); `channel` 0.
+    pub const GNSS_RECEIVER: u8 = u8::MAX - 1;
 }
 
 wire_enum! {

@@ -25,6 +25,8 @@ wire_enum! {
         NavigatorStandby = 6 => "navigator-standby",
         /// The MAVLink output, when enabled.
         Mavlink = 7 => "mavlink",
+        /// GNSS receiver acquisition, when a receiver is configured.
+        Gnss = 8 => "gnss",
     }
 }
 

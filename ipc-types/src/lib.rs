@@ -17,6 +17,7 @@ mod wire_enum;
 mod altitude;
 mod control;
 mod fused;
+mod gnss;
 mod header;
 mod health;
 mod nav;
@@ -31,6 +32,7 @@ pub use control::{
     SimFault,
 };
 pub use fused::{ChannelState, FaultReason, FusedImu, fused_flags};
+pub use gnss::{GnssFix, GnssFixType, GnssProtocol};
 pub use header::{Header, Stage};
 pub use health::{
     Health, HealthReport, LinkError, LinkReport, MAX_SUPERVISED, NavReport, RedundancyReport,
@@ -41,7 +43,7 @@ pub use raw::{MAX_TEMPERATURES, RawAux, RawBaro, RawImu, RawMag, status};
 pub use truth::Truth;
 
 /// Version of every payload layout in this crate. Bump it on any layout change.
-pub const PAYLOAD_VERSION: u16 = 6;
+pub const PAYLOAD_VERSION: u16 = 7;
 
 /// Up to this many single-axis channels per sensor type (gyro, accelerometer).
 pub const MAX_CHANNELS: usize = 16;

@@ -8,6 +8,8 @@ pub const RAW_BARO: &str = "rins/raw/baro";
 pub const RAW_MAG: &str = "rins/raw/mag";
 /// Raw auxiliary (foot-pressure) samples ([`crate::RawAux`]), from acquisition.
 pub const RAW_AUX: &str = "rins/raw/aux";
+/// GNSS receiver epochs ([`crate::GnssFix`]), from the `gnss` service.
+pub const GNSS: &str = "rins/gnss";
 /// Fused body rate and specific force ([`crate::FusedImu`]), from fusion.
 pub const FUSED_IMU: &str = "rins/fused/imu";
 /// Barometric altitude ([`crate::Altitude`]), from the altimeter.
@@ -35,11 +37,12 @@ pub const FUSION_CONTROL: &str = "rins/control/fusion";
 pub const FUSION_REPLY: &str = "rins/control/fusion/reply";
 
 /// Every published topic, with the short name `rins echo` accepts.
-pub const TOPICS: [(&str, &str); 10] = [
+pub const TOPICS: [(&str, &str); 11] = [
     ("raw-imu", RAW_IMU),
     ("raw-baro", RAW_BARO),
     ("raw-mag", RAW_MAG),
     ("raw-aux", RAW_AUX),
+    ("gnss", GNSS),
     ("fused-imu", FUSED_IMU),
     ("altitude", ALTITUDE),
     ("nav", NAV_STATE),

@@ -70,9 +70,12 @@ pub mod integrity_reason {
     pub const NON_FINITE: u32 = 1 << 8;
     /// A configured aiding source is silent: the filter coasts on the inertial solution.
     pub const AIDING_STALE: u32 = 1 << 9;
+    /// The GNSS receiver disagrees with the inertial solution (a jump, or a drift the inertial
+    /// solution does not follow): it is rejected until it is consistent again.
+    pub const GNSS_INCONSISTENT: u32 = 1 << 10;
 
     /// Every reason with its name, in bit order.
-    pub const NAMES: [(u32, &str); 10] = [
+    pub const NAMES: [(u32, &str); 11] = [
         (IMU_UNUSABLE, "imu-unusable"),
         (TIME_NOT_ADVANCING, "time-not-advancing"),
         (ALL_AIDING_REJECTED, "all-aiding-rejected"),
@@ -83,6 +86,7 @@ pub mod integrity_reason {
         (RECOVERING, "recovering"),
         (NON_FINITE, "non-finite"),
         (AIDING_STALE, "aiding-stale"),
+        (GNSS_INCONSISTENT, "gnss-inconsistent"),
     ];
 
     /// The names of the bits set in `reasons`, comma-separated (empty for none).
@@ -106,29 +110,42 @@ pub mod aiding {
     pub const HUPT: u32 = 1 << 3;
     /// The tilt is being re-levelled from gravity (after the IMU stopped propagating the attitude).
     pub const GRAVITY: u32 = 1 << 4;
+    /// GNSS position and velocity updates.
+    pub const GNSS: u32 = 1 << 5;
     /// Baro aiding is configured but no reading arrived within the aiding timeout: the altitude
     /// coasts on the inertial solution.
     pub const BARO_STALE: u32 = 1 << 8;
     /// Magnetometer aiding is configured but no reading arrived within the aiding timeout: the
     /// heading coasts on the gyros.
     pub const MAG_STALE: u32 = 1 << 9;
+    /// GNSS aiding is configured but no usable fix arrived within the aiding timeout (an outage):
+    /// the horizontal position coasts on the inertial solution, its covariance growing.
+    pub const GNSS_STALE: u32 = 1 << 10;
+    /// The GNSS receiver's fixes are rejected as inconsistent with the inertial solution (a jump
+    /// or a drift): the position coasts on the inertial solution until they agree again.
+    pub const GNSS_REJECTED: u32 = 1 << 11;
 
     /// Every source with its name, in bit order.
-    pub const SOURCE_NAMES: [(u32, &str); 5] = [
+    pub const SOURCE_NAMES: [(u32, &str); 6] = [
         (BARO, "baro"),
         (MAG, "mag"),
         (ZUPT, "zupt"),
         (HUPT, "hupt"),
         (GRAVITY, "gravity"),
+        (GNSS, "gnss"),
     ];
 
     /// Every stale-source bit with the source's name.
-    pub const STALE_NAMES: [(u32, &str); 2] = [(BARO_STALE, "baro"), (MAG_STALE, "mag")];
+    pub const STALE_NAMES: [(u32, &str); 3] = [
+        (BARO_STALE, "baro"),
+        (MAG_STALE, "mag"),
+        (GNSS_STALE, "gnss"),
+    ];
 }
 
 /// Aiding sources counted in [`NavState::aiding_accepted`] / [`NavState::aiding_rejected`], in
-/// this order: baro, mag, zupt, hupt, gravity.
-pub const AIDING_SOURCES: usize = 5;
+/// this order: baro, mag, zupt, hupt, gravity, gnss.
+pub const AIDING_SOURCES: usize = 6;
 
 /// Length of [`NavState::covariance_diag`]: attitude error, velocity, position, gyro bias, accel bias.
 pub const NAV_STATES: usize = 15;
@@ -163,7 +180,7 @@ pub struct NavState {
     /// (3, (m/s)²), position NED (3, m²), gyro bias (3, (rad/s)²), accelerometer bias (3,
     /// (m/s²)²). Zero while aligning.
     pub covariance_diag: [f64; NAV_STATES],
-    /// Updates accepted per aiding source since alignment (baro, mag, zupt, hupt, gravity).
+    /// Updates accepted per aiding source since alignment (baro, mag, zupt, hupt, gravity, gnss).
     pub aiding_accepted: [u32; AIDING_SOURCES],
     /// Updates rejected by the innovation gate per aiding source since alignment.
     pub aiding_rejected: [u32; AIDING_SOURCES],

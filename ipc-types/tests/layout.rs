@@ -1,11 +1,11 @@
 //! The payload layouts are the contract between processes built at different times: their size
 //! and alignment must not change without a new [`PAYLOAD_VERSION`]. The figures are the layouts of
-//! version 6.
+//! version 7.
 
 use std::mem::{align_of, offset_of, size_of};
 
 use rins_ipc_types::{
-    Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, Header, Health, HealthReport,
+    Altitude, FaultApplied, FusedImu, GnssFix, FusionControl, FusionReply, Header, Health, HealthReport,
     LinkReport, NavReport, NavState, PAYLOAD_VERSION, RawAux, RawBaro, RawImu, RawMag,
     RedundancyReport, ServiceHealth, SimControl, Truth,
 };
@@ -16,8 +16,8 @@ fn layout<T>() -> (usize, usize) {
 }
 
 #[test]
-fn the_layouts_are_those_of_version_6() {
-    assert_eq!(PAYLOAD_VERSION, 6);
+fn the_layouts_are_those_of_version_7() {
+    assert_eq!(PAYLOAD_VERSION, 7);
 }
 
 #[test]
@@ -29,7 +29,8 @@ fn every_payload_keeps_its_size_and_alignment() {
     assert_eq!(layout::<RawAux>(), (72, 8));
     assert_eq!(layout::<FusedImu>(), (232, 8));
     assert_eq!(layout::<Altitude>(), (88, 8));
-    assert_eq!(layout::<NavState>(), (368, 8));
+    assert_eq!(layout::<NavState>(), (376, 8));
+    assert_eq!(layout::<GnssFix>(), (152, 8));
     assert_eq!(layout::<Truth>(), (144, 8));
     assert_eq!(layout::<SimControl>(), (16, 8));
     assert_eq!(layout::<FaultApplied>(), (24, 8));
@@ -52,6 +53,7 @@ fn the_version_leads_every_payload_and_the_header_stays_in_place() {
         offset_of!(RawBaro, version),
         offset_of!(RawMag, version),
         offset_of!(RawAux, version),
+        offset_of!(GnssFix, version),
         offset_of!(FusedImu, version),
         offset_of!(Altitude, version),
         offset_of!(NavState, version),
@@ -63,16 +65,17 @@ fn the_version_leads_every_payload_and_the_header_stays_in_place() {
         offset_of!(Health, version),
         offset_of!(HealthReport, version),
     ];
-    assert_eq!(version, [0; 14]);
+    assert_eq!(version, [0; 15]);
     let header = [
         offset_of!(RawBaro, header),
         offset_of!(RawMag, header),
         offset_of!(RawAux, header),
+        offset_of!(GnssFix, header),
         offset_of!(FusedImu, header),
         offset_of!(Altitude, header),
         offset_of!(NavState, header),
         offset_of!(Truth, header),
     ];
-    assert_eq!(header, [8; 7]);
+    assert_eq!(header, [8; 8]);
     assert_eq!(offset_of!(RawImu, header), 16);
 }

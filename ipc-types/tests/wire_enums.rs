@@ -117,8 +117,32 @@ fn sim_fault() {
             (Saturate, 6, "saturate"),
             (Intermittent, 7, "intermittent"),
             (Disconnect, 8, "disconnect"),
+            (GnssOutage, 9, "gnss-outage"),
+            (GnssJump, 10, "gnss-jump"),
+            (GnssFreeze, 11, "gnss-freeze"),
+            (GnssDrift, 12, "gnss-drift"),
         ]
     );
+}
+
+#[test]
+fn gnss_fix_type() {
+    use rins_ipc_types::{GnssFixType, GnssProtocol};
+    check_wire_enum!(
+        GnssFixType,
+        from_u8,
+        [
+            (NoFix, 0, "no-fix"),
+            (DeadReckoning, 1, "dead-reckoning"),
+            (Fix2d, 2, "2d"),
+            (Fix3d, 3, "3d"),
+            (Differential, 4, "dgps"),
+            (RtkFloat, 5, "rtk-float"),
+            (RtkFixed, 6, "rtk-fixed"),
+        ]
+    );
+    check_wire_enum!(GnssProtocol, from_u8, [(Nmea, 0, "nmea"), (Ubx, 1, "ubx")]);
+    assert!(GnssFixType::Fix3d.is_3d() && !GnssFixType::Fix2d.is_3d());
 }
 
 #[test]
@@ -149,6 +173,7 @@ fn service_kind() {
             (Watchdog, 5, "watchdog"),
             (NavigatorStandby, 6, "navigator-standby"),
             (Mavlink, 7, "mavlink"),
+            (Gnss, 8, "gnss"),
         ]
     );
     assert_eq!(

@@ -6,8 +6,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Result, bail};
 use ipc_types::{
-    Altitude, FusedImu, Health, HealthReport, NavState, RawAux, RawBaro, RawImu, RawMag, Truth,
-    names,
+    Altitude, FusedImu, GnssFix, Health, HealthReport, NavState, RawAux, RawBaro, RawImu, RawMag,
+    Truth, names,
 };
 use rins_runtime::ipc::{IpcNode, SampleSource, TopicSubscriber};
 use rins_runtime::nav_subscriber::NavSubscriber;
@@ -111,7 +111,7 @@ macro_rules! received_at {
 }
 
 received_at!(
-    with header: RawImu, RawBaro, RawMag, RawAux, FusedImu, Altitude, NavState;
+    with header: RawImu, RawBaro, RawMag, RawAux, GnssFix, FusedImu, Altitude, NavState;
     // Truth comes from the simulator, not from a received frame: no receive time.
     without: Truth, Health, HealthReport
 );
@@ -207,6 +207,7 @@ pub fn run(topic: &str, count: Option<u64>, csv: bool, raw: bool, timeout_s: f64
         names::RAW_BARO => echo_topic::<RawBaro>(names::RAW_BARO, opts),
         names::RAW_MAG => echo_topic::<RawMag>(names::RAW_MAG, opts),
         names::RAW_AUX => echo_topic::<RawAux>(names::RAW_AUX, opts),
+        names::GNSS => echo_topic::<GnssFix>(names::GNSS, opts),
         names::FUSED_IMU => echo_topic::<FusedImu>(names::FUSED_IMU, opts),
         names::ALTITUDE => echo_topic::<Altitude>(names::ALTITUDE, opts),
         // The stream consumers see: both navigator lanes through the lane selector.

@@ -7,9 +7,9 @@
 //! (`"bit N"` in a list): a newer writer or a corrupted sample is shown as it is, never guessed.
 
 use ipc_types::{
-    Altitude, ChannelState, FaultReason, FusedImu, Health, HealthReport, Integrity, LinkError,
-    NavMode, NavState, RawAux, RawBaro, RawImu, RawMag, ServiceKind, ServiceState, Stage, Truth,
-    aiding, fused_flags, integrity_reason, status,
+    Altitude, ChannelState, FaultReason, FusedImu, GnssFix, Health, HealthReport, Integrity,
+    LinkError, NavMode, NavState, RawAux, RawBaro, RawImu, RawMag, ServiceKind, ServiceState,
+    Stage, Truth, aiding, fused_flags, integrity_reason, status,
 };
 use serde::Serialize;
 use serde_json::{Map, Value};
@@ -303,7 +303,7 @@ macro_rules! plain_readable {
     };
 }
 
-plain_readable!(RawBaro, RawMag, RawAux, Altitude);
+plain_readable!(RawBaro, RawMag, RawAux, GnssFix, Altitude);
 
 #[cfg(test)]
 mod tests {

@@ -7,8 +7,8 @@
 //! is the header followed by the payload's bytes, copied, with no per-field work on the hot path.
 
 use ipc_types::{
-    Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, Health, HealthReport, NavState,
-    RawAux, RawBaro, RawImu, RawMag, SimControl, Truth,
+    Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, GnssFix, Health, HealthReport,
+    NavState, RawAux, RawBaro, RawImu, RawMag, SimControl, Truth,
 };
 
 use crate::schema::{self, StructLayout};
@@ -87,6 +87,7 @@ recordable! {
     RawBaro => RAW_BARO,
     RawMag => RAW_MAG,
     RawAux => RAW_AUX,
+    GnssFix => GNSS_FIX,
     FusedImu => FUSED_IMU,
     Altitude => ALTITUDE,
     NavState => NAV_STATE,
@@ -134,6 +135,7 @@ mod tests {
         check::<RawImu>();
         check::<RawBaro>();
         check::<RawMag>();
+        check::<GnssFix>();
         check::<RawAux>();
         check::<FusedImu>();
         check::<Altitude>();

@@ -14,9 +14,9 @@
 //! (a Python `ctypes` mirror, a C header) can be written from it as well.
 
 use ipc_types::{
-    Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, Header, Health, HealthReport,
-    LinkReport, NavReport, NavState, RawAux, RawBaro, RawImu, RawMag, RedundancyReport,
-    ServiceHealth, SimControl, Truth,
+    Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, GnssFix, Header, Health,
+    HealthReport, LinkReport, NavReport, NavState, RawAux, RawBaro, RawImu, RawMag,
+    RedundancyReport, ServiceHealth, SimControl, Truth,
 };
 
 /// A primitive field type of a payload; payloads hold no `bool`, `usize` or Rust enum (enums
@@ -292,6 +292,13 @@ layout! {
         version, _pad as pad0, header, foot_pressure, _pad2 as pad1,
     }
 
+    /// [`GnssFix`], on [`ipc_types::names::GNSS`].
+    pub static GNSS_FIX: GnssFix = "GnssFix" {
+        version, fix_type, satellites, protocol, velocity_valid, accuracy_reported,
+        _pad as pad0, header, receiver_time_us, latitude_rad, longitude_rad, altitude_m,
+        velocity_ned_mps, horizontal_accuracy_m, vertical_accuracy_m, speed_accuracy_mps, hdop,
+    }
+
     /// [`FusedImu`], on [`ipc_types::names::FUSED_IMU`].
     pub static FUSED_IMU: FusedImu = "FusedImu" {
         version, n_gyro, n_accel, flags, header, rate_rps, specific_force_mps2, rate_var,
@@ -377,11 +384,12 @@ layout! {
 
 /// Every top-level payload (each starts with `version`); the nested structs are reached through
 /// their fields.
-pub static PAYLOADS: [&StructLayout; 14] = [
+pub static PAYLOADS: [&StructLayout; 15] = [
     &RAW_IMU,
     &RAW_BARO,
     &RAW_MAG,
     &RAW_AUX,
+    &GNSS_FIX,
     &FUSED_IMU,
     &ALTITUDE,
     &NAV_STATE,
@@ -409,11 +417,12 @@ pub const MAX_PAYLOAD: usize = {
 
 // A constant cannot read a static's fields, so the sizes are listed again from the types; a test
 // checks the list against `PAYLOADS`.
-const PAYLOAD_SIZES: [usize; 14] = [
+const PAYLOAD_SIZES: [usize; 15] = [
     size_of::<RawImu>(),
     size_of::<RawBaro>(),
     size_of::<RawMag>(),
     size_of::<RawAux>(),
+    size_of::<GnssFix>(),
     size_of::<FusedImu>(),
     size_of::<Altitude>(),
     size_of::<NavState>(),
@@ -617,6 +626,7 @@ mod tests {
             name::<RawBaro>(),
             name::<RawMag>(),
             name::<RawAux>(),
+            name::<GnssFix>(),
             name::<FusedImu>(),
             name::<Altitude>(),
             name::<NavState>(),

@@ -6,11 +6,12 @@ use crate::schema::{self, StructLayout};
 
 /// Every topic a recording may hold, with the layout of the payload it carries: the pipeline's
 /// outputs, both navigator lanes, supervision, and the commands with their answers.
-pub static TOPICS: [(&str, &StructLayout); 15] = [
+pub static TOPICS: [(&str, &StructLayout); 16] = [
     (names::RAW_IMU, &schema::RAW_IMU),
     (names::RAW_BARO, &schema::RAW_BARO),
     (names::RAW_MAG, &schema::RAW_MAG),
     (names::RAW_AUX, &schema::RAW_AUX),
+    (names::GNSS, &schema::GNSS_FIX),
     (names::FUSED_IMU, &schema::FUSED_IMU),
     (names::ALTITUDE, &schema::ALTITUDE),
     (names::NAV_LANES[0], &schema::NAV_STATE),

@@ -2,7 +2,7 @@
 //! once, on receipt), and the header each stage stamps with its publish time.
 
 use ipc_types::{
-    Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, Header, NavState,
+    Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, GnssFix, Header, NavState,
     PAYLOAD_VERSION, RawAux, RawBaro, RawImu, RawMag, SimControl, Truth,
 };
 
@@ -53,7 +53,7 @@ macro_rules! stamped {
 
 versioned!(FusionControl, FusionReply, SimControl, FaultApplied);
 stamped!(
-    RawImu, RawBaro, RawMag, RawAux, FusedImu, Altitude, NavState, Truth
+    RawImu, RawBaro, RawMag, RawAux, GnssFix, FusedImu, Altitude, NavState, Truth
 );
 
 #[cfg(test)]

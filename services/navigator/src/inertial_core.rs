@@ -220,6 +220,7 @@ impl AidedNavigator {
             AidingSource::Baro => self.config.baro.enabled,
             AidingSource::Mag => self.config.mag.enabled && !self.config.mag.stance_only,
             AidingSource::Zupt | AidingSource::Hupt | AidingSource::Gravity => false,
+            AidingSource::Gnss => false,
         };
         let (Some(now), Some(since)) = (self.last_time_us, self.navigating_since_us) else {
             return false;

@@ -454,5 +454,6 @@ fn inconsistency_bit(source: AidingSource) -> u32 {
         AidingSource::Zupt | AidingSource::Hupt => why::ZUPT_INCONSISTENT,
         // Never configured: it only acts while the attitude is recovered.
         AidingSource::Gravity => 0,
+        AidingSource::Gnss => why::GNSS_INCONSISTENT,
     }
 }

@@ -100,6 +100,7 @@ const SOURCE_BITS: [(AidingSource, u32); AidingSource::COUNT] = [
     (AidingSource::Zupt, aiding::ZUPT),
     (AidingSource::Hupt, aiding::HUPT),
     (AidingSource::Gravity, aiding::GRAVITY),
+    (AidingSource::Gnss, aiding::GNSS),
 ];
 
 /// The navigator of the process. Allocation-free per sample once aligned.

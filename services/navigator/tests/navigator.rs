@@ -260,12 +260,13 @@ fn output_fills_the_ipc_payload() {
             },
             AidingCounts::default(),
             AidingCounts::default(),
+            AidingCounts::default(),
         ],
         gyro_bias_rps: [1e-3, -2e-3, 3e-3],
         accel_bias_mps2: [0.1, 0.2, -0.3],
         integrity: Integrity::Degraded,
         integrity_reasons: integrity_reason::MAG_INCONSISTENT | integrity_reason::RECOVERING,
-        resets: [0, 2, 0, 0, 0],
+        resets: [0, 2, 0, 0, 0, 0],
     };
     let mut state = NavState::default();
     out.write_nav_state(&mut state);
@@ -280,8 +281,8 @@ fn output_fills_the_ipc_payload() {
     assert_eq!(state.aiding, aiding::BARO | aiding::ZUPT);
     assert_eq!(state.covariance_diag, out.covariance_diag);
     // Counts saturate rather than wrap.
-    assert_eq!(state.aiding_accepted, [5, 0, u32::MAX, 0, 0]);
-    assert_eq!(state.aiding_rejected, [1, 0, 0, 0, 0]);
+    assert_eq!(state.aiding_accepted, [5, 0, u32::MAX, 0, 0, 0]);
+    assert_eq!(state.aiding_rejected, [1, 0, 0, 0, 0, 0]);
     assert_eq!(state.quaternion, out.quaternion);
     assert_eq!(state.velocity_ned_mps, out.velocity_ned);
     assert_eq!(

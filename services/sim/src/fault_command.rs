@@ -140,6 +140,21 @@ fn arg_spec(fault: SimFault) -> Option<ArgSpec> {
             unit: "seconds the device stays unplugged, > 0 and <= 3600",
             required: true,
         }),
+        SimFault::GnssOutage | SimFault::GnssFreeze => Some(ArgSpec {
+            name: "DURATION_S",
+            unit: "seconds, >= 0 (0: until cleared)",
+            required: false,
+        }),
+        SimFault::GnssJump => Some(ArgSpec {
+            name: "METRES",
+            unit: "metres north",
+            required: true,
+        }),
+        SimFault::GnssDrift => Some(ArgSpec {
+            name: "M_PER_S",
+            unit: "metres per second north",
+            required: true,
+        }),
         SimFault::Clear | SimFault::Dead | SimFault::Stuck | SimFault::Saturate => None,
     }
 }
@@ -153,6 +168,10 @@ pub fn check_param(fault: SimFault, param: f64) -> Result<(), &'static str> {
             param.is_finite() && param > 0.0 && param <= MAX_INTERMITTENT_PERIOD_S
         }
         SimFault::Disconnect => Disconnect::new(param).is_ok(),
+        SimFault::GnssOutage | SimFault::GnssFreeze => {
+            param.is_finite() && (0.0..=MAX_INTERMITTENT_PERIOD_S).contains(&param)
+        }
+        SimFault::GnssJump | SimFault::GnssDrift => param.is_finite(),
         SimFault::Clear | SimFault::Dead | SimFault::Stuck | SimFault::Saturate => true,
     };
     if ok {
@@ -164,6 +183,7 @@ pub fn check_param(fault: SimFault, param: f64) -> Result<(), &'static str> {
         }
         SimFault::Intermittent => "must be > 0 and <= 3600 seconds",
         SimFault::Disconnect => DURATION_RANGE,
+        SimFault::GnssOutage | SimFault::GnssFreeze => "must be >= 0 and <= 3600 seconds",
         _ => "must be a finite number",
     })
 }
@@ -319,8 +339,12 @@ impl FaultCommand {
                 period_s: p,
                 dropout_s: 0.5 * p,
             }),
-            // Never a channel's fault: `new` and `from_control` refuse it, so nothing to set.
-            SimFault::Disconnect => None,
+            // Never a channel's fault: `new` and `from_control` refuse them, so nothing to set.
+            SimFault::Disconnect
+            | SimFault::GnssOutage
+            | SimFault::GnssJump
+            | SimFault::GnssFreeze
+            | SimFault::GnssDrift => None,
         }
     }
 }

@@ -200,7 +200,10 @@ impl Monitor {
             ServiceKind::Altimeter => topic("alt"),
             ServiceKind::Navigator => Some(self.nav.lane_totals()[0]),
             ServiceKind::NavigatorStandby => Some(self.nav.lane_totals()[1]),
-            ServiceKind::Simulator | ServiceKind::Watchdog | ServiceKind::Mavlink => None,
+            ServiceKind::Simulator
+            | ServiceKind::Watchdog
+            | ServiceKind::Mavlink
+            | ServiceKind::Gnss => None,
         }
     }
 
@@ -215,7 +218,8 @@ impl Monitor {
             ServiceKind::Acquisition
             | ServiceKind::Simulator
             | ServiceKind::Watchdog
-            | ServiceKind::Mavlink => None,
+            | ServiceKind::Mavlink
+            | ServiceKind::Gnss => None,
         }
     }
 

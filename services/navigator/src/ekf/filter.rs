@@ -25,11 +25,13 @@ pub enum AidingSource {
     /// Tilt from the specific force: its direction as gravity's (a quasi-static vehicle, or the
     /// AHRS updates of `[navigator.tilt]`), or its body x/y part as rotor drag (multirotor).
     Gravity = 4,
+    /// GNSS receiver position and velocity.
+    Gnss = 5,
 }
 
 impl AidingSource {
     /// Number of sources, the length of per-source arrays.
-    pub const COUNT: usize = 5;
+    pub const COUNT: usize = 6;
     /// Every source, in index order.
     pub const ALL: [AidingSource; Self::COUNT] = [
         AidingSource::Baro,
@@ -37,6 +39,7 @@ impl AidingSource {
         AidingSource::Zupt,
         AidingSource::Hupt,
         AidingSource::Gravity,
+        AidingSource::Gnss,
     ];
 
     /// Lower-case name for logs and reports.
@@ -47,6 +50,7 @@ impl AidingSource {
             AidingSource::Zupt => "zupt",
             AidingSource::Hupt => "hupt",
             AidingSource::Gravity => "gravity",
+            AidingSource::Gnss => "gnss",
         }
     }
 }

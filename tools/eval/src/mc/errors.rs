@@ -203,7 +203,7 @@ mod tests {
             accel_bias_mps2: [0.0; 3],
             integrity: ipc_types::Integrity::Ok,
             integrity_reasons: 0,
-            resets: [0; 5],
+            resets: [0; 6],
         }
     }
 
