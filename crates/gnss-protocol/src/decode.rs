@@ -1,0 +1,1 @@
+//! Receiver byte stream → epochs.

@@ -1,0 +1,1 @@
+//! Epochs → receiver messages, for the simulated receiver.
