@@ -5,9 +5,9 @@
 use std::mem::{align_of, offset_of, size_of};
 
 use rins_ipc_types::{
-    Altitude, FaultApplied, FusedImu, GnssFix, FusionControl, FusionReply, Header, Health, HealthReport,
-    LinkReport, NavReport, NavState, PAYLOAD_VERSION, RawAux, RawBaro, RawImu, RawMag,
-    RedundancyReport, ServiceHealth, SimControl, Truth,
+    Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, GnssFix, Header, Health,
+    HealthReport, LinkReport, NavReport, NavState, PAYLOAD_VERSION, RawAux, RawBaro, RawImu,
+    RawMag, RedundancyReport, ServiceHealth, SimControl, Truth,
 };
 
 /// Size and alignment in bytes of `T`.

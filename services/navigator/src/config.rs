@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 use crate::alignment::AlignConfig;
 use crate::baro_height::BaroAidingConfig;
 use crate::ekf::EkfNoise;
+use crate::gnss_config::GnssAidingConfig;
 use crate::inertial_core::{AidedConfig, ZuptConfig};
 use crate::integrity::IntegrityConfig;
 use crate::mag_calibration::MagCalibration;
@@ -57,6 +58,8 @@ pub struct NavigatorConfig {
     pub mag: MagAidingConfig,
     /// Tilt updates from the specific force, the AHRS (`[navigator.tilt]`).
     pub tilt: TiltAidingConfig,
+    /// GNSS position and velocity updates (`[navigator.gnss]`).
+    pub gnss: GnssAidingConfig,
     /// Hard- and soft-iron correction of the magnetometer (`[navigator.mag_calibration]`, as
     /// printed by `rins calibrate mag`).
     pub mag_calibration: MagCalibration,
@@ -87,6 +90,7 @@ impl Default for NavigatorConfig {
             baro: BaroAidingConfig::default(),
             mag: MagAidingConfig::default(),
             tilt: TiltAidingConfig::default(),
+            gnss: GnssAidingConfig::default(),
             mag_calibration: MagCalibration::default(),
             integrity: IntegrityConfig::default(),
         }
@@ -215,6 +219,14 @@ impl NavigatorConfig {
             )
             .within("navigator.mag"));
         }
+        if let Err((field, value)) = self.gnss.check() {
+            return Err(ConfigError::new(
+                field,
+                value,
+                "out of range (delay_s in [0, 0.5], |lever_arm_m| <= 100, others finite and > 0)",
+            )
+            .within("navigator.gnss"));
+        }
         if let Err((field, value)) = self.tilt.check() {
             return Err(
                 ConfigError::new(field, value, "must be finite and > 0 (the gains >= 0)")
@@ -254,6 +266,7 @@ impl NavigatorConfig {
             baro: self.baro,
             mag: self.mag,
             tilt: self.tilt,
+            gnss: self.gnss,
             mag_calibration: self.mag_calibration,
             stale_after_s: self.aiding_timeout_s,
             declination_rad: self.declination_deg.to_radians(),

@@ -14,6 +14,8 @@ use crate::alignment::{AlignConfig, AlignError, Alignment, StaticAligner};
 use crate::attitude_recovery::AttitudeRecovery;
 use crate::baro_height::BaroAidingConfig;
 use crate::ekf::{AidingSource, EkfNoise, ErrorStateEkf, UpdateOutcome};
+use crate::gnss_config::GnssAidingConfig;
+use crate::gnss_updates::GnssAidingState;
 use crate::integrity::{IntegrityConfig, IntegrityMonitor};
 use crate::mag_calibration::MagCalibration;
 use crate::mag_heading::{FieldReference, MagAidingConfig};
@@ -63,6 +65,8 @@ pub struct AidedConfig {
     pub mag: MagAidingConfig,
     /// Tilt updates from the specific force (AHRS).
     pub tilt: TiltAidingConfig,
+    /// GNSS position and velocity updates.
+    pub gnss: GnssAidingConfig,
     /// Applied to every magnetometer sample before use.
     pub mag_calibration: MagCalibration,
     /// An aiding source whose last reading is older than this is stale: the filter coasts on the
@@ -84,6 +88,7 @@ impl AidedConfig {
         on[AidingSource::Mag as usize] = self.mag.enabled && !self.mag.stance_only;
         on[AidingSource::Zupt as usize] = self.zupt.enabled;
         on[AidingSource::Hupt as usize] = self.mag.enabled && self.mag.stance_only;
+        on[AidingSource::Gnss as usize] = self.gnss.enabled;
         on
     }
 }
@@ -156,6 +161,8 @@ pub struct AidedNavigator {
     attitude_recovery: AttitudeRecovery,
     /// Tilt updates in normal navigation (see [`crate::tilt_aiding`]).
     tilt: TiltAiding,
+    /// GNSS aiding: state history and the receiver's consistency monitor.
+    pub(crate) gnss: GnssAidingState,
 }
 
 impl AidedNavigator {
@@ -181,6 +188,7 @@ impl AidedNavigator {
             integrity: IntegrityMonitor::new(config.integrity, config.configured_sources()),
             attitude_recovery: AttitudeRecovery::default(),
             tilt: TiltAiding::default(),
+            gnss: GnssAidingState::new(config.gnss),
         }
     }
 
@@ -209,6 +217,7 @@ impl AidedNavigator {
             IntegrityMonitor::new(self.config.integrity, self.config.configured_sources());
         self.attitude_recovery = AttitudeRecovery::default();
         self.tilt.reset();
+        self.gnss.reset(self.config.gnss);
         self.phase = Phase::Navigating(ekf);
     }
 
@@ -220,7 +229,7 @@ impl AidedNavigator {
             AidingSource::Baro => self.config.baro.enabled,
             AidingSource::Mag => self.config.mag.enabled && !self.config.mag.stance_only,
             AidingSource::Zupt | AidingSource::Hupt | AidingSource::Gravity => false,
-            AidingSource::Gnss => false,
+            AidingSource::Gnss => self.config.gnss.enabled,
         };
         let (Some(now), Some(since)) = (self.last_time_us, self.navigating_since_us) else {
             return false;
@@ -253,6 +262,11 @@ impl AidedNavigator {
             Phase::Aligning(aligner) => Some(aligner),
             Phase::Navigating(_) => None,
         }
+    }
+
+    /// The GNSS receiver's consistency monitor.
+    pub fn gnss_monitor(&self) -> &crate::gnss_monitor::GnssMonitor {
+        &self.gnss.monitor
     }
 
     /// Device time of the last IMU sample, µs.
@@ -384,6 +398,9 @@ impl AidedNavigator {
                         .on_update(AidingSource::Zupt, t_us, result, 3);
                     step.zupt = Some(result);
                 }
+                if self.config.gnss.enabled && outcome.is_applied() {
+                    self.gnss.history.record(t_us, ekf, rate);
+                }
             }
         }
         step
@@ -408,7 +425,23 @@ impl AidedNavigator {
     pub fn evaluate_integrity(&mut self) -> (Integrity, u32) {
         let stale = AidingSource::ALL.map(|s| self.is_stale(s));
         match &self.phase {
-            Phase::Navigating(ekf) => self.integrity.evaluate(ekf, stale),
+            Phase::Navigating(ekf) => {
+                let (integrity, reasons) = self.integrity.evaluate(ekf, stale);
+                // A receiver judged inconsistent leaves the solution usable (it coasts on the
+                // inertial one) but no longer vouched for by every source.
+                if self.gnss.monitor.rejected().is_some() {
+                    let degraded = match integrity {
+                        Integrity::Ok => Integrity::Degraded,
+                        other => other,
+                    };
+                    (
+                        degraded,
+                        reasons | ipc_types::integrity_reason::GNSS_INCONSISTENT,
+                    )
+                } else {
+                    (integrity, reasons)
+                }
+            }
             Phase::Aligning(_) => (Integrity::Invalid, 0),
         }
     }
@@ -449,6 +482,7 @@ impl AidedNavigator {
             .and_then(|m| FieldReference::from_field(&m, &a.attitude));
         self.alignment = Some(a);
         self.navigating_since_us = self.last_time_us;
+        self.gnss.reset(self.config.gnss);
         self.phase = Phase::Navigating(ekf);
     }
 }

@@ -1,5 +1,6 @@
 //! Navigator core: static alignment, quaternion strapdown mechanisation, the error-state EKF and its
-//! aiding (baro height, magnetometer heading, zero-velocity updates, tilt from the specific force).
+//! aiding (baro height, magnetometer heading, zero-velocity updates, tilt from the specific force,
+//! GNSS position and velocity).
 //!
 //! Pure functions and small structs, no I/O. Frames: NED navigation, FRD body; quaternions rotate
 //! body → NED (Hamilton, scalar first); SI units inside, degrees only in [`NavigatorConfig`].
@@ -14,6 +15,10 @@ mod checks;
 pub mod config;
 pub mod ekf;
 pub mod force_window;
+pub mod gnss_config;
+pub mod gnss_hold;
+pub mod gnss_monitor;
+pub mod gnss_updates;
 pub mod inertial_core;
 pub mod integrity;
 pub mod mag_calibration;
@@ -22,6 +27,7 @@ pub mod mechanisation;
 pub mod navigator;
 pub mod service;
 pub mod stance;
+pub mod state_history;
 pub mod takeover;
 pub mod tilt_aiding;
 

@@ -25,6 +25,7 @@ use crate::attitude::quaternion_to_array;
 use crate::baro_mag_updates::AidingOutcome;
 use crate::config::{ConfigError, NavigatorConfig};
 use crate::ekf::{AidingCounts, AidingSource, ErrorStateEkf};
+use crate::gnss_updates::{GnssMeasurement, GnssOutcome};
 use crate::inertial_core::AidedNavigator;
 use crate::mechanisation::{NominalState, StepOutcome};
 use crate::takeover::{TakeOverError, peer_solution};
@@ -251,6 +252,16 @@ impl Navigator {
             .on_baro(device_time_us, height_m, variance_m2, valid)
     }
 
+    /// One GNSS receiver fix, measured at device time `t_us` (see [`AidedNavigator::on_gnss`]).
+    pub fn on_gnss(&mut self, fix: &ipc_types::GnssFix, t_us: u64) -> GnssOutcome {
+        self.core.on_gnss(&GnssMeasurement::from_fix(fix, t_us))
+    }
+
+    /// The GNSS receiver's consistency monitor.
+    pub fn gnss_monitor(&self) -> &crate::gnss_monitor::GnssMonitor {
+        self.core.gnss_monitor()
+    }
+
     /// The current solution (a level, at-rest placeholder at the configured position while aligning).
     pub fn output(&self) -> NavOutput {
         let placeholder;
@@ -291,6 +302,7 @@ impl Navigator {
             for (source, bit) in [
                 (AidingSource::Baro, aiding::BARO_STALE),
                 (AidingSource::Mag, aiding::MAG_STALE),
+                (AidingSource::Gnss, aiding::GNSS_STALE),
             ] {
                 if self.core.is_stale(source) {
                     aiding_bits |= bit;
@@ -302,8 +314,14 @@ impl Navigator {
             }
             // An invalid solution is aided by nothing: whatever was accepted before no longer
             // vouches for it.
+            if self.core.gnss_monitor().rejected().is_some() {
+                aiding_bits |= aiding::GNSS_REJECTED;
+            }
             if integrity == Integrity::Invalid {
-                aiding_bits &= aiding::BARO_STALE | aiding::MAG_STALE;
+                aiding_bits &= aiding::BARO_STALE
+                    | aiding::MAG_STALE
+                    | aiding::GNSS_STALE
+                    | aiding::GNSS_REJECTED;
             }
         }
         NavOutput {

@@ -6,8 +6,8 @@ use std::time::Duration;
 
 use anyhow::{Result, bail};
 use ipc_types::{
-    Altitude, FusedImu, Health, Integrity, NavMode, NavState, PAYLOAD_VERSION, RawMag, ServiceKind,
-    Stage, integrity_reason, names,
+    Altitude, FusedImu, GnssFix, Health, Integrity, NavMode, NavState, PAYLOAD_VERSION, RawMag,
+    ServiceKind, Stage, integrity_reason, names,
 };
 use rins_runtime::ipc::{IpcError, TopicSubscriber};
 use rins_runtime::service::{Service, ServiceContext};
@@ -16,6 +16,8 @@ use rins_runtime::stage_loop::{PipelineStage, StageLoop, StageTopics, Step};
 
 use crate::aiding_queue::{AidingQueue, Reading};
 use crate::ekf::AidingSource;
+use crate::gnss_hold::GnssHold;
+use crate::gnss_monitor::{RejectReason, Transition};
 use crate::navigator::{Navigator, fused_sample_usable};
 use crate::takeover::Handover;
 
@@ -119,12 +121,39 @@ fn log_resets(before: [u64; AidingSource::COUNT], now: [u64; AidingSource::COUNT
     }
 }
 
+/// A change of the GNSS receiver's standing (rare: logged off the per-sample path).
+fn log_gnss(transition: Option<Transition>) {
+    match transition {
+        Some(Transition::Rejected { t_us, reason }) => {
+            let why = match reason {
+                RejectReason::Jump => "its fixes jumped away from the inertial solution",
+                RejectReason::Drift => "its fixes drift away from the inertial solution",
+            };
+            tracing::warn!(
+                device_time_us = t_us,
+                "GNSS receiver rejected: {why}; coasting on the inertial solution"
+            );
+        }
+        Some(Transition::Readmitted { t_us }) => tracing::info!(
+            device_time_us = t_us,
+            "GNSS receiver re-admitted: its fixes agree with the inertial solution again"
+        ),
+        None => {}
+    }
+}
+
 /// The navigator as a stage of the pipeline: one navigation state per fused IMU sample, the
 /// aiding topics read before each sample, the peer lane listened to while aligning.
 struct NavigatorStage {
     nav: Navigator,
     alt_in: StageInput<Altitude>,
     mag_in: StageInput<RawMag>,
+    /// Receiver fixes, when GNSS aiding is on.
+    gnss_in: Option<StageInput<GnssFix>>,
+    /// Fixes waiting for the IMU stream to place them.
+    gnss_hold: GnssHold,
+    /// The receiver's last change of standing, already logged.
+    gnss_transition: Option<Transition>,
     /// The other lane's output, with two lanes.
     peer_in: Option<TopicSubscriber<NavState>>,
     /// Whether this batch listens to the peer (the lane aligns and has one).
@@ -152,6 +181,10 @@ impl PipelineStage for NavigatorStage {
         })?;
         self.mag_in
             .drain(counters, |mag| queue.hold(Reading::from_mag(&mag), nav))?;
+        if let Some(gnss_in) = &self.gnss_in {
+            let hold = &mut self.gnss_hold;
+            gnss_in.drain(counters, |fix| hold.push(fix))?;
+        }
         Ok(())
     }
 
@@ -174,6 +207,14 @@ impl PipelineStage for NavigatorStage {
         }
         self.aiding
             .release_to(imu.header.origin_device_time_us, &mut self.nav);
+        let nav = &mut self.nav;
+        self.gnss_hold.release(
+            imu.header.origin_device_time_us,
+            imu.header.origin_rx_ns,
+            |fix, t_us| {
+                let _ = nav.on_gnss(fix, t_us);
+            },
+        );
         let taken_over = if self.listening && self.nav.mode() == NavMode::Aligning {
             self.handover.push_imu(*imu);
             take_over_if_ready(&mut self.nav, &mut self.handover, &mut self.last)
@@ -202,6 +243,11 @@ impl PipelineStage for NavigatorStage {
                 state.header.origin_device_time_us,
             );
             self.resets = self.nav.resets();
+        }
+        let transition = self.nav.gnss_monitor().last_transition();
+        if transition != self.gnss_transition {
+            log_gnss(transition);
+            self.gnss_transition = transition;
         }
         self.last = *state;
     }
@@ -259,7 +305,15 @@ impl Service for NavigatorService {
             )?),
             _ => None,
         };
+        let gnss = self.navigator.config().gnss;
+        let gnss_in = match gnss.enabled {
+            true => Some(StageInput::new(&node, names::GNSS)?),
+            false => None,
+        };
         let mut stage = NavigatorStage {
+            gnss_in,
+            gnss_hold: GnssHold::new(gnss.delay_s),
+            gnss_transition: None,
             resets: self.navigator.resets(),
             nav: self.navigator,
             alt_in: StageInput::new(&node, names::ALTITUDE)?,

@@ -89,6 +89,21 @@ impl UpdateOutcome {
     }
 }
 
+/// Every correction the filter has injected into the position and velocity so far, on its own
+/// clock: what a state remembered from the past lacks to be corrected like the present one (see
+/// [`crate::state_history`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct CorrectionTotals {
+    /// Time the filter has propagated, s (the sum of the applied steps).
+    pub elapsed_s: f64,
+    /// Sum of the position corrections, NED m.
+    pub position_ned_m: Vector3<f64>,
+    /// Sum of the velocity corrections, NED m/s.
+    pub velocity_ned_mps: Vector3<f64>,
+    /// Sum of each velocity correction times the elapsed time it was made at, NED m·s/s.
+    pub velocity_time: Vector3<f64>,
+}
+
 /// Error-state EKF around a [`Strapdown`] mechanisation. Allocation-free.
 #[derive(Debug, Clone)]
 pub struct ErrorStateEkf {
@@ -96,6 +111,7 @@ pub struct ErrorStateEkf {
     p: Covariance,
     noise: EkfNoise,
     counts: [AidingCounts; AidingSource::COUNT],
+    corrections: CorrectionTotals,
 }
 
 /// `[v×]`, the matrix of `x ↦ v × x`.
@@ -130,7 +146,13 @@ impl ErrorStateEkf {
             p: Covariance::from_diagonal(&diagonal),
             noise,
             counts: [AidingCounts::default(); AidingSource::COUNT],
+            corrections: CorrectionTotals::default(),
         }
+    }
+
+    /// The corrections injected so far, on the filter's own clock.
+    pub fn corrections(&self) -> &CorrectionTotals {
+        &self.corrections
     }
 
     /// The nominal state: attitude, velocity and position.
@@ -232,7 +254,22 @@ impl ErrorStateEkf {
             }
         }
         self.p = (p + p.transpose()) * 0.5;
+        self.corrections.elapsed_s += dt_s;
         outcome
+    }
+
+    /// The innovation covariance `H P Hᵀ + R` of a measurement and the innovation's squared
+    /// Mahalanobis distance; `None` when it is not positive definite. Nothing is applied: a
+    /// monitor judges a measurement with it before (or instead of) [`Self::update`].
+    pub fn innovation_test<const M: usize>(
+        &self,
+        h: &SMatrix<f64, M, STATES>,
+        innovation: &SVector<f64, M>,
+        r: &SMatrix<f64, M, M>,
+    ) -> Option<(SMatrix<f64, M, M>, f64)> {
+        let s = h * self.p * h.transpose() + r;
+        let chol = s.cholesky()?;
+        Some((s, innovation.dot(&chol.solve(innovation))))
     }
 
     /// Applies measurement `innovation = z − h(x̂)` with Jacobian `h` and noise `r` when its
@@ -276,6 +313,11 @@ impl ErrorStateEkf {
         q.renormalize();
         s.attitude = q;
         s.velocity_ned += d_v;
+        let d_p = Vector3::new(dx[POS], dx[POS + 1], dx[POS + 2]);
+        let totals = &mut self.corrections;
+        totals.position_ned_m += d_p;
+        totals.velocity_ned_mps += d_v;
+        totals.velocity_time += d_v * totals.elapsed_s;
         let cos_lat = s.lat.cos().max(MIN_COS_LATITUDE);
         s.lat = (s.lat + dx[POS] / (meridian_radius(s.lat) + s.alt))
             .clamp(-std::f64::consts::FRAC_PI_2, std::f64::consts::FRAC_PI_2);

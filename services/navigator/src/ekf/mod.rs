@@ -19,10 +19,11 @@
 //! as the identity, accurate to first order in the small corrections).
 
 mod filter;
+pub mod gnss;
 mod measurements;
 mod noise;
 
-pub use filter::{AidingCounts, AidingSource, ErrorStateEkf, UpdateOutcome};
+pub use filter::{AidingCounts, AidingSource, CorrectionTotals, ErrorStateEkf, UpdateOutcome};
 pub use measurements::heading_jacobian;
 pub use noise::EkfNoise;
 

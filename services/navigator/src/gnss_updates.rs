@@ -1,0 +1,221 @@
+//! GNSS position and velocity updates of the [`AidedNavigator`]: each fix compared with the
+//! filter's state at the instant the receiver measured (see [`crate::state_history`]), judged by
+//! the consistency monitor ([`crate::gnss_monitor`]), and applied when the receiver is believed.
+
+use ipc_types::{GnssFix, GnssFixType};
+use nalgebra::Vector3;
+
+use crate::ekf::gnss::{Linearised, antenna_position, antenna_velocity};
+use crate::ekf::{AidingSource, ErrorStateEkf, POS, UpdateOutcome};
+use crate::gnss_monitor::Verdict;
+use crate::inertial_core::AidedNavigator;
+use crate::state_history::HistoryError;
+
+/// One receiver fix, placed on the device time base.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GnssMeasurement {
+    /// Device time of the instant the receiver measured, µs.
+    pub t_us: u64,
+    /// The receiver's own time of the fix, µs: a fix whose time does not advance is a repeat.
+    pub receiver_time_us: u64,
+    /// The receiver has a three-dimensional fix from the satellites.
+    pub fix_3d: bool,
+    /// Antenna latitude, longitude (rad) and altitude (m).
+    pub position: [f64; 3],
+    /// Antenna velocity NED, m/s, when reported.
+    pub velocity_ned: Option<[f64; 3]>,
+    /// Reported horizontal σ per axis, m.
+    pub sigma_h_m: f64,
+    /// Reported vertical σ, m.
+    pub sigma_v_m: f64,
+    /// Reported velocity σ per axis, m/s.
+    pub sigma_vel_mps: f64,
+}
+
+impl GnssMeasurement {
+    /// The measurement of `fix`, whose receiver measured at device time `t_us`.
+    pub fn from_fix(fix: &GnssFix, t_us: u64) -> Self {
+        let fix_3d = GnssFixType::from_u8(fix.fix_type).is_some_and(GnssFixType::is_3d);
+        Self {
+            t_us,
+            receiver_time_us: fix.receiver_time_us,
+            fix_3d,
+            position: [fix.latitude_rad, fix.longitude_rad, fix.altitude_m],
+            velocity_ned: (fix.velocity_valid != 0).then_some(fix.velocity_ned_mps),
+            sigma_h_m: fix.horizontal_accuracy_m,
+            sigma_v_m: fix.vertical_accuracy_m,
+            sigma_vel_mps: fix.speed_accuracy_mps,
+        }
+    }
+
+    fn is_finite(&self) -> bool {
+        self.position.iter().all(|x| x.is_finite())
+            && self
+                .velocity_ned
+                .is_none_or(|v| v.iter().all(|x| x.is_finite()))
+    }
+}
+
+/// What became of one fix.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GnssOutcome {
+    /// Position (and velocity) applied; `d2` is the position innovation's squared Mahalanobis
+    /// distance.
+    Applied {
+        /// Squared Mahalanobis distance of the position innovation.
+        d2: f64,
+    },
+    /// The receiver came back after a rejection; this fix was applied.
+    Readmitted,
+    /// Outside the gate, alone so far: skipped.
+    Outlier,
+    /// The receiver is judged inconsistent: skipped.
+    Rejected,
+    /// No three-dimensional fix, or values that are not numbers: nothing to apply.
+    NoFix,
+    /// The receiver's time did not advance (a frozen receiver repeating itself): skipped.
+    Repeated,
+    /// Measured before the oldest remembered state: skipped.
+    TooOld,
+    /// GNSS aiding is off, or the filter is not navigating yet.
+    NotUsed,
+}
+
+impl AidedNavigator {
+    /// One receiver fix (see [`GnssMeasurement`]).
+    pub fn on_gnss(&mut self, m: &GnssMeasurement) -> GnssOutcome {
+        let c = self.config.gnss;
+        if !c.enabled || !self.is_navigating() {
+            return GnssOutcome::NotUsed;
+        }
+        if !m.fix_3d || !m.is_finite() {
+            return GnssOutcome::NoFix;
+        }
+        if self
+            .gnss
+            .last_receiver_time_us
+            .is_some_and(|last| m.receiver_time_us <= last)
+        {
+            return GnssOutcome::Repeated;
+        }
+        self.gnss.last_receiver_time_us = Some(m.receiver_time_us);
+        self.last_reading_us[AidingSource::Gnss as usize] = Some(m.t_us);
+        let Some(ekf) = self.ekf() else {
+            return GnssOutcome::NotUsed;
+        };
+        let past = match self.gnss.history.at(m.t_us, ekf.corrections()) {
+            Ok(past) => past,
+            Err(HistoryError::TooOld | HistoryError::Empty) => return GnssOutcome::TooOld,
+        };
+        let arm = Vector3::from(c.lever_arm_m);
+        let position = antenna_position(
+            &past,
+            m.position,
+            &arm,
+            floor(m.sigma_h_m, c.sigma_horizontal_floor_m),
+            floor(m.sigma_v_m, c.sigma_vertical_floor_m),
+        );
+        let Some((s, d2)) = ekf.innovation_test(&position.h, &position.innovation, &position.r)
+        else {
+            return GnssOutcome::Outlier;
+        };
+        let normalised = [0, 1].map(|k| position.innovation[k] / s[(k, k)].max(0.0).sqrt());
+        // A rejected receiver is judged against the uncertainty the solution had when it was
+        // rejected: the coast makes the covariance grow until any offset looks consistent, and
+        // a receiver that jumped 50 m and stayed there must not come back because of that.
+        let d2 = match self.gnss.rejected_position_cov {
+            Some(frozen) if self.gnss.monitor.rejected().is_some() => {
+                (frozen + position.r).cholesky().map_or(f64::INFINITY, |c| {
+                    position.innovation.dot(&c.solve(&position.innovation))
+                })
+            }
+            _ => d2,
+        };
+        let p_pos = ekf.covariance().fixed_view::<3, 3>(POS, POS).into_owned();
+        let verdict = self.gnss.monitor.judge(m.t_us, d2, normalised);
+        if verdict == Verdict::Rejected && self.gnss.rejected_position_cov.is_none() {
+            self.gnss.rejected_position_cov = Some(p_pos);
+        }
+        if verdict == Verdict::Readmitted {
+            self.gnss.rejected_position_cov = None;
+        }
+        let readmitted = match verdict {
+            Verdict::Use => false,
+            Verdict::Readmitted => true,
+            Verdict::Outlier => return GnssOutcome::Outlier,
+            Verdict::Rejected => return GnssOutcome::Rejected,
+        };
+        let velocity = m.velocity_ned.filter(|_| c.use_velocity).map(|v| {
+            antenna_velocity(
+                &past,
+                v,
+                &arm,
+                floor(m.sigma_vel_mps, c.sigma_velocity_floor_mps),
+            )
+        });
+        let Some(ekf) = self.ekf_mut() else {
+            return GnssOutcome::NotUsed;
+        };
+        // Re-admitted after coasting: the first fix is applied whatever the gate says (it was
+        // consistent for `readmit_after_s`, the gate only measures how far the coast went).
+        let gate = if readmitted { f64::INFINITY } else { c.gate };
+        let outcome = apply(ekf, &position, gate);
+        if let Some(v) = velocity {
+            let _ = apply(ekf, &v, gate);
+        }
+        if outcome.is_accepted() {
+            self.last_accepted_us[AidingSource::Gnss as usize] = Some(m.t_us);
+        }
+        match (readmitted, outcome) {
+            (true, _) => GnssOutcome::Readmitted,
+            (false, UpdateOutcome::Accepted { d2 }) => GnssOutcome::Applied { d2 },
+            (false, _) => GnssOutcome::Outlier,
+        }
+    }
+}
+
+fn apply(ekf: &mut ErrorStateEkf, m: &Linearised, gate: f64) -> UpdateOutcome {
+    ekf.update(AidingSource::Gnss, &m.h, &m.innovation, &m.r, gate)
+}
+
+/// The reported σ, raised to `min` (a σ that is not a number is `min`).
+fn floor(sigma: f64, min: f64) -> f64 {
+    if sigma.is_finite() {
+        sigma.max(min)
+    } else {
+        min
+    }
+}
+
+/// What the navigator keeps for its GNSS aiding.
+#[derive(Debug, Clone)]
+pub(crate) struct GnssAidingState {
+    /// Recent states, for fixes measured before the IMU stream's present.
+    pub(crate) history: crate::state_history::StateHistory,
+    /// Whether the receiver is believed.
+    pub(crate) monitor: crate::gnss_monitor::GnssMonitor,
+    /// The receiver time of the last fix taken, µs.
+    pub(crate) last_receiver_time_us: Option<u64>,
+    /// The position covariance when the receiver was rejected, which judges its return.
+    pub(crate) rejected_position_cov: Option<nalgebra::Matrix3<f64>>,
+}
+
+impl GnssAidingState {
+    pub(crate) fn new(config: crate::gnss_config::GnssAidingConfig) -> Self {
+        Self {
+            history: crate::state_history::StateHistory::default(),
+            monitor: crate::gnss_monitor::GnssMonitor::new(config),
+            last_receiver_time_us: None,
+            rejected_position_cov: None,
+        }
+    }
+
+    /// Forgets everything for a new solution, keeping the history's storage (no allocation on
+    /// the sample that starts navigation).
+    pub(crate) fn reset(&mut self, config: crate::gnss_config::GnssAidingConfig) {
+        self.history.clear();
+        self.monitor = crate::gnss_monitor::GnssMonitor::new(config);
+        self.last_receiver_time_us = None;
+        self.rejected_position_cov = None;
+    }
+}
