@@ -1,10 +1,13 @@
 //! Detection and isolation of injected faults, measured in device time from the simulator's
 //! fault events and fusion's per-channel states; and false alarms: channels leaving Ok, or
 //! fusion reporting a fault it cannot isolate, on a sensor type with no injected fault active.
+//! Faults of the simulated GNSS receiver are detected from the navigation solution: a jump or a
+//! drift when it rejects the receiver, an outage or a freeze when it reports GNSS aiding stale;
+//! a receiver rejected with no GNSS fault active is a false alarm.
 
 use ipc_types::{
     ChannelState, FaultApplied, FaultOutcome, FaultReason, FusedImu, MAX_CHANNELS, SensorType,
-    SimFault, fused_flags,
+    SimControl, SimFault, aiding, fused_flags,
 };
 use serde::Serialize;
 
@@ -30,8 +33,17 @@ pub struct FaultRecord {
     pub reason: Option<&'static str>,
     /// When the fault was cleared or replaced by another fault on the same channel.
     pub cleared_at_s: Option<f64>,
+    /// GNSS faults: the solution's horizontal error against the truth at the last navigation
+    /// sample of the fault (the end of an outage, the coast's drift), m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub coast_horiz_err_m: Option<f64>,
+    /// GNSS faults: the horizontal position σ the navigator reported at that sample (the larger
+    /// of north and east), m — the drift as the solution reports it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub coast_horiz_sigma_m: Option<f64>,
+    /// The sensor type; `None` for the GNSS receiver.
     #[serde(skip)]
-    sensor: SensorType,
+    sensor: Option<SensorType>,
     #[serde(skip)]
     index: usize,
 }
@@ -68,7 +80,8 @@ impl Default for ChannelTrack {
 /// A false alarm: when, and on which sensor type.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct FalseAlarm {
-    sensor: SensorType,
+    /// `None` for the GNSS receiver.
+    sensor: Option<SensorType>,
     t_s: f64,
 }
 
@@ -102,6 +115,8 @@ pub struct FaultTracker {
     /// Start of the current detected-not-isolated stretch, per sensor type.
     unisolated_since_s: [Option<f64>; 2],
     false_alarms: Vec<FalseAlarm>,
+    /// The last navigation sample had the GNSS receiver rejected.
+    gnss_rejected: bool,
 }
 
 impl FaultTracker {
@@ -120,7 +135,7 @@ impl FaultTracker {
         self.false_alarms.len() as u64
     }
 
-    fn fault_active(&self, sensor: SensorType, t_s: f64) -> bool {
+    fn fault_active(&self, sensor: Option<SensorType>, t_s: f64) -> bool {
         self.records
             .iter()
             .any(|r| r.sensor == sensor && r.active_at(t_s))
@@ -130,6 +145,10 @@ impl FaultTracker {
     /// fault; any other fault replaces the channel's fault and starts a new record.
     pub fn on_fault_applied(&mut self, event: &FaultApplied) {
         if FaultOutcome::from_u8(event.outcome) != Some(FaultOutcome::Applied) {
+            return;
+        }
+        if event.sensor == SimControl::GNSS_RECEIVER {
+            self.on_gnss_fault(event);
             return;
         }
         let (Some(sensor), Some(fault)) = (
@@ -146,7 +165,7 @@ impl FaultTracker {
         for r in self
             .records
             .iter_mut()
-            .filter(|r| r.sensor == sensor && r.index == index && r.cleared_at_s.is_none())
+            .filter(|r| r.sensor == Some(sensor) && r.index == index && r.cleared_at_s.is_none())
         {
             r.cleared_at_s = Some(t_s);
         }
@@ -166,7 +185,9 @@ impl FaultTracker {
             isolated_at_s: None,
             reason: None,
             cleared_at_s: None,
-            sensor,
+            coast_horiz_err_m: None,
+            coast_horiz_sigma_m: None,
+            sensor: Some(sensor),
             index,
         };
         // Late event: credit what fusion already showed after the injection time.
@@ -182,8 +203,71 @@ impl FaultTracker {
             record.reason = Some(track.reason);
         }
         self.false_alarms
-            .retain(|a| !(a.sensor == sensor && a.t_s >= t_s));
+            .retain(|a| !(a.sensor == Some(sensor) && a.t_s >= t_s));
         self.records.push(record);
+    }
+
+    /// A fault of the simulated GNSS receiver: `clear` ends the active one, any other replaces it.
+    fn on_gnss_fault(&mut self, event: &FaultApplied) {
+        let Some(fault) = SimFault::from_u8(event.fault) else {
+            return;
+        };
+        let t_s = event.device_time_us as f64 / 1e6;
+        for r in self
+            .records
+            .iter_mut()
+            .filter(|r| r.sensor.is_none() && r.cleared_at_s.is_none())
+        {
+            r.cleared_at_s = Some(t_s);
+        }
+        if fault == SimFault::Clear {
+            return;
+        }
+        self.records.push(FaultRecord {
+            channel: "gnss".to_string(),
+            kind: fault.name(),
+            param: Some(event.param),
+            injected_at_s: t_s,
+            detected_at_s: None,
+            isolated_at_s: None,
+            reason: None,
+            cleared_at_s: None,
+            coast_horiz_err_m: None,
+            coast_horiz_sigma_m: None,
+            sensor: None,
+            index: 0,
+        });
+        self.false_alarms
+            .retain(|a| !(a.sensor.is_none() && a.t_s >= t_s));
+    }
+
+    /// Takes one navigation sample after alignment at device time `t_s`: its aiding bits, its
+    /// horizontal error against the truth (when known) and its horizontal σ. Detects GNSS faults
+    /// and counts a receiver rejected with none active as a false alarm.
+    pub fn on_nav(&mut self, t_s: f64, aiding_bits: u32, horiz_err_m: Option<f64>, sigma_m: f64) {
+        let rejected = aiding_bits & aiding::GNSS_REJECTED != 0;
+        let stale = aiding_bits & aiding::GNSS_STALE != 0;
+        if rejected && !self.gnss_rejected && !self.fault_active(None, t_s) {
+            self.false_alarms.push(FalseAlarm { sensor: None, t_s });
+        }
+        self.gnss_rejected = rejected;
+        for r in self
+            .records
+            .iter_mut()
+            .filter(|r| r.sensor.is_none() && r.active_at(t_s))
+        {
+            let seen = match SimFault::from_name(r.kind) {
+                Some(SimFault::GnssJump | SimFault::GnssDrift) => rejected,
+                _ => stale || rejected,
+            };
+            if r.detected_at_s.is_none() && seen {
+                r.detected_at_s = Some(t_s);
+            }
+            if horiz_err_m.is_some() {
+                r.coast_horiz_err_m = horiz_err_m;
+                r.coast_horiz_sigma_m = Some(sigma_m);
+            }
+        }
     }
 
     /// Takes one fused output; allocation-free except when a false alarm is recorded.
@@ -196,14 +280,17 @@ impl FaultTracker {
                 SensorType::Accel => (fused.n_accel, &fused.accel_state, &fused.accel_reason),
             };
             let n = usize::from(n).min(MAX_CHANNELS);
-            let fault_active = self.fault_active(sensor, t_s);
+            let fault_active = self.fault_active(Some(sensor), t_s);
 
             let unisolated = fused.flags & detected_not_isolated_flag(sensor) != 0;
             match (unisolated, self.unisolated_since_s[ti]) {
                 (true, None) => {
                     self.unisolated_since_s[ti] = Some(t_s);
                     if !fault_active {
-                        self.false_alarms.push(FalseAlarm { sensor, t_s });
+                        self.false_alarms.push(FalseAlarm {
+                            sensor: Some(sensor),
+                            t_s,
+                        });
                     }
                 }
                 (false, Some(_)) => self.unisolated_since_s[ti] = None,
@@ -224,7 +311,10 @@ impl FaultTracker {
                 if is_not_ok(state) && !was_not_ok {
                     track.not_ok_since_s = Some(t_s);
                     if !fault_active {
-                        self.false_alarms.push(FalseAlarm { sensor, t_s });
+                        self.false_alarms.push(FalseAlarm {
+                            sensor: Some(sensor),
+                            t_s,
+                        });
                     }
                 } else if !is_not_ok(state) {
                     track.not_ok_since_s = None;
@@ -243,7 +333,7 @@ impl FaultTracker {
             for r in self
                 .records
                 .iter_mut()
-                .filter(|r| r.sensor == sensor && r.active_at(t_s))
+                .filter(|r| r.sensor == Some(sensor) && r.active_at(t_s))
             {
                 let state = self.channels[ti][r.index].state;
                 if r.detected_at_s.is_none() && (is_not_ok(state) || unisolated) {
@@ -510,5 +600,52 @@ mod tests {
             ..event(SensorType::Gyro, 1, SimFault::Dead, 1_000_000)
         });
         assert!(tr.records().is_empty());
+    }
+
+    fn gnss_event(fault: SimFault, param: f64, t_us: u64) -> FaultApplied {
+        FaultApplied {
+            sensor: SimControl::GNSS_RECEIVER,
+            channel: 0,
+            param,
+            ..event(SensorType::Gyro, 0, fault, t_us)
+        }
+    }
+
+    #[test]
+    fn a_gnss_jump_is_detected_when_the_solution_rejects_the_receiver() {
+        let mut tr = FaultTracker::new();
+        tr.on_nav(29.0, aiding::GNSS, Some(0.5), 0.4);
+        tr.on_fault_applied(&gnss_event(SimFault::GnssJump, 50.0, 30_000_000));
+        tr.on_nav(30.2, aiding::GNSS, Some(0.5), 0.4);
+        tr.on_nav(30.6, aiding::GNSS_REJECTED, Some(0.6), 0.5);
+        tr.on_fault_applied(&gnss_event(SimFault::Clear, 0.0, 40_000_000));
+        tr.on_nav(45.0, aiding::GNSS, Some(0.5), 0.4);
+        let r = &tr.records()[0];
+        assert_eq!((r.channel.as_str(), r.kind), ("gnss", "gnss-jump"));
+        assert_eq!(
+            (r.param, r.detected_at_s, r.cleared_at_s),
+            (Some(50.0), Some(30.6), Some(40.0))
+        );
+        assert_eq!(tr.false_alarms(), 0);
+    }
+
+    #[test]
+    fn a_gnss_outage_reports_the_drift_at_its_end_and_a_rejection_without_fault_is_a_false_alarm() {
+        let mut tr = FaultTracker::new();
+        tr.on_fault_applied(&gnss_event(SimFault::GnssOutage, 60.0, 10_000_000));
+        tr.on_nav(10.5, aiding::GNSS, Some(0.5), 0.4);
+        tr.on_nav(11.5, aiding::GNSS_STALE, Some(0.9), 0.8);
+        tr.on_nav(69.9, aiding::GNSS_STALE, Some(7.5), 9.0);
+        tr.on_fault_applied(&gnss_event(SimFault::Clear, 0.0, 70_000_000));
+        tr.on_nav(70.1, aiding::GNSS, Some(3.0), 1.0);
+        let r = &tr.records()[0];
+        assert_eq!(r.detected_at_s, Some(11.5));
+        assert_eq!(
+            (r.coast_horiz_err_m, r.coast_horiz_sigma_m),
+            (Some(7.5), Some(9.0))
+        );
+        tr.on_nav(80.0, aiding::GNSS_REJECTED, Some(3.0), 1.0);
+        tr.on_nav(80.2, aiding::GNSS_REJECTED, Some(3.0), 1.0);
+        assert_eq!(tr.false_alarms(), 1);
     }
 }

@@ -38,6 +38,7 @@ pub struct HorizontalTrack {
     last_truth: Option<Position>,
     distance_m: f64,
     end_error_m: Option<f64>,
+    errors: crate::accuracy::ErrorStats,
 }
 
 impl HorizontalTrack {
@@ -48,7 +49,14 @@ impl HorizontalTrack {
             self.distance_m += last.distance_to(&truth);
         }
         self.last_truth = Some(truth);
-        self.end_error_m = Some(truth.distance_to(&nav));
+        let error = truth.distance_to(&nav);
+        self.end_error_m = Some(error);
+        self.errors.push(error);
+    }
+
+    /// RMS and largest horizontal error over every sample added.
+    pub fn errors(&self) -> &crate::accuracy::ErrorStats {
+        &self.errors
     }
 
     /// Horizontal distance the truth travelled while samples were added, m; `None` before the
@@ -105,6 +113,9 @@ mod tests {
         assert!((t.distance_m().unwrap() - 100.0).abs() < 1e-2, "{t:?}");
         assert!((t.end_error_m().unwrap() - 5.0).abs() < 1e-3, "{t:?}");
         assert!((t.end_error_pct().unwrap() - 5.0).abs() < 1e-3, "{t:?}");
+        // Errors 0, 1, 1, 5 m.
+        assert!((t.errors().rms().unwrap() - (27.0f64 / 4.0).sqrt()).abs() < 1e-3);
+        assert!((t.errors().max().unwrap() - 5.0).abs() < 1e-3);
     }
 
     #[test]

@@ -269,7 +269,30 @@ impl Monitor {
             let integrity = Integrity::from_u8(nav.integrity).unwrap_or(Integrity::Invalid);
             self.integrity_samples[integrity as usize] += 1;
             let truth = &self.truth_ring[(seq as usize) % TRUTH_RING];
-            if truth.header.origin_seq == seq && truth.version != 0 {
+            let known = truth.header.origin_seq == seq && truth.version != 0;
+            let horiz_err = known.then(|| {
+                let at = |lat_rad, lon_rad, height_m| Position {
+                    lat_rad,
+                    lon_rad,
+                    height_m,
+                };
+                at(truth.latitude_rad, truth.longitude_rad, truth.altitude_m).distance_to(&at(
+                    nav.latitude_rad,
+                    nav.longitude_rad,
+                    nav.altitude_m,
+                ))
+            });
+            let sigma = nav.covariance_diag[6]
+                .max(nav.covariance_diag[7])
+                .max(0.0)
+                .sqrt();
+            self.faults.on_nav(
+                nav.header.origin_device_time_us as f64 / 1e6,
+                nav.aiding,
+                horiz_err,
+                sigma,
+            );
+            if known {
                 self.accuracy.push(
                     truth.quaternion,
                     truth.altitude_m,

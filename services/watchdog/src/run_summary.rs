@@ -59,6 +59,8 @@ pub fn summarise(
         att_err_deg_max: sim(acc.attitude_deg.max()),
         alt_err_m_rms: sim(acc.altitude_m.rms()),
         alt_err_m_max: sim(acc.altitude_m.max()),
+        horiz_pos_err_m_rms: sim(acc.horizontal.errors().rms()),
+        horiz_pos_err_m_max: sim(acc.horizontal.errors().max()),
         distance_m: sim(acc.horizontal.distance_m()),
         horiz_end_err_m: sim(acc.horizontal.end_error_m()),
         horiz_end_err_pct: sim(acc.horizontal.end_error_pct()),

@@ -97,6 +97,13 @@ pub struct Summary {
     /// Largest altitude error, m (simulator only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub alt_err_m_max: Option<f64>,
+    /// Horizontal position error against simulator truth after alignment, RMS, m (simulator
+    /// only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub horiz_pos_err_m_rms: Option<f64>,
+    /// Largest horizontal position error, m (simulator only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub horiz_pos_err_m_max: Option<f64>,
     /// Horizontal distance the truth travelled after alignment, m (simulator only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub distance_m: Option<f64>,

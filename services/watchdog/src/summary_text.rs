@@ -20,6 +20,11 @@ pub fn summary_text(s: &Summary) -> String {
             "  altitude error after alignment: RMS {rms:.2} m, max {max:.2} m\n"
         ));
     }
+    if let (Some(rms), Some(max)) = (s.horiz_pos_err_m_rms, s.horiz_pos_err_m_max) {
+        out.push_str(&format!(
+            "  horizontal position error after alignment: RMS {rms:.2} m, max {max:.2} m\n"
+        ));
+    }
     if let (Some(err), Some(distance)) = (s.horiz_end_err_m, s.distance_m) {
         let share = s
             .horiz_end_err_pct
@@ -42,6 +47,21 @@ pub fn summary_text(s: &Summary) -> String {
             s.faults.len(),
             s.false_alarms
         ));
+        for f in s.faults.iter().filter(|f| f.channel == "gnss") {
+            let detected = f.detected_at_s.map_or("not detected".to_string(), |t| {
+                format!("detected after {:.2} s", t - f.injected_at_s)
+            });
+            let coast = match (f.coast_horiz_err_m, f.coast_horiz_sigma_m) {
+                (Some(err), Some(sigma)) => {
+                    format!(", horizontal error {err:.2} m at its end (σ reported {sigma:.2} m)")
+                }
+                _ => String::new(),
+            };
+            out.push_str(&format!(
+                "  gnss {} at {:.1} s: {detected}{coast}\n",
+                f.kind, f.injected_at_s
+            ));
+        }
     }
     out
 }
@@ -81,6 +101,8 @@ mod tests {
             att_err_deg_max: Some(2.38),
             alt_err_m_rms: None,
             alt_err_m_max: None,
+            horiz_pos_err_m_rms: Some(0.84),
+            horiz_pos_err_m_max: Some(1.3),
             distance_m: Some(125.8),
             horiz_end_err_m: Some(1.11),
             horiz_end_err_pct: Some(0.882),
