@@ -9,7 +9,8 @@ static ALLOCATOR: CountingAllocator = CountingAllocator;
 
 #[test]
 fn navigating_samples_do_not_allocate() {
-    let config = NavigatorConfig::default();
+    let mut config = NavigatorConfig::default();
+    config.gnss.enabled = true;
     let g = normal_gravity(0.0, 0.0);
     let mut nav = Navigator::new(config).unwrap();
     let mut t = 0u64;
@@ -35,6 +36,19 @@ fn navigating_samples_do_not_allocate() {
             if k.is_multiple_of(40) {
                 let _ = nav.on_baro(time, 10.5, 0.04, k.is_multiple_of(80));
             }
+            if k.is_multiple_of(200) && k > 0 {
+                let fix = ipc_types::GnssFix {
+                    fix_type: ipc_types::GnssFixType::Fix3d as u8,
+                    velocity_valid: 1,
+                    receiver_time_us: time,
+                    altitude_m: 10.0,
+                    horizontal_accuracy_m: 1.5,
+                    vertical_accuracy_m: 3.0,
+                    speed_accuracy_mps: 0.1,
+                    ..ipc_types::GnssFix::default()
+                };
+                let _ = nav.on_gnss(&fix, time - 80_000);
+            }
             let out = nav
                 .on_imu(
                     time,
@@ -50,6 +64,7 @@ fn navigating_samples_do_not_allocate() {
     });
     assert_eq!(navigating, 0);
     assert!(sink.is_finite());
+    assert!(nav.ekf().unwrap().counts(rins_navigator::ekf::AidingSource::Gnss).accepted > 0);
 
     // The counter does see allocations, so the zero above means something.
     let boxed = allocations_during(|| {
