@@ -64,7 +64,13 @@ fn navigating_samples_do_not_allocate() {
     });
     assert_eq!(navigating, 0);
     assert!(sink.is_finite());
-    assert!(nav.ekf().unwrap().counts(rins_navigator::ekf::AidingSource::Gnss).accepted > 0);
+    assert!(
+        nav.ekf()
+            .unwrap()
+            .counts(rins_navigator::ekf::AidingSource::Gnss)
+            .accepted
+            > 0
+    );
 
     // The counter does see allocations, so the zero above means something.
     let boxed = allocations_during(|| {

@@ -39,6 +39,10 @@ pub struct HorizontalTrack {
     distance_m: f64,
     end_error_m: Option<f64>,
     errors: crate::accuracy::ErrorStats,
+    /// North/east error of the last sample, m.
+    last_error_ne: Option<[f64; 2]>,
+    /// Largest change of the north/east error from one sample to the next, m.
+    largest_step_m: f64,
 }
 
 impl HorizontalTrack {
@@ -52,6 +56,17 @@ impl HorizontalTrack {
         let error = truth.distance_to(&nav);
         self.end_error_m = Some(error);
         self.errors.push(error);
+        let ne = truth.north_east_to(&nav);
+        if let Some([n, e]) = self.last_error_ne {
+            self.largest_step_m = self.largest_step_m.max((ne[0] - n).hypot(ne[1] - e));
+        }
+        self.last_error_ne = Some(ne);
+    }
+
+    /// Largest jump of the solution from one sample to the next that the truth's motion does
+    /// not explain (the change of the horizontal error vector), m; `None` before two samples.
+    pub fn largest_step_m(&self) -> Option<f64> {
+        (self.errors.count() > 1).then_some(self.largest_step_m)
     }
 
     /// RMS and largest horizontal error over every sample added.
@@ -116,6 +131,8 @@ mod tests {
         // Errors 0, 1, 1, 5 m.
         assert!((t.errors().rms().unwrap() - (27.0f64 / 4.0).sqrt()).abs() < 1e-3);
         assert!((t.errors().max().unwrap() - 5.0).abs() < 1e-3);
+        // Error vectors (n, e): (0, 0), (0, 1), (1, 0), (4, 3): the last change is the largest.
+        assert!((t.largest_step_m().unwrap() - 3.0f64.hypot(3.0)).abs() < 1e-3);
     }
 
     #[test]

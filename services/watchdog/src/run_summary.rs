@@ -61,6 +61,7 @@ pub fn summarise(
         alt_err_m_max: sim(acc.altitude_m.max()),
         horiz_pos_err_m_rms: sim(acc.horizontal.errors().rms()),
         horiz_pos_err_m_max: sim(acc.horizontal.errors().max()),
+        horiz_step_m_max: sim(acc.horizontal.largest_step_m()),
         distance_m: sim(acc.horizontal.distance_m()),
         horiz_end_err_m: sim(acc.horizontal.end_error_m()),
         horiz_end_err_pct: sim(acc.horizontal.end_error_pct()),

@@ -104,6 +104,10 @@ pub struct Summary {
     /// Largest horizontal position error, m (simulator only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub horiz_pos_err_m_max: Option<f64>,
+    /// Largest step of the horizontal solution from one sample to the next that the truth's
+    /// motion does not explain, m (simulator only): what an accepted bad fix would show.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub horiz_step_m_max: Option<f64>,
     /// Horizontal distance the truth travelled after alignment, m (simulator only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub distance_m: Option<f64>,

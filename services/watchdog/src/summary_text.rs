@@ -103,6 +103,7 @@ mod tests {
             alt_err_m_max: None,
             horiz_pos_err_m_rms: Some(0.84),
             horiz_pos_err_m_max: Some(1.3),
+            horiz_step_m_max: Some(0.2),
             distance_m: Some(125.8),
             horiz_end_err_m: Some(1.11),
             horiz_end_err_pct: Some(0.882),
