@@ -216,7 +216,7 @@ impl FaultTracker {
         for r in self
             .records
             .iter_mut()
-            .filter(|r| r.sensor.is_none() && r.cleared_at_s.is_none())
+            .filter(|r| r.sensor.is_none() && r.cleared_at_s.is_none_or(|c| c > t_s))
         {
             r.cleared_at_s = Some(t_s);
         }
@@ -231,7 +231,11 @@ impl FaultTracker {
             detected_at_s: None,
             isolated_at_s: None,
             reason: None,
-            cleared_at_s: None,
+            // An outage or freeze of a given length ends by itself.
+            cleared_at_s: matches!(fault, SimFault::GnssOutage | SimFault::GnssFreeze)
+                .then_some(event.param)
+                .filter(|&d| d > 0.0)
+                .map(|d| t_s + d),
             coast_horiz_err_m: None,
             coast_horiz_sigma_m: None,
             sensor: None,
@@ -636,7 +640,7 @@ mod tests {
         tr.on_nav(10.5, aiding::GNSS, Some(0.5), 0.4);
         tr.on_nav(11.5, aiding::GNSS_STALE, Some(0.9), 0.8);
         tr.on_nav(69.9, aiding::GNSS_STALE, Some(7.5), 9.0);
-        tr.on_fault_applied(&gnss_event(SimFault::Clear, 0.0, 70_000_000));
+        // The 60 s outage ends by itself at 70 s.
         tr.on_nav(70.1, aiding::GNSS, Some(3.0), 1.0);
         let r = &tr.records()[0];
         assert_eq!(r.detected_at_s, Some(11.5));

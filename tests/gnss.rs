@@ -1,0 +1,106 @@
+//! GNSS aiding end to end: the simulated receiver on its own pseudo-terminal, the gnss service,
+//! the navigator's updates, and the receiver's faults injected through `rins up --inject`, as the
+//! run summary reports them.
+
+mod common;
+
+use common::{Isolated, last_json, num, stderr};
+
+fn gnss_faults(summary: &serde_json::Value) -> Vec<serde_json::Value> {
+    summary["faults"]
+        .as_array()
+        .expect("summary has a faults array")
+        .iter()
+        .filter(|f| f["channel"] == "gnss")
+        .cloned()
+        .collect()
+}
+
+/// A jump of 50 m from 30 s to 45 s, then a drift of 0.5 m/s from 60 s to 100 s, in one flight.
+#[test]
+fn a_jump_is_rejected_within_a_second_and_a_drift_within_30_s() {
+    let ipc = Isolated::new("gnss_jump_drift");
+    let out = ipc.run_with_timeout(
+        &[
+            "up",
+            "--scenario",
+            "uav",
+            "--gnss",
+            "--duration",
+            "105",
+            "--json",
+            "--inject",
+            "gnss:jump=50@30s",
+            "--inject",
+            "gnss:clear@45s",
+            "--inject",
+            "gnss:drift=0.5@60s",
+            "--inject",
+            "gnss:clear@100s",
+        ],
+        std::time::Duration::from_secs(240),
+    );
+    assert!(out.status.success(), "rins up failed:\n{}", stderr(&out));
+    let s = last_json(&out);
+    let faults = gnss_faults(&s);
+    assert_eq!(faults.len(), 2, "{s}");
+    let (jump, drift) = (&faults[0], &faults[1]);
+    assert_eq!(jump["kind"], "gnss-jump", "{jump}");
+    let jump_delay = num(jump, "detected_at_s") - num(jump, "injected_at_s");
+    assert!(
+        (0.0..=1.0).contains(&jump_delay),
+        "jump detected after {jump_delay} s: {jump}"
+    );
+    assert_eq!(drift["kind"], "gnss-drift", "{drift}");
+    let drift_delay = num(drift, "detected_at_s") - num(drift, "injected_at_s");
+    assert!(
+        (0.0..=30.0).contains(&drift_delay),
+        "drift detected after {drift_delay} s: {drift}"
+    );
+    // The jump never reached the solution: no step the vehicle's motion does not explain.
+    let step = num(&s, "horiz_step_m_max");
+    assert!(step <= 1.0, "the solution stepped {step} m: {s}");
+    assert_eq!(num(&s, "false_alarms"), 0.0, "{s}");
+}
+
+/// A 60 s outage: reported as such, the solution coasts, and the drift at its end is reported.
+#[test]
+fn an_outage_coasts_and_reports_its_drift() {
+    let ipc = Isolated::new("gnss_outage");
+    let out = ipc.run_with_timeout(
+        &[
+            "up",
+            "--scenario",
+            "uav",
+            "--gnss",
+            "--duration",
+            "95",
+            "--json",
+            "--inject",
+            "gnss:outage=60@30s",
+        ],
+        std::time::Duration::from_secs(240),
+    );
+    assert!(out.status.success(), "rins up failed:\n{}", stderr(&out));
+    let s = last_json(&out);
+    let faults = gnss_faults(&s);
+    assert_eq!(faults.len(), 1, "{s}");
+    let outage = &faults[0];
+    assert_eq!(outage["kind"], "gnss-outage", "{outage}");
+    // Reported stale after the aiding timeout (1 s) and the fix period.
+    let delay = num(outage, "detected_at_s") - num(outage, "injected_at_s");
+    assert!(
+        (0.0..=2.0).contains(&delay),
+        "outage seen after {delay} s: {outage}"
+    );
+    // The coast drifts, and the navigator's σ says so: the error is within 3σ of what it reported.
+    let err = num(outage, "coast_horiz_err_m");
+    let sigma = num(outage, "coast_horiz_sigma_m");
+    assert!(err.is_finite() && sigma > 0.0, "{outage}");
+    assert!(
+        err <= 3.0 * sigma * std::f64::consts::SQRT_2,
+        "{err} m against σ {sigma} m"
+    );
+    // Aided again afterwards: the run's error stays that of a GNSS-aided solution.
+    assert!(num(&s, "horiz_pos_err_m_rms") < 10.0, "{s}");
+}
