@@ -1,1 +1,0 @@
-//! Receiver byte stream → epochs.

@@ -1,1 +1,0 @@
-//! Epochs → receiver messages, for the simulated receiver.
