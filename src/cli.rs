@@ -29,12 +29,16 @@ pub enum Command {
         /// Configuration file (default: the built-in configuration).
         #[arg(long)]
         config: Option<PathBuf>,
-        /// Serial device for acquisition (overrides acquisition.port).
+        /// Serial device for acquisition, or for the gnss service its receiver (overrides
+        /// acquisition.port or gnss.port).
         #[arg(long)]
         port: Option<String>,
         /// MAVLink endpoint for the mavlink service (overrides mavlink.endpoints).
         #[arg(long, value_name = "ENDPOINT")]
         mavlink: Option<String>,
+        /// A GNSS receiver is fitted: turns on `[gnss]`, `[navigator.gnss]` and `[sim.gnss]`.
+        #[arg(long)]
+        gnss: bool,
     },
     /// Run the device simulator on a pseudo-terminal.
     Sim(SimArgs),
@@ -295,6 +299,8 @@ pub enum ServiceName {
     NavigatorStandby,
     /// The MAVLink 2 output over UDP (`[mavlink]`).
     Mavlink,
+    /// GNSS receiver acquisition (`[gnss]`): publishes one fix per receiver epoch.
+    Gnss,
 }
 
 impl ServiceName {
@@ -307,6 +313,7 @@ impl ServiceName {
             ServiceName::Navigator => ipc_types::ServiceKind::Navigator,
             ServiceName::NavigatorStandby => ipc_types::ServiceKind::NavigatorStandby,
             ServiceName::Mavlink => ipc_types::ServiceKind::Mavlink,
+            ServiceName::Gnss => ipc_types::ServiceKind::Gnss,
         }
     }
 }
@@ -352,6 +359,10 @@ pub struct UpArgs {
     /// MAVLink output whatever the configuration says.
     #[arg(long, value_name = "ENDPOINT")]
     pub mavlink: Option<String>,
+    /// A GNSS receiver is fitted: runs the gnss service (on the simulated receiver unless
+    /// `[gnss] port` names one) and turns on the navigator's GNSS updates.
+    #[arg(long)]
+    pub gnss: bool,
     /// Record every topic into this MCAP file from the start (replaced if it exists), as
     /// `rins record` does.
     #[arg(long, value_name = "FILE")]
@@ -439,6 +450,10 @@ pub struct SimArgs {
     /// Also make this path a symbolic link to the pseudo-terminal (replaced if it exists).
     #[arg(long)]
     pub link: Option<PathBuf>,
+    /// Simulate the GNSS receiver too (`[sim.gnss]`), its terminal also reachable under this
+    /// path.
+    #[arg(long, value_name = "PATH")]
+    pub gnss_link: Option<PathBuf>,
     /// Stop after this many seconds (the uav scenario then flies its circuits for that long).
     #[arg(long, allow_negative_numbers = true)]
     pub duration: Option<f64>,

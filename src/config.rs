@@ -7,6 +7,7 @@ use anyhow::{Result, anyhow};
 use rins_acquisition::config::AcquisitionConfig;
 use rins_altimeter::AltimeterConfig;
 use rins_fusion::FusionConfig;
+use rins_gnss::config::GnssConfig;
 use rins_mavlink::config::MavlinkConfig;
 use rins_navigator::config::NavigatorConfig;
 use rins_runtime::bounded_file;
@@ -130,9 +131,19 @@ pub struct RinsConfig {
     pub deployment: DeploymentConfig,
     /// `[mavlink]`: the MAVLink 2 output over UDP.
     pub mavlink: MavlinkConfig,
+    /// `[gnss]`: the GNSS receiver's serial line.
+    pub gnss: GnssConfig,
 }
 
 impl RinsConfig {
+    /// A GNSS receiver is fitted: the gnss service runs, the navigator takes its fixes, and a
+    /// simulated deployment simulates it.
+    pub fn enable_gnss(&mut self) {
+        self.gnss.enabled = true;
+        self.navigator.gnss.enabled = true;
+        self.sim.gnss.enabled = true;
+    }
+
     /// Parses and validates a configuration text; errors start with `origin` (the file's path or
     /// the built-in profile's name) and name the offending field and value.
     pub fn parse(text: &str, origin: &str) -> Result<Self> {
@@ -150,6 +161,7 @@ impl RinsConfig {
         self.device.validate()?;
         self.sim.validate().map_err(|e| e.to_string())?;
         self.acquisition.validate()?;
+        self.gnss.validate()?;
         self.fusion
             .validate()
             .map_err(|e| e.within("fusion").to_string())?;

@@ -39,7 +39,8 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             config,
             port,
             mavlink,
-        } => service::run(name, config.as_deref(), port, mavlink).map(|()| ExitCode::SUCCESS),
+            gnss,
+        } => service::run(name, config.as_deref(), port, mavlink, gnss).map(|()| ExitCode::SUCCESS),
         Command::Sim(args) => {
             rins_runtime::logging::init("sim");
             sim::run(&args).map(|()| ExitCode::SUCCESS)

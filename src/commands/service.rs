@@ -11,18 +11,25 @@ use crate::cli::ServiceName;
 use crate::config;
 
 /// Runs service `name` with the configuration at `config_path` (the built-in one when none) and,
-/// for acquisition, the serial device `port`; for the MAVLink output, the endpoint `mavlink`.
+/// for acquisition (or the gnss service), the serial device `port`; for the MAVLink output, the
+/// endpoint `mavlink`; with `gnss`, a GNSS receiver fitted.
 pub fn run(
     name: ServiceName,
     config_path: Option<&Path>,
     port: Option<String>,
     mavlink: Option<String>,
+    gnss: bool,
 ) -> Result<()> {
     let process = name.kind().name();
     rins_runtime::logging::init(process);
     let mut cfg = config::load(config_path)?;
-    if let Some(port) = port {
-        cfg.acquisition.port = Some(port);
+    if gnss {
+        cfg.enable_gnss();
+    }
+    match (name, port) {
+        (ServiceName::Gnss, Some(port)) => cfg.gnss.port = Some(port),
+        (_, Some(port)) => cfg.acquisition.port = Some(port),
+        (_, None) => {}
     }
     if let Some(endpoint) = mavlink {
         cfg.mavlink.endpoints = vec![endpoint];
@@ -61,6 +68,7 @@ pub fn run(
             config: cfg.mavlink,
         }
         .run(ctx),
+        ServiceName::Gnss => rins_gnss::service::GnssService { config: cfg.gnss }.run(ctx),
     };
     tracing::info!(service = %process, ok = result.is_ok(), "stopped");
     result

@@ -6,7 +6,7 @@ use rins_runtime::service::{Service, ServiceContext};
 use rins_runtime::shutdown::Shutdown;
 use rins_sim::Simulator;
 use rins_sim::fault_command::WhiteNoise;
-use rins_sim::service::{SimOptions, SimService};
+use rins_sim::service::{GnssOptions, SimOptions, SimService};
 
 use crate::cli::SimArgs;
 use crate::commands::fault_args;
@@ -34,7 +34,13 @@ pub fn run(args: &SimArgs) -> Result<()> {
     let faults = fault_args::schedule(&args.faults, gyro.n(), accel.n())?;
     let sim = Simulator::new(&cfg.sim, gyro.axes(), accel.axes(), cfg.sim.seed)?;
     let shutdown = Shutdown::install()?;
+    let gnss = (cfg.sim.gnss.enabled || args.gnss_link.is_some()).then(|| GnssOptions {
+        config: cfg.sim.gnss,
+        link: args.gnss_link.clone(),
+        seed: cfg.sim.seed,
+    });
     let options = SimOptions {
+        gnss,
         link: args.link.clone(),
         duration_s: args.duration,
         faults,

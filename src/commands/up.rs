@@ -51,6 +51,9 @@ fn apply_overrides(cfg: &mut RinsConfig, args: &UpArgs) -> Result<()> {
         }
         cfg.acquisition.port = Some(port.to_string_lossy().into_owned());
     }
+    if args.gnss {
+        cfg.enable_gnss();
+    }
     if let Some(endpoint) = &args.mavlink {
         rins_mavlink::endpoint::Endpoint::parse(endpoint)
             .map_err(|why| anyhow::anyhow!("--mavlink {endpoint:?}: {why}"))?;
@@ -98,9 +101,15 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     let _ = std::fs::remove_file(rins_acquisition::resume_file::path_for(&settings));
     let simulate = cfg.acquisition.port.is_none() && !args.external_source;
     let link = run_dir.join("sim-tty");
+    let gnss_link = run_dir.join("sim-gnss-tty");
     if simulate {
         let _ = std::fs::remove_file(&link);
         cfg.acquisition.port = Some(link.to_string_lossy().into_owned());
+        if cfg.gnss.enabled && cfg.gnss.port.is_none() {
+            let _ = std::fs::remove_file(&gnss_link);
+            cfg.gnss.port = Some(gnss_link.to_string_lossy().into_owned());
+            cfg.sim.gnss.enabled = true;
+        }
     }
     // Children read the same file (or the built-in configuration); command-line overrides travel as
     // arguments.
@@ -124,7 +133,12 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     let mut timing = RestartTiming::default();
     let mut recorder: Option<std::process::Child> = None;
     let outcome = (|| -> Result<()> {
-        for kind in pipeline_services(cfg.deployment.navigator_lanes, cfg.mavlink.enabled) {
+        let kinds = pipeline_services(
+            cfg.deployment.navigator_lanes,
+            cfg.mavlink.enabled,
+            cfg.gnss.enabled,
+        );
+        for kind in kinds {
             if args.external_source && kind == ServiceKind::Acquisition {
                 continue;
             }
@@ -136,6 +150,14 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
             child_args.extend(config_args.iter().cloned());
             if kind == ServiceKind::Acquisition {
                 child_args.extend(["--port".to_string(), port.clone()]);
+            }
+            if args.gnss {
+                child_args.push("--gnss".to_string());
+            }
+            if kind == ServiceKind::Gnss
+                && let Some(gnss_port) = &cfg.gnss.port
+            {
+                child_args.extend(["--port".to_string(), gnss_port.clone()]);
             }
             if kind == ServiceKind::Mavlink
                 && let Some(endpoint) = &args.mavlink
@@ -162,7 +184,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
             supervisor.start(ChildSpec {
                 name: ServiceKind::Simulator.name().into(),
                 program: exe.clone(),
-                args: sim_args(&cfg, &config_args, &link, args),
+                args: sim_args(&cfg, &config_args, &link, &gnss_link, args),
                 policy: cfg.watchdog.policy_for(ServiceKind::Simulator.name()),
             })?;
             if !wait_for_path(&link, &mut supervisor, &shutdown)? {
@@ -272,8 +294,15 @@ fn stop_recorder(child: std::process::Child) {
     }
 }
 
-/// The simulator's command line: the scenario, seed and faults of this run, and its terminal link.
-fn sim_args(cfg: &RinsConfig, config_args: &[String], link: &Path, up: &UpArgs) -> Vec<String> {
+/// The simulator's command line: the scenario, seed and faults of this run, and its terminal
+/// links (the GNSS receiver's when one is simulated).
+fn sim_args(
+    cfg: &RinsConfig,
+    config_args: &[String],
+    link: &Path,
+    gnss_link: &Path,
+    up: &UpArgs,
+) -> Vec<String> {
     let mut args = vec!["sim".to_string()];
     args.extend(config_args.iter().cloned());
     args.extend([
@@ -284,6 +313,12 @@ fn sim_args(cfg: &RinsConfig, config_args: &[String], link: &Path, up: &UpArgs) 
         "--link".to_string(),
         link.to_string_lossy().into_owned(),
     ]);
+    if cfg.sim.gnss.enabled {
+        args.extend([
+            "--gnss-link".to_string(),
+            gnss_link.to_string_lossy().into_owned(),
+        ]);
+    }
     // A run of given length flies the uav circuits for all of it, unless the configuration says
     // how long the flight is.
     if let (Some(d), None) = (up.duration, cfg.sim.uav_flight_s) {

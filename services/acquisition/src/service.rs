@@ -66,7 +66,7 @@ impl Publishers {
 /// Sleeps `total` between attempts to open the device, waking early on shutdown and keeping the
 /// heartbeat going: a process waiting for its device is not hung, and must not be restarted as if
 /// it were, however long the backoff.
-fn wait_for_retry(
+pub fn wait_for_retry(
     total: Duration,
     shutdown: &Shutdown,
     heartbeat: &mut Heartbeat,

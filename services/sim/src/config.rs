@@ -84,6 +84,8 @@ pub struct SimConfig {
     pub sensors: SensorModelConfig,
     /// Calibrate scenario: the turns and the magnetometer's hard and soft iron.
     pub calibration: CalibrationConfig,
+    /// The simulated GNSS receiver (`[sim.gnss]`).
+    pub gnss: crate::gnss_config::GnssReceiverConfig,
 }
 
 impl Default for SimConfig {
@@ -105,6 +107,7 @@ impl Default for SimConfig {
             earth_field: EarthFieldConfig::default(),
             sensors: SensorModelConfig::default(),
             calibration: CalibrationConfig::default(),
+            gnss: crate::gnss_config::GnssReceiverConfig::default(),
         }
     }
 }
@@ -203,6 +206,9 @@ impl SimConfig {
             "must be within -180..=180",
         )?;
         self.calibration.validate()?;
+        self.gnss
+            .validate(self.imu_rate_hz)
+            .map_err(SimError::GnssReceiver)?;
         self.sensors.validate()
     }
 

@@ -15,6 +15,9 @@ pub enum SimError {
         /// What the value must satisfy.
         reason: &'static str,
     },
+    /// A `[sim.gnss]` value is out of range (the message names the field and the value).
+    #[error("{0}")]
+    GnssReceiver(String),
     /// A sensor axis list has an unsupported number of channels.
     #[error("{kind} axes: {count} channels given: must be 3..=16")]
     AxisCount {

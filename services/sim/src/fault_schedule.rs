@@ -46,8 +46,9 @@ pub fn parse_time_s(text: &str) -> Result<f64, FaultParseError> {
 }
 
 impl ScheduledFault {
-    /// Parses `CHANNEL:KIND[=PARAM]@TIME`, e.g. `gyro2:dead@5s`, `accel1:bias=0.5@3.2s`, or
-    /// `disconnect=DURATION_S@TIME` for the whole device, e.g. `disconnect=1.5@5s`.
+    /// Parses `CHANNEL:KIND[=PARAM]@TIME`, e.g. `gyro2:dead@5s`, `accel1:bias=0.5@3.2s`,
+    /// `disconnect=DURATION_S@TIME` for the whole device, e.g. `disconnect=1.5@5s`, or
+    /// `gnss:KIND[=PARAM]@TIME` for the GNSS receiver, e.g. `gnss:jump=50@30s`.
     pub fn parse(spec: &str) -> Result<Self, FaultParseError> {
         Self::parse_inner(spec).map_err(|e| e.within(&format!("{spec:?}")))
     }
@@ -58,6 +59,23 @@ impl ScheduledFault {
         let Some((what, time)) = spec.rsplit_once('@') else {
             return Err(FaultParseError::new("no \"@TIME\"", FORM));
         };
+        if let Some(("gnss", fault)) = what.split_once(':') {
+            let (kind, param) = match fault.split_once('=') {
+                Some((k, p)) => (k, Some(p)),
+                None => (fault, None),
+            };
+            let param = param
+                .map(|p| {
+                    p.parse::<f64>().map_err(|_| {
+                        FaultParseError::new(format!("gnss {kind} {p:?}"), "expected a number")
+                    })
+                })
+                .transpose()?;
+            return Ok(Self {
+                at_s: parse_time_s(time)?,
+                command: SimCommand::gnss(kind, param)?,
+            });
+        }
         let (channel, fault) = match what.split_once(':') {
             Some((channel, fault)) => (Some(ChannelId::parse(channel)?), fault),
             None => (None, what),

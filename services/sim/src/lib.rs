@@ -13,6 +13,8 @@ pub mod error;
 pub mod fault_command;
 pub mod fault_parse_error;
 pub mod fault_schedule;
+pub mod gnss_config;
+pub mod gnss_receiver;
 pub mod outage;
 pub mod sensor_model;
 pub mod serial_line;

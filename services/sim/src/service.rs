@@ -7,8 +7,8 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use ipc_types::{
-    FaultApplied, FaultOutcome, Header, Health, PAYLOAD_VERSION, ServiceKind, SimControl, Truth,
-    names,
+    FaultApplied, FaultOutcome, Header, Health, PAYLOAD_VERSION, ServiceKind, SimControl, SimFault,
+    Truth, names,
 };
 use rins_protocol::{Frame, MAX_FRAME_LEN, encode};
 use rins_runtime::clock::monotonic_ns;
@@ -19,6 +19,7 @@ use rins_runtime::service::{Service, ServiceContext};
 use crate::device_fault::Disconnect;
 use crate::fault_command::{ControlError, FaultCommand, WhiteNoise};
 use crate::fault_schedule::{FaultSchedule, ScheduledFault};
+use crate::gnss_receiver::GnssReceiver;
 use crate::outage::Outage;
 use crate::serial_line::SerialLine;
 use crate::sim_command::SimCommand;
@@ -39,6 +40,61 @@ pub struct SimOptions {
     pub faults: Vec<ScheduledFault>,
     /// Configured white noise, the unit of noise-factor faults.
     pub noise: WhiteNoise,
+    /// The simulated GNSS receiver on its own terminal, when one is fitted.
+    pub gnss: Option<GnssOptions>,
+}
+
+/// The simulated GNSS receiver's settings and its terminal's stable name.
+pub struct GnssOptions {
+    /// `[sim.gnss]`.
+    pub config: crate::gnss_config::GnssReceiverConfig,
+    /// Also expose the receiver's pseudo-terminal under this path.
+    pub link: Option<PathBuf>,
+    /// Seed of its noise (mixed with a salt of its own).
+    pub seed: u64,
+}
+
+/// The receiver and its line.
+struct GnssDevice {
+    receiver: GnssReceiver,
+    line: SerialLine,
+    /// Bytes of the tick, reused.
+    buf: Vec<u8>,
+}
+
+impl GnssDevice {
+    /// Applies a receiver fault before the next step.
+    fn apply(&mut self, sim: &Simulator, fault: SimFault, param: f64) -> FaultOutcome {
+        match self.receiver.apply(fault, param, next_sample_time_us(sim)) {
+            Ok(()) => {
+                tracing::info!(
+                    fault = fault.name(),
+                    param,
+                    time_s = sim.time_s(),
+                    "GNSS receiver fault applied"
+                );
+                FaultOutcome::Applied
+            }
+            Err(why) => {
+                tracing::warn!(
+                    fault = fault.name(),
+                    param,
+                    "GNSS receiver fault ignored: {why}"
+                );
+                FaultOutcome::InvalidParameter
+            }
+        }
+    }
+
+    /// The receiver's share of one tick: its bytes, if any, on its line.
+    fn tick(&mut self, truth: &crate::simulator::TruthSample) {
+        self.buf.clear();
+        self.receiver.tick(truth, &mut self.buf);
+        if !self.buf.is_empty() {
+            // Nobody reading (the gnss service restarting): the epoch is lost, as on a real line.
+            let _ = self.line.send(&self.buf);
+        }
+    }
 }
 
 /// The truth topic's sample for one tick of the simulated trajectory.
@@ -149,6 +205,7 @@ struct Device {
     line: SerialLine,
     outage: Outage,
     imu_rate_hz: f64,
+    gnss: Option<GnssDevice>,
 }
 
 impl Device {
@@ -206,6 +263,23 @@ impl Device {
         match command {
             SimCommand::Channel(c) => apply_fault(sim, c, noise),
             SimCommand::Disconnect(d) => self.disconnect(sim, d),
+            SimCommand::Gnss { fault, param } => {
+                let outcome = match &mut self.gnss {
+                    Some(gnss) => gnss.apply(sim, *fault, *param),
+                    None => {
+                        tracing::warn!(
+                            fault = fault.name(),
+                            "no GNSS receiver is simulated: fault ignored"
+                        );
+                        FaultOutcome::NoSuchChannel
+                    }
+                };
+                FaultApplied {
+                    outcome: outcome as u8,
+                    device_time_us: next_sample_time_us(sim),
+                    ..fault_event(&command.to_control())
+                }
+            }
         }
     }
 
@@ -280,10 +354,23 @@ fn run(mut sim: Simulator, options: &SimOptions, ctx: &ServiceContext) -> Result
     let control = TopicSubscriber::<SimControl>::new(&node, names::SIM_CONTROL)?;
     let imu_rate_hz = 1.0 / sim.imu_period_s();
     let mut schedule = FaultSchedule::new(&options.faults, imu_rate_hz);
+    let gnss = match &options.gnss {
+        Some(g) => {
+            let line = SerialLine::open(g.link.clone())?;
+            tracing::info!(port = line.tty().unwrap_or_default(), link = ?g.link, "simulated GNSS receiver streaming");
+            Some(GnssDevice {
+                receiver: GnssReceiver::new(g.config, g.seed),
+                line,
+                buf: Vec::with_capacity(1024),
+            })
+        }
+        None => None,
+    };
     let mut device = Device {
         line,
         outage: Outage::default(),
         imu_rate_hz,
+        gnss,
     };
     let mut heartbeat = Heartbeat::new(&node, ServiceKind::Simulator)?;
     let mut counters = Health::default();
@@ -309,6 +396,9 @@ fn run(mut sim: Simulator, options: &SimOptions, ctx: &ServiceContext) -> Result
         sim.step(&mut out);
         // Truth first: whoever compares against it must find it before the frame's navigation output.
         truth.publish(truth_message(&out.truth))?;
+        if let Some(gnss) = &mut device.gnss {
+            gnss.tick(&out.truth);
+        }
         let len = encode_tick(&out, &mut buf);
         // Unplugged, or nobody reads the line (acquisition restarting): the frames are lost, and
         // the device's time and sequence numbers go on regardless.

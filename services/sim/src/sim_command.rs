@@ -18,6 +18,56 @@ pub enum SimCommand {
     Channel(FaultCommand),
     /// The serial line unplugged for a while.
     Disconnect(Disconnect),
+    /// A fault of the simulated GNSS receiver (or [`SimFault::Clear`] to end it).
+    Gnss {
+        /// One of the `Gnss*` faults, or `Clear`.
+        fault: SimFault,
+        /// Its parameter (0 for `clear`, and for an outage or freeze until cleared).
+        param: f64,
+    },
+}
+
+/// The target name of the GNSS receiver in `rins inject gnss …` and `gnss:KIND=PARAM@TIME`.
+pub const GNSS_TARGET: &str = "gnss";
+
+impl SimCommand {
+    /// A GNSS receiver fault from its short name (`outage`, `jump`, `freeze`, `drift`, `clear`)
+    /// and parameter; errors name the piece that is wrong.
+    pub fn gnss(kind: &str, param: Option<f64>) -> Result<Self, FaultParseError> {
+        let fault = match kind {
+            "clear" => SimFault::Clear,
+            "outage" => SimFault::GnssOutage,
+            "jump" => SimFault::GnssJump,
+            "freeze" => SimFault::GnssFreeze,
+            "drift" => SimFault::GnssDrift,
+            other => {
+                return Err(FaultParseError::new(
+                    format!("gnss fault {other:?}"),
+                    "expected outage [SECONDS], jump METRES, freeze [SECONDS], drift M_PER_S or clear",
+                ));
+            }
+        };
+        let param = match (fault, param) {
+            (SimFault::Clear, None) => 0.0,
+            (SimFault::Clear, Some(p)) => {
+                return Err(FaultParseError::new(
+                    format!("gnss clear {p}"),
+                    "takes no parameter",
+                ));
+            }
+            (SimFault::GnssOutage | SimFault::GnssFreeze, p) => p.unwrap_or(0.0),
+            (_, Some(p)) => p,
+            (_, None) => {
+                return Err(FaultParseError::new(
+                    format!("gnss {kind}"),
+                    "needs its parameter: jump METRES or drift M_PER_S",
+                ));
+            }
+        };
+        crate::fault_command::check_param(fault, param)
+            .map_err(|reason| FaultParseError::new(format!("gnss {kind} {param}"), reason))?;
+        Ok(Self::Gnss { fault, param })
+    }
 }
 
 impl SimCommand {
@@ -76,6 +126,22 @@ impl SimCommand {
             };
             return Disconnect::parse("disconnect --duration", text).map(Self::Disconnect);
         }
+        if target == GNSS_TARGET {
+            let Some(kind) = fault else {
+                return Err(FaultParseError::new(
+                    "gnss",
+                    "needs a FAULT: outage [SECONDS], jump METRES, freeze [SECONDS], drift M_PER_S or clear",
+                ));
+            };
+            let param = arg
+                .map(|a| {
+                    a.parse::<f64>().map_err(|_| {
+                        FaultParseError::new(format!("gnss {kind} {a:?}"), "expected a number")
+                    })
+                })
+                .transpose()?;
+            return Self::gnss(kind, param.or(duration.and_then(|d| d.parse().ok())));
+        }
         let channel = ChannelId::parse(target)?;
         if let Some(text) = duration {
             return Err(FaultParseError::new(
@@ -98,6 +164,7 @@ impl SimCommand {
         match self {
             Self::Channel(c) => c.fault,
             Self::Disconnect(_) => SimFault::Disconnect,
+            Self::Gnss { fault, .. } => *fault,
         }
     }
 
@@ -106,6 +173,7 @@ impl SimCommand {
         match self {
             Self::Channel(c) => c.param,
             Self::Disconnect(d) => d.duration_s,
+            Self::Gnss { param, .. } => *param,
         }
     }
 
@@ -113,12 +181,15 @@ impl SimCommand {
     pub fn channel(&self) -> Option<ChannelId> {
         match self {
             Self::Channel(c) => Some(c.channel),
-            Self::Disconnect(_) => None,
+            Self::Disconnect(_) | Self::Gnss { .. } => None,
         }
     }
 
-    /// What the command addresses, for messages: the channel's name or `device`.
+    /// What the command addresses, for messages: the channel's name, `gnss` or `device`.
     pub fn target(&self) -> String {
+        if matches!(self, Self::Gnss { .. }) {
+            return GNSS_TARGET.to_string();
+        }
         self.channel()
             .map_or_else(|| "device".to_string(), |c| c.to_string())
     }
@@ -127,7 +198,7 @@ impl SimCommand {
     pub fn check_fitted(&self, n_gyro: usize, n_accel: usize) -> Result<(), FaultParseError> {
         match self {
             Self::Channel(c) => c.channel.check_fitted(n_gyro, n_accel),
-            Self::Disconnect(_) => Ok(()),
+            Self::Disconnect(_) | Self::Gnss { .. } => Ok(()),
         }
     }
 
@@ -143,6 +214,14 @@ impl SimCommand {
                 _pad: [0; 3],
                 param: d.duration_s,
             },
+            Self::Gnss { fault, param } => SimControl {
+                version: PAYLOAD_VERSION,
+                sensor: SimControl::GNSS_RECEIVER,
+                channel: 0,
+                fault: *fault as u8,
+                _pad: [0; 3],
+                param: *param,
+            },
         }
     }
 
@@ -150,6 +229,26 @@ impl SimCommand {
     pub fn from_control(control: &SimControl) -> Result<Self, ControlError> {
         if !control.is_current() {
             return Err(ControlError::Unknown);
+        }
+        if control.sensor == SimControl::GNSS_RECEIVER {
+            let fault = SimFault::from_u8(control.fault).ok_or(ControlError::Unknown)?;
+            let gnss_fault = matches!(
+                fault,
+                SimFault::Clear
+                    | SimFault::GnssOutage
+                    | SimFault::GnssJump
+                    | SimFault::GnssFreeze
+                    | SimFault::GnssDrift
+            );
+            if !gnss_fault || control.channel != 0 {
+                return Err(ControlError::Unknown);
+            }
+            crate::fault_command::check_param(fault, control.param)
+                .map_err(|_| ControlError::InvalidParameter)?;
+            return Ok(Self::Gnss {
+                fault,
+                param: control.param,
+            });
         }
         if control.fault != SimFault::Disconnect as u8 {
             return FaultCommand::from_control(control).map(Self::Channel);
@@ -168,6 +267,7 @@ impl fmt::Display for SimCommand {
         match self {
             Self::Channel(c) => c.fmt(f),
             Self::Disconnect(d) => d.fmt(f),
+            Self::Gnss { fault, param } => write!(f, "{GNSS_TARGET} {} {param}", fault.name()),
         }
     }
 }
@@ -299,5 +399,37 @@ mod tests {
             FaultCommand::from_control(&as_channel),
             Err(ControlError::Unknown)
         );
+    }
+
+    #[test]
+    fn gnss_faults_parse_round_trip_and_name_bad_pieces() {
+        let j = inject("gnss", Some("jump"), Some("50"), None).unwrap();
+        assert_eq!(
+            j,
+            SimCommand::Gnss {
+                fault: SimFault::GnssJump,
+                param: 50.0
+            }
+        );
+        assert_eq!(j.target(), "gnss");
+        assert_eq!(SimCommand::from_control(&j.to_control()), Ok(j));
+        let o = inject("gnss", Some("outage"), None, None).unwrap();
+        assert_eq!((o.fault(), o.param()), (SimFault::GnssOutage, 0.0));
+        let c = inject("gnss", Some("clear"), None, None).unwrap();
+        assert_eq!(SimCommand::from_control(&c.to_control()), Ok(c));
+        let err = inject("gnss", Some("wobble"), None, None).unwrap_err();
+        assert!(err.token.contains("\"wobble\""), "{err}");
+        let err = inject("gnss", Some("jump"), None, None).unwrap_err();
+        assert!(err.reason.contains("METRES"), "{err}");
+        let err = inject("gnss", Some("drift"), Some("fast"), None).unwrap_err();
+        assert!(err.token.contains("\"fast\""), "{err}");
+        let err = inject("gnss", Some("outage"), Some("-3"), None).unwrap_err();
+        assert!(err.token.contains("-3"), "{err}");
+        // A channel fault number sent to the receiver is refused.
+        let bad = SimControl {
+            fault: SimFault::Dead as u8,
+            ..j.to_control()
+        };
+        assert_eq!(SimCommand::from_control(&bad), Err(ControlError::Unknown));
     }
 }

@@ -41,6 +41,11 @@ pub struct FaultRecord {
     /// of north and east), m — the drift as the solution reports it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub coast_horiz_sigma_m: Option<f64>,
+    /// GNSS faults: the largest step of the horizontal solution from one sample to the next
+    /// while the fault was active that the truth's motion does not explain, m: what reached
+    /// the solution of a jump or a drift.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub horiz_step_m_max: Option<f64>,
     /// The sensor type; `None` for the GNSS receiver.
     #[serde(skip)]
     sensor: Option<SensorType>,
@@ -117,6 +122,8 @@ pub struct FaultTracker {
     false_alarms: Vec<FalseAlarm>,
     /// The last navigation sample had the GNSS receiver rejected.
     gnss_rejected: bool,
+    /// North/east error of the last navigation sample, m.
+    last_err_ne_m: Option<[f64; 2]>,
 }
 
 impl FaultTracker {
@@ -187,6 +194,7 @@ impl FaultTracker {
             cleared_at_s: None,
             coast_horiz_err_m: None,
             coast_horiz_sigma_m: None,
+            horiz_step_m_max: None,
             sensor: Some(sensor),
             index,
         };
@@ -238,6 +246,7 @@ impl FaultTracker {
                 .map(|d| t_s + d),
             coast_horiz_err_m: None,
             coast_horiz_sigma_m: None,
+            horiz_step_m_max: None,
             sensor: None,
             index: 0,
         });
@@ -246,9 +255,15 @@ impl FaultTracker {
     }
 
     /// Takes one navigation sample after alignment at device time `t_s`: its aiding bits, its
-    /// horizontal error against the truth (when known) and its horizontal σ. Detects GNSS faults
+    /// north/east error against the truth (when known) and its horizontal σ. Detects GNSS faults
     /// and counts a receiver rejected with none active as a false alarm.
-    pub fn on_nav(&mut self, t_s: f64, aiding_bits: u32, horiz_err_m: Option<f64>, sigma_m: f64) {
+    pub fn on_nav(&mut self, t_s: f64, aiding_bits: u32, err_ne_m: Option<[f64; 2]>, sigma_m: f64) {
+        let horiz_err_m = err_ne_m.map(|[n, e]| n.hypot(e));
+        let step = match (err_ne_m, self.last_err_ne_m) {
+            (Some([n, e]), Some([n0, e0])) => Some((n - n0).hypot(e - e0)),
+            _ => None,
+        };
+        self.last_err_ne_m = err_ne_m;
         let rejected = aiding_bits & aiding::GNSS_REJECTED != 0;
         let stale = aiding_bits & aiding::GNSS_STALE != 0;
         if rejected && !self.gnss_rejected && !self.fault_active(None, t_s) {
@@ -270,6 +285,9 @@ impl FaultTracker {
             if horiz_err_m.is_some() {
                 r.coast_horiz_err_m = horiz_err_m;
                 r.coast_horiz_sigma_m = Some(sigma_m);
+            }
+            if let Some(step) = step {
+                r.horiz_step_m_max = Some(r.horiz_step_m_max.map_or(step, |m| m.max(step)));
             }
         }
     }
@@ -618,14 +636,16 @@ mod tests {
     #[test]
     fn a_gnss_jump_is_detected_when_the_solution_rejects_the_receiver() {
         let mut tr = FaultTracker::new();
-        tr.on_nav(29.0, aiding::GNSS, Some(0.5), 0.4);
+        tr.on_nav(29.0, aiding::GNSS, Some([0.5, 0.0]), 0.4);
         tr.on_fault_applied(&gnss_event(SimFault::GnssJump, 50.0, 30_000_000));
-        tr.on_nav(30.2, aiding::GNSS, Some(0.5), 0.4);
-        tr.on_nav(30.6, aiding::GNSS_REJECTED, Some(0.6), 0.5);
+        tr.on_nav(30.2, aiding::GNSS, Some([0.5, 0.0]), 0.4);
+        tr.on_nav(30.6, aiding::GNSS_REJECTED, Some([0.6, 0.0]), 0.5);
         tr.on_fault_applied(&gnss_event(SimFault::Clear, 0.0, 40_000_000));
-        tr.on_nav(45.0, aiding::GNSS, Some(0.5), 0.4);
+        tr.on_nav(45.0, aiding::GNSS, Some([0.5, 0.0]), 0.4);
         let r = &tr.records()[0];
         assert_eq!((r.channel.as_str(), r.kind), ("gnss", "gnss-jump"));
+        // Steps within the fault: 0.5 → 0.5 → 0.6 m north: 0.1 m at most.
+        assert!((r.horiz_step_m_max.unwrap() - 0.1).abs() < 1e-9, "{r:?}");
         assert_eq!(
             (r.param, r.detected_at_s, r.cleared_at_s),
             (Some(50.0), Some(30.6), Some(40.0))
@@ -637,19 +657,19 @@ mod tests {
     fn a_gnss_outage_reports_the_drift_at_its_end_and_a_rejection_without_fault_is_a_false_alarm() {
         let mut tr = FaultTracker::new();
         tr.on_fault_applied(&gnss_event(SimFault::GnssOutage, 60.0, 10_000_000));
-        tr.on_nav(10.5, aiding::GNSS, Some(0.5), 0.4);
-        tr.on_nav(11.5, aiding::GNSS_STALE, Some(0.9), 0.8);
-        tr.on_nav(69.9, aiding::GNSS_STALE, Some(7.5), 9.0);
+        tr.on_nav(10.5, aiding::GNSS, Some([0.5, 0.0]), 0.4);
+        tr.on_nav(11.5, aiding::GNSS_STALE, Some([0.9, 0.0]), 0.8);
+        tr.on_nav(69.9, aiding::GNSS_STALE, Some([7.5, 0.0]), 9.0);
         // The 60 s outage ends by itself at 70 s.
-        tr.on_nav(70.1, aiding::GNSS, Some(3.0), 1.0);
+        tr.on_nav(70.1, aiding::GNSS, Some([3.0, 0.0]), 1.0);
         let r = &tr.records()[0];
         assert_eq!(r.detected_at_s, Some(11.5));
         assert_eq!(
             (r.coast_horiz_err_m, r.coast_horiz_sigma_m),
             (Some(7.5), Some(9.0))
         );
-        tr.on_nav(80.0, aiding::GNSS_REJECTED, Some(3.0), 1.0);
-        tr.on_nav(80.2, aiding::GNSS_REJECTED, Some(3.0), 1.0);
+        tr.on_nav(80.0, aiding::GNSS_REJECTED, Some([3.0, 0.0]), 1.0);
+        tr.on_nav(80.2, aiding::GNSS_REJECTED, Some([3.0, 0.0]), 1.0);
         assert_eq!(tr.false_alarms(), 1);
     }
 }

@@ -270,18 +270,16 @@ impl Monitor {
             self.integrity_samples[integrity as usize] += 1;
             let truth = &self.truth_ring[(seq as usize) % TRUTH_RING];
             let known = truth.header.origin_seq == seq && truth.version != 0;
-            let horiz_err = known.then(|| {
-                let at = |lat_rad, lon_rad, height_m| Position {
-                    lat_rad,
-                    lon_rad,
-                    height_m,
-                };
-                at(truth.latitude_rad, truth.longitude_rad, truth.altitude_m).distance_to(&at(
-                    nav.latitude_rad,
-                    nav.longitude_rad,
-                    nav.altitude_m,
-                ))
-            });
+            let err_ne =
+                known.then(|| {
+                    let at = |lat_rad, lon_rad, height_m| Position {
+                        lat_rad,
+                        lon_rad,
+                        height_m,
+                    };
+                    at(truth.latitude_rad, truth.longitude_rad, truth.altitude_m)
+                        .north_east_to(&at(nav.latitude_rad, nav.longitude_rad, nav.altitude_m))
+                });
             let sigma = nav.covariance_diag[6]
                 .max(nav.covariance_diag[7])
                 .max(0.0)
@@ -289,7 +287,7 @@ impl Monitor {
             self.faults.on_nav(
                 nav.header.origin_device_time_us as f64 / 1e6,
                 nav.aiding,
-                horiz_err,
+                err_ne,
                 sigma,
             );
             if known {

@@ -4,9 +4,10 @@ use ipc_types::ServiceKind;
 
 /// The pipeline's services in start order: consumers first, so that no sample is published before
 /// its subscriber exists. The hot-standby navigator lane runs when the deployment asks for two
-/// navigator lanes, the MAVLink output when it is enabled. The simulator is not here: it replaces
-/// the serial device, and starts last, once acquisition waits for its terminal.
-pub fn pipeline_services(navigator_lanes: u8, mavlink: bool) -> Vec<ServiceKind> {
+/// navigator lanes, the MAVLink output when it is enabled, the gnss service when a receiver is
+/// fitted (after the navigators that read it). The simulator is not here: it replaces the serial
+/// devices, and starts last, once acquisition waits for its terminal.
+pub fn pipeline_services(navigator_lanes: u8, mavlink: bool, gnss: bool) -> Vec<ServiceKind> {
     let mut kinds = Vec::new();
     if mavlink {
         kinds.push(ServiceKind::Mavlink);
@@ -14,6 +15,9 @@ pub fn pipeline_services(navigator_lanes: u8, mavlink: bool) -> Vec<ServiceKind>
     kinds.push(ServiceKind::Navigator);
     if navigator_lanes == 2 {
         kinds.push(ServiceKind::NavigatorStandby);
+    }
+    if gnss {
+        kinds.push(ServiceKind::Gnss);
     }
     kinds.extend([
         ServiceKind::Altimeter,
@@ -30,7 +34,7 @@ mod tests {
     #[test]
     fn consumers_start_before_their_producers() {
         let names = |lanes| -> Vec<&str> {
-            pipeline_services(lanes, false)
+            pipeline_services(lanes, false, false)
                 .into_iter()
                 .map(ServiceKind::name)
                 .collect()
@@ -50,11 +54,19 @@ mod tests {
             ]
         );
         assert_eq!(
-            pipeline_services(1, true)
+            pipeline_services(1, true, false)
                 .into_iter()
                 .map(ServiceKind::name)
                 .collect::<Vec<_>>(),
             ["mavlink", "navigator", "altimeter", "fusion", "acquisition"]
+        );
+        // The receiver's fixes have their reader before the first one is published.
+        assert_eq!(
+            pipeline_services(1, false, true)
+                .into_iter()
+                .map(ServiceKind::name)
+                .collect::<Vec<_>>(),
+            ["navigator", "gnss", "altimeter", "fusion", "acquisition"]
         );
     }
 }

@@ -1,0 +1,101 @@
+//! `[gnss]` configuration: whether a receiver is fitted, and its serial line.
+
+use std::time::Duration;
+
+use rins_acquisition::config::AcquisitionConfig;
+use serde::{Deserialize, Serialize};
+
+/// `[gnss]` of the configuration.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GnssConfig {
+    /// A receiver is fitted: the watchdog runs the gnss service.
+    pub enabled: bool,
+    /// The receiver's serial device; `rins up` sets it to the simulated receiver.
+    pub port: Option<String>,
+    /// Line speed, baud.
+    pub baud: u32,
+    /// Longest a read blocks before the loop looks at shutdown and heartbeats again.
+    pub read_timeout_ms: u64,
+    /// First delay before reopening a missing or lost port; doubles up to `reconnect_max_ms`.
+    pub reconnect_initial_ms: u64,
+    /// Longest delay between two attempts.
+    pub reconnect_max_ms: u64,
+    /// The line counts as quiet (heartbeat `input_stale`) after this long without a byte.
+    pub stale_after_ms: u64,
+}
+
+impl Default for GnssConfig {
+    fn default() -> Self {
+        Self {
+            enabled: false,
+            port: None,
+            baud: 115_200,
+            read_timeout_ms: 50,
+            reconnect_initial_ms: 10,
+            reconnect_max_ms: 1_000,
+            stale_after_ms: 1_000,
+        }
+    }
+}
+
+impl GnssConfig {
+    /// The serial line's settings in the form the acquisition's port and backoff take.
+    pub fn line(&self) -> AcquisitionConfig {
+        AcquisitionConfig {
+            port: self.port.clone(),
+            baud: self.baud,
+            read_timeout_ms: self.read_timeout_ms,
+            reconnect_initial_ms: self.reconnect_initial_ms,
+            reconnect_max_ms: self.reconnect_max_ms,
+        }
+    }
+
+    /// How long without a byte makes the line quiet.
+    pub fn stale_after(&self) -> Duration {
+        Duration::from_millis(self.stale_after_ms)
+    }
+
+    /// Checks every value's range; the error names the field and the value.
+    pub fn validate(&self) -> Result<(), String> {
+        self.line()
+            .validate()
+            .map_err(|e| e.replacen("acquisition.", "gnss.", 1))?;
+        if !(100..=60_000).contains(&self.stale_after_ms) {
+            return Err(format!(
+                "gnss.stale_after_ms = {}: must be in 100..=60000",
+                self.stale_after_ms
+            ));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_bad_values_are_named_under_gnss() {
+        assert!(GnssConfig::default().validate().is_ok());
+        let bad = GnssConfig {
+            baud: 0,
+            ..Default::default()
+        };
+        assert_eq!(bad.validate().unwrap_err(), "gnss.baud = 0: must be > 0");
+        let bad = GnssConfig {
+            port: Some(String::new()),
+            ..Default::default()
+        };
+        assert!(bad.validate().unwrap_err().starts_with("gnss.port = \"\""));
+        let bad = GnssConfig {
+            stale_after_ms: 5,
+            ..Default::default()
+        };
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .contains("gnss.stale_after_ms = 5")
+        );
+    }
+}
