@@ -188,6 +188,12 @@ pub enum QuadrotorMode {
     /// The navigator's tilt updates (AHRS), cross-validated leave-one-flight-out, beside each
     /// unit alone and each unit's own on-board filter.
     Ahrs,
+    /// GNSS-aided from a standard receiver made from the reference (5 Hz, σ 1.5 m / 3 m /
+    /// 0.1 m/s): attitude, heading and position errors, receiver rejections.
+    Gnss,
+    /// As `gnss` with the receiver cut for the last 10 s: the horizontal error at the end of
+    /// the outage, the fused units against each unit alone.
+    Outage,
 }
 
 /// Options of `rins eval quadrotor`.
@@ -421,13 +427,17 @@ pub struct ProbeArgs {
 /// Options of `rins inject`.
 #[derive(Debug, Args)]
 pub struct InjectArgs {
-    /// Channel: gyro or accel followed by its 0-based index, e.g. gyro2, accel0; or `disconnect`
-    /// to unplug the whole serial device for --duration seconds.
+    /// Channel: gyro or accel followed by its 0-based index, e.g. gyro2, accel0; `disconnect`
+    /// to unplug the whole serial device for --duration seconds; or `gnss` for the simulated
+    /// GNSS receiver.
     pub channel: String,
-    /// dead | stuck | bias | ramp | noise | saturate | intermittent | clear.
+    /// dead | stuck | bias | ramp | noise | saturate | intermittent | clear; for gnss: outage |
+    /// jump | freeze | drift | clear.
     pub fault: Option<String>,
     /// bias: STEP (rad/s, m/s²); ramp: RATE (per s); noise: FACTOR (>= 1, times the configured
-    /// white noise); intermittent: PERIOD_S (default 0.2, dead for the first half).
+    /// white noise); intermittent: PERIOD_S (default 0.2, dead for the first half); gnss outage
+    /// and freeze: SECONDS (default: until cleared); gnss jump: METRES north; gnss drift: M_PER_S
+    /// north.
     #[arg(allow_negative_numbers = true)]
     pub arg: Option<String>,
     /// disconnect: seconds the device stays unplugged (> 0, <= 3600); frames of that time are lost.

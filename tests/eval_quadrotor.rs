@@ -298,3 +298,43 @@ fn eval_quadrotor_ahrs_goes_on_past_failed_units_and_broken_files() {
         .unwrap();
     assert_eq!(three_units["imus"], serde_json::json!([1, 2, 4]));
 }
+
+#[test]
+fn eval_quadrotor_gnss_and_outage_modes_report_their_figures() {
+    let Some(dir) = common::quadrotor_data_dir() else {
+        return;
+    };
+    for mode in ["gnss", "outage"] {
+        let out = rins(&[
+            "eval",
+            "quadrotor",
+            dir.to_str().unwrap(),
+            "--mode",
+            mode,
+            "--json",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(report["mode"], mode);
+        let trials = report["trials"].as_array().unwrap();
+        assert!(!trials.is_empty(), "{report}");
+        for key in [
+            "roll_pitch_rmse_deg",
+            "heading_rmse_deg",
+            "horizontal_rmse_m",
+        ] {
+            assert!(number(&report[key]).is_finite(), "{key}: {report}");
+        }
+        // A GNSS-aided solution is held to metres, not the tens of metres of the free one.
+        assert!(number(&report["horizontal_rmse_m"]) < 5.0, "{report}");
+        if mode == "outage" {
+            assert!(number(&report["outage_error_m"]).is_finite(), "{report}");
+            let single = report["single_outage_error_m"].as_array().unwrap();
+            assert_eq!(single.len(), 4, "{report}");
+        }
+    }
+}

@@ -104,6 +104,8 @@ fn an_outage_coasts_and_reports_its_drift() {
         err <= 3.0 * sigma * std::f64::consts::SQRT_2,
         "{err} m against σ {sigma} m"
     );
-    // Aided again afterwards: the run's error stays that of a GNSS-aided solution.
-    assert!(num(&s, "horiz_pos_err_m_rms") < 10.0, "{s}");
+    // Aided again afterwards: five seconds after the outage the error is that of a GNSS-aided
+    // solution again, and the receiver's return was no false alarm.
+    assert!(num(&s, "horiz_end_err_m") < 5.0, "{s}");
+    assert_eq!(num(&s, "false_alarms"), 0.0, "{s}");
 }

@@ -90,6 +90,22 @@ pub fn run_quadrotor(args: &EvalQuadrotorArgs) -> Result<()> {
             rins_eval::quadrotor_ahrs::report::to_table,
         );
     }
+    let gnss_mode = match args.mode {
+        QuadrotorMode::Gnss => Some(rins_eval::quadrotor_gnss::GnssMode::Gnss),
+        QuadrotorMode::Outage => Some(rins_eval::quadrotor_gnss::GnssMode::Outage),
+        QuadrotorMode::Free | QuadrotorMode::Ahrs => None,
+    };
+    if let Some(mode) = gnss_mode {
+        let report = rins_eval::quadrotor_gnss::evaluate(&args.dir, &aided, mode, &mut |d, t| {
+            bar.set(d, t)
+        })?;
+        bar.finish();
+        return print(
+            args.common.json,
+            &report,
+            rins_eval::quadrotor_gnss::report::to_table,
+        );
+    }
     let report = rins_eval::quadrotor_nav::evaluate(&args.dir, &aided, &mut |d, t| bar.set(d, t))?;
     bar.finish();
     print(

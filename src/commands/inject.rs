@@ -1,6 +1,7 @@
 //! `rins inject CHANNEL FAULT [ARG]`: apply a fault to one channel of the running simulator (or
-//! `rins inject disconnect --duration S`: unplug its serial device) and wait for the simulator to
-//! confirm the device time it took effect.
+//! `rins inject disconnect --duration S`: unplug its serial device; or `rins inject gnss FAULT
+//! [ARG]`: a fault of its GNSS receiver) and wait for the simulator to confirm the device time it
+//! took effect.
 
 use std::time::{Duration, Instant};
 
@@ -61,6 +62,13 @@ pub fn run(args: &InjectArgs) -> Result<()> {
                         event.device_time_us as f64 * 1e-6
                     );
                     Ok(())
+                }
+                Some(FaultOutcome::NoSuchChannel)
+                    if control.sensor == SimControl::GNSS_RECEIVER =>
+                {
+                    bail!(
+                        "gnss: the simulator has no GNSS receiver (run rins up --gnss, or rins sim --gnss-link)"
+                    )
                 }
                 Some(FaultOutcome::NoSuchChannel) => bail!(
                     "channel {:?}: the simulated sensor block has no such channel",

@@ -238,22 +238,22 @@ mod tests {
     }
 
     #[test]
-    fn a_persistent_bias_of_two_sigma_is_a_drift_within_ten_fixes() {
+    fn a_persistent_bias_of_four_sigma_is_a_drift_within_13_fixes() {
         let mut m = monitor();
-        // Each fix adds 2 − 0.5 = 1.5 σ to the upper north sum: 12 σ after 9 fixes.
+        // Each fix adds 4 − 2 = 2 σ to the upper north sum: past 25 σ at the 13th fix.
         let mut fired = None;
-        for i in 0..20 {
-            if m.judge(i * FIX_US, 4.0, [2.0, 0.0]) == Verdict::Rejected {
+        for i in 0..40 {
+            if m.judge(i * FIX_US, 16.0, [4.0, 0.0]) == Verdict::Rejected {
                 fired = Some(i);
                 break;
             }
         }
-        assert_eq!(fired, Some(8));
+        assert_eq!(fired, Some(12));
         assert_eq!(m.rejected(), Some(RejectReason::Drift));
         assert_eq!(
             m.last_transition(),
             Some(Transition::Rejected {
-                t_us: 8 * FIX_US,
+                t_us: 12 * FIX_US,
                 reason: RejectReason::Drift
             })
         );

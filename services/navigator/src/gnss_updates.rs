@@ -99,7 +99,14 @@ impl AidedNavigator {
             return GnssOutcome::Repeated;
         }
         self.gnss.last_receiver_time_us = Some(m.receiver_time_us);
+        // Back after an outage: the position has coasted, its covariance grown and its
+        // correlations with velocity and attitude stretched far beyond what one fix can sort out;
+        // the fix re-sets the position (and velocity) instead of being gated against it.
+        let returning = self.is_stale(AidingSource::Gnss);
         self.last_reading_us[AidingSource::Gnss as usize] = Some(m.t_us);
+        if returning && self.gnss.monitor.rejected().is_none() {
+            return self.reset_from_fix(m);
+        }
         let Some(ekf) = self.ekf() else {
             return GnssOutcome::NotUsed;
         };
@@ -171,6 +178,45 @@ impl AidedNavigator {
             (false, UpdateOutcome::Accepted { d2 }) => GnssOutcome::Applied { d2 },
             (false, _) => GnssOutcome::Outlier,
         }
+    }
+}
+
+impl AidedNavigator {
+    /// Re-sets the position (and the velocity, when reported) from the fix `m` after an outage:
+    /// the antenna's position less the lever arm, its correlations dropped, its variance the
+    /// fix's. The fix's measurement instant is taken as now (the outage was much longer than the
+    /// receiver's latency; the latency's motion is within the variance given here).
+    fn reset_from_fix(&mut self, m: &GnssMeasurement) -> GnssOutcome {
+        let c = self.config.gnss;
+        let Some(ekf) = self.ekf_mut() else {
+            return GnssOutcome::NotUsed;
+        };
+        let past = crate::state_history::PastState::now(ekf, Vector3::zeros());
+        let arm = Vector3::from(c.lever_arm_m);
+        let fix = antenna_position(&past, m.position, &arm, 1.0, 1.0);
+        let (sh, sv) = (
+            floor(m.sigma_h_m, c.sigma_horizontal_floor_m),
+            floor(m.sigma_v_m, c.sigma_vertical_floor_m),
+        );
+        // Move by the innovation (fix − predicted antenna), then forget the old uncertainty.
+        let d = fix.innovation;
+        let s = ekf.state_mut();
+        s.lat += d.x / (rins_earth::meridian_radius(s.lat) + s.alt);
+        s.lon += d.y / ((rins_earth::prime_vertical_radius(s.lat) + s.alt) * s.lat.cos());
+        s.alt -= d.z;
+        for (k, sigma) in [sh, sh, sv].into_iter().enumerate() {
+            ekf.reset_component(POS + k, sigma * sigma);
+        }
+        if let Some(v) = m.velocity_ned.filter(|_| c.use_velocity) {
+            let sigma = floor(m.sigma_vel_mps, c.sigma_velocity_floor_mps);
+            ekf.state_mut().velocity_ned = Vector3::from(v);
+            for k in 0..3 {
+                ekf.reset_component(crate::ekf::VEL + k, sigma * sigma);
+            }
+        }
+        self.gnss.history.clear();
+        self.last_accepted_us[AidingSource::Gnss as usize] = Some(m.t_us);
+        GnssOutcome::Readmitted
     }
 }
 

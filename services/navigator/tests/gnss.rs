@@ -181,6 +181,10 @@ fn hover(
         if i % 200 == 0 {
             let t_s = t_us as f64 * 1e-6;
             let [n, e] = fix_at(t_s);
+            if n.is_nan() {
+                // No fix (an outage).
+                continue;
+            }
             let n = n + noise.sample(&mut rng);
             let e = e + noise.sample(&mut rng);
             let m = GnssMeasurement {
@@ -259,4 +263,22 @@ fn a_half_metre_per_second_drift_is_detected_within_30_s() {
         "detected at {rejected_at} s"
     );
     assert_eq!(nav.gnss_monitor().rejected(), Some(RejectReason::Drift));
+}
+
+#[test]
+fn after_an_outage_the_first_fix_resets_the_position_and_nothing_is_rejected() {
+    // No fixes from 20 s to 80 s; then the truth again.
+    let (nav, outcomes, _) = hover(100.0, |t| {
+        if (20.0..80.0).contains(&t) {
+            [f64::NAN; 2]
+        } else {
+            [0.0, 0.0]
+        }
+    });
+    let back = outcomes.iter().find(|(t, _)| *t >= 80.0).map(|(_, o)| *o);
+    assert_eq!(back, Some(GnssOutcome::Readmitted));
+    assert_eq!(nav.gnss_monitor().rejections(), 0);
+    let ekf = nav.ekf().expect("navigating");
+    let here = PastState::now(ekf, Vector3::zeros()).ned_to(LAT, 0.0, ALT);
+    assert!(here.x.hypot(here.y) < 3.0, "{here}");
 }

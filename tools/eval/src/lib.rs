@@ -19,5 +19,6 @@ pub mod installation;
 pub mod integrity_tally;
 pub mod mc;
 pub mod quadrotor_ahrs;
+pub mod quadrotor_gnss;
 pub mod quadrotor_nav;
 pub mod stats;

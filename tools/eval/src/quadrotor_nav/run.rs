@@ -26,6 +26,8 @@ pub struct Start {
     pub velocity_ned: [f64; 3],
     /// Height above take-off, m.
     pub height_m: f64,
+    /// North, east, down from the reference's first row, m.
+    pub ned_m: [f64; 3],
 }
 
 /// The start at the first truth row inside `[from_s, to_s]` that has a row on either side: the
@@ -50,6 +52,7 @@ pub fn start_from_truth(truth: &[TruthRow], from_s: f64, to_s: f64) -> Option<St
             (after.down_m - before.down_m) / span,
         ],
         height_m: at.height_m,
+        ned_m: [at.north_m, at.east_m, at.down_m],
     })
 }
 

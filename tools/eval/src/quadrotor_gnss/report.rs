@@ -1,0 +1,73 @@
+//! The GNSS modes' report as text.
+
+use std::fmt::Write;
+
+use super::{GnssMode, GnssReport, OUTAGE_RATIO_TARGET, OUTAGE_S, ROLL_PITCH_TARGET_DEG};
+
+/// One line per run, then the means and the targets.
+pub fn to_table(r: &GnssReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{:<22} {:>6} {:<6} {:>9} {:>9} {:>9} {:>10} {:>8}",
+        "flight", "s", "run", "rp rmse°", "yaw rmse°", "horiz m", "end err m", "rejected"
+    );
+    for t in &r.trials {
+        for (k, run) in t.single.iter().chain(std::iter::once(&t.fused)).enumerate() {
+            let (name, secs) = if k == 0 {
+                (t.name.as_str(), format!("{:.1}", t.duration_s))
+            } else {
+                ("", String::new())
+            };
+            let label = run.imu.map_or("fused".to_string(), |i| format!("imu{i}"));
+            let _ = writeln!(
+                s,
+                "{name:<22} {secs:>6} {label:<6} {:>9.3} {:>9.2} {:>9.2} {:>10.2} {:>8}",
+                run.roll_pitch_rmse_deg,
+                run.heading_rmse_deg,
+                run.horizontal_rmse_m,
+                run.end_horizontal_error_m,
+                run.rejections
+            );
+        }
+    }
+    let _ = writeln!(
+        s,
+        "fused, mean over {} flights: roll/pitch {:.3}° (target {ROLL_PITCH_TARGET_DEG}°: {}), heading {:.2}°, horizontal {:.2} m; receiver rejections on clean fixes (drift test chosen leave-one-flight-out): {} in all runs, {} in the fused ones",
+        r.trials.len(),
+        r.roll_pitch_rmse_deg,
+        if r.roll_pitch_target_met {
+            "met"
+        } else {
+            "not met"
+        },
+        r.heading_rmse_deg,
+        r.horizontal_rmse_m,
+        r.gnss_rejections,
+        r.gnss_rejections_fused
+    );
+    if r.mode == GnssMode::Outage {
+        let singles: Vec<String> = r
+            .single_outage_error_m
+            .iter()
+            .map(|e| format!("{e:.2}"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "after a {OUTAGE_S} s outage: fused {:.2} m, single units [{}] m, median single {:.2} m; fused/median {:.2} (target {OUTAGE_RATIO_TARGET}: {})",
+            r.outage_error_m,
+            singles.join(", "),
+            r.median_single_outage_error_m,
+            r.outage_ratio,
+            if r.outage_target_met {
+                "met"
+            } else {
+                "not met"
+            }
+        );
+    }
+    for skip in &r.skipped {
+        let _ = writeln!(s, "skipped {}: {}", skip.trial, skip.reason);
+    }
+    s
+}
