@@ -64,8 +64,8 @@ mod tests {
         // first. Flight 0 held out: candidates 1.. tie at 0 on the others, the most sensitive (1)
         // wins. Any other held out: flight 0 counts, so only the last candidate is clean.
         let mut r = vec![vec![0u64; CANDIDATES.len()]; 3];
-        for c in 0..CANDIDATES.len() - 1 {
-            r[0][c] = 5;
+        for count in r[0].iter_mut().take(CANDIDATES.len() - 1) {
+            *count = 5;
         }
         r[1][0] = 1;
         r[2][0] = 1;
