@@ -54,6 +54,11 @@ fn apply_overrides(cfg: &mut RinsConfig, args: &UpArgs) -> Result<()> {
     if args.gnss {
         cfg.enable_gnss();
     }
+    if cfg.gnss.enabled && args.port.is_some() && cfg.gnss.port.is_none() {
+        bail!(
+            "GNSS is on with a real device (--port) but gnss.port is not set: name the receiver's serial device in [gnss] port"
+        );
+    }
     if let Some(endpoint) = &args.mavlink {
         rins_mavlink::endpoint::Endpoint::parse(endpoint)
             .map_err(|why| anyhow::anyhow!("--mavlink {endpoint:?}: {why}"))?;
