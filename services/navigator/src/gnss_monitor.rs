@@ -10,11 +10,10 @@
 //! under it and stays near zero under noise. Past `drift_threshold` the receiver is rejected.
 //!
 //! A rejected receiver is not used; the solution coasts on the inertial one, its covariance
-//! growing. Its fixes go on being compared — against the uncertainty the solution had when the
-//! receiver was rejected, not the grown one, under which any offset would end up looking
-//! consistent: once they have passed the gate for `readmit_after_s`, it is re-admitted and the
-//! sums start again. A receiver that never comes back leaves the solution coasting, its
-//! covariance growing until the integrity monitor's horizontal limit says so.
+//! growing. Its fixes go on being compared; once they have passed the gate for
+//! `readmit_after_s`, it is re-admitted and the sums start again. The caller holds a receiver
+//! rejected for a jump out while its fixes stay about as far away as they jumped (see
+//! [`crate::gnss_updates`]): the grown covariance alone would in time let a persistent jump back.
 
 use crate::gnss_config::GnssAidingConfig;
 

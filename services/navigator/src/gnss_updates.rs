@@ -127,31 +127,31 @@ impl AidedNavigator {
             return GnssOutcome::Outlier;
         };
         let normalised = [0, 1].map(|k| position.innovation[k] / s[(k, k)].max(0.0).sqrt());
-        // A rejected receiver is judged against the uncertainty the solution had when it was
-        // rejected: the coast makes the covariance grow until any offset looks consistent, and
-        // a receiver that jumped 50 m and stayed there must not come back because of that.
-        let d2 = match self.gnss.rejected_position_cov {
-            Some(frozen) if self.gnss.monitor.rejected().is_some() => {
-                (frozen + position.r).cholesky().map_or(f64::INFINITY, |c| {
-                    position.innovation.dot(&c.solve(&position.innovation))
-                })
-            }
+        // A rejected receiver stays out while its fixes are still at least half as far from the
+        // solution as when it was rejected: the coast's growing covariance would in time make a
+        // persistent jump look consistent, and a drift that goes on never leaves the gate at
+        // all. A receiver that jumped back is judged by the covariance as it has grown, which
+        // includes the coast's own drift.
+        let offset_m = position.innovation.x.hypot(position.innovation.y);
+        let d2 = match (self.gnss.monitor.rejected(), self.gnss.jump_offset_m) {
+            (Some(_), Some(at_rejection)) if offset_m >= 0.5 * at_rejection => f64::INFINITY,
             _ => d2,
         };
-        let p_pos = ekf.covariance().fixed_view::<3, 3>(POS, POS).into_owned();
         let verdict = self.gnss.monitor.judge(m.t_us, d2, normalised);
-        if verdict == Verdict::Rejected && self.gnss.rejected_position_cov.is_none() {
-            self.gnss.rejected_position_cov = Some(p_pos);
+        if verdict == Verdict::Rejected && self.gnss.jump_offset_m.is_none() {
+            self.gnss.jump_offset_m = Some(offset_m);
         }
         if verdict == Verdict::Readmitted {
-            self.gnss.rejected_position_cov = None;
+            self.gnss.jump_offset_m = None;
         }
-        let readmitted = match verdict {
-            Verdict::Use => false,
-            Verdict::Readmitted => true,
+        match verdict {
+            Verdict::Use => {}
+            // Back after coasting: the fix re-sets the position as after an outage, for the
+            // same reason (see `reset_from_fix`).
+            Verdict::Readmitted => return self.reset_from_fix(m),
             Verdict::Outlier => return GnssOutcome::Outlier,
             Verdict::Rejected => return GnssOutcome::Rejected,
-        };
+        }
         let velocity = m.velocity_ned.filter(|_| c.use_velocity).map(|v| {
             antenna_velocity(
                 &past,
@@ -163,26 +163,23 @@ impl AidedNavigator {
         let Some(ekf) = self.ekf_mut() else {
             return GnssOutcome::NotUsed;
         };
-        // Re-admitted after coasting: the first fix is applied whatever the gate says (it was
-        // consistent for `readmit_after_s`, the gate only measures how far the coast went).
-        let gate = if readmitted { f64::INFINITY } else { c.gate };
-        let outcome = apply(ekf, &position, gate);
+        let outcome = apply(ekf, &position, c.gate);
         if let Some(v) = velocity {
-            let _ = apply(ekf, &v, gate);
+            let _ = apply(ekf, &v, c.gate);
         }
         if outcome.is_accepted() {
             self.last_accepted_us[AidingSource::Gnss as usize] = Some(m.t_us);
         }
-        match (readmitted, outcome) {
-            (true, _) => GnssOutcome::Readmitted,
-            (false, UpdateOutcome::Accepted { d2 }) => GnssOutcome::Applied { d2 },
-            (false, _) => GnssOutcome::Outlier,
+        match outcome {
+            UpdateOutcome::Accepted { d2 } => GnssOutcome::Applied { d2 },
+            _ => GnssOutcome::Outlier,
         }
     }
 }
 
 impl AidedNavigator {
-    /// Re-sets the position (and the velocity, when reported) from the fix `m` after an outage:
+    /// Re-sets the position (and the velocity, when reported) from the fix `m` after an outage
+    /// or a re-admission:
     /// the antenna's position less the lever arm, its correlations dropped, its variance the
     /// fix's. The fix's measurement instant is taken as now (the outage was much longer than the
     /// receiver's latency; the latency's motion is within the variance given here).
@@ -242,8 +239,8 @@ pub(crate) struct GnssAidingState {
     pub(crate) monitor: crate::gnss_monitor::GnssMonitor,
     /// The receiver time of the last fix taken, µs.
     pub(crate) last_receiver_time_us: Option<u64>,
-    /// The position covariance when the receiver was rejected, which judges its return.
-    pub(crate) rejected_position_cov: Option<nalgebra::Matrix3<f64>>,
+    /// The horizontal distance of the fixes from the solution when the receiver was rejected, m.
+    pub(crate) jump_offset_m: Option<f64>,
 }
 
 impl GnssAidingState {
@@ -252,7 +249,7 @@ impl GnssAidingState {
             history: crate::state_history::StateHistory::default(),
             monitor: crate::gnss_monitor::GnssMonitor::new(config),
             last_receiver_time_us: None,
-            rejected_position_cov: None,
+            jump_offset_m: None,
         }
     }
 
@@ -262,6 +259,6 @@ impl GnssAidingState {
         self.history.clear();
         self.monitor = crate::gnss_monitor::GnssMonitor::new(config);
         self.last_receiver_time_us = None;
-        self.rejected_position_cov = None;
+        self.jump_offset_m = None;
     }
 }

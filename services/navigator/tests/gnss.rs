@@ -252,7 +252,7 @@ fn a_50_m_jump_is_rejected_within_a_second_without_moving_the_solution() {
 
 #[test]
 fn a_half_metre_per_second_drift_is_detected_within_30_s() {
-    let (nav, outcomes, _) = hover(120.0, |t| [0.5 * (t - 30.0).max(0.0), 0.0]);
+    let (nav, outcomes, _) = hover(60.0, |t| [0.5 * (t - 30.0).max(0.0), 0.0]);
     let rejected_at = outcomes
         .iter()
         .find(|(_, o)| *o == GnssOutcome::Rejected)
@@ -281,4 +281,26 @@ fn after_an_outage_the_first_fix_resets_the_position_and_nothing_is_rejected() {
     let ekf = nav.ekf().expect("navigating");
     let here = PastState::now(ekf, Vector3::zeros()).ned_to(LAT, 0.0, ALT);
     assert!(here.x.hypot(here.y) < 3.0, "{here}");
+}
+
+#[test]
+fn a_receiver_that_jumps_back_is_readmitted_and_one_that_stays_away_is_not() {
+    let (nav, outcomes, _) = hover(70.0, |t| {
+        if (30.0..45.0).contains(&t) {
+            [50.0, 0.0]
+        } else {
+            [0.0, 0.0]
+        }
+    });
+    let back = outcomes
+        .iter()
+        .find(|(_, o)| *o == GnssOutcome::Readmitted)
+        .map(|(t, _)| *t)
+        .expect("readmitted");
+    // Consistent again from 45 s, back after readmit_after_s (3 s).
+    assert!((48.0..=49.0).contains(&back), "readmitted at {back} s");
+    assert_eq!(nav.gnss_monitor().rejected(), None);
+    // A jump that stays: still out two minutes later, however far the coast's covariance grew.
+    let (nav, _, _) = hover(150.0, |t| if t >= 30.0 { [50.0, 0.0] } else { [0.0, 0.0] });
+    assert_eq!(nav.gnss_monitor().rejected(), Some(RejectReason::Jump));
 }

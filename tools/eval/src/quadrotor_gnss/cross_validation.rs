@@ -6,10 +6,13 @@
 use serde::Serialize;
 
 /// The candidates: (slack σ, threshold σ), most sensitive first.
-pub const CANDIDATES: [(f64, f64); 9] = [
+pub const CANDIDATES: [(f64, f64); 12] = [
     (0.5, 12.0),
     (1.0, 12.0),
     (2.0, 12.0),
+    (0.5, 18.0),
+    (1.0, 18.0),
+    (2.0, 18.0),
     (0.5, 25.0),
     (1.0, 25.0),
     (2.0, 25.0),
