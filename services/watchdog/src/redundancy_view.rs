@@ -219,6 +219,9 @@ pub fn nav_summary(n: &NavReport) -> String {
     if !stale.is_empty() {
         out.push_str(&format!(": {} stale", stale.join("+")));
     }
+    if n.aiding & aiding::GNSS_REJECTED != 0 {
+        out.push_str(", gnss rejected");
+    }
     out.push_str(&format!(", lane {}", n.lane));
     let sources = bit_names(n.aiding, &aiding::SOURCE_NAMES);
     if !sources.is_empty() {
