@@ -16,32 +16,39 @@ fn gnss_faults(summary: &serde_json::Value) -> Vec<serde_json::Value> {
         .collect()
 }
 
+/// `rins up --scenario uav --gnss --json` for `seconds` with `faults` scheduled; the summary.
+fn fly(test: &str, seconds: &str, faults: &[&str]) -> serde_json::Value {
+    let ipc = Isolated::new(test);
+    let mut args = vec![
+        "up",
+        "--scenario",
+        "uav",
+        "--gnss",
+        "--duration",
+        seconds,
+        "--json",
+    ];
+    for f in faults {
+        args.extend(["--inject", f]);
+    }
+    let out = ipc.run_with_timeout(&args, std::time::Duration::from_secs(240));
+    assert!(out.status.success(), "rins up failed:\n{}", stderr(&out));
+    last_json(&out)
+}
+
 /// A jump of 50 m from 30 s to 45 s, then a drift of 0.5 m/s from 60 s to 100 s, in one flight.
 #[test]
 fn a_jump_is_rejected_within_a_second_and_a_drift_within_30_s() {
-    let ipc = Isolated::new("gnss_jump_drift");
-    let out = ipc.run_with_timeout(
+    let s = fly(
+        "gnss_jump_drift",
+        "105",
         &[
-            "up",
-            "--scenario",
-            "uav",
-            "--gnss",
-            "--duration",
-            "105",
-            "--json",
-            "--inject",
             "gnss:jump=50@30s",
-            "--inject",
             "gnss:clear@45s",
-            "--inject",
             "gnss:drift=0.5@60s",
-            "--inject",
             "gnss:clear@100s",
         ],
-        std::time::Duration::from_secs(240),
     );
-    assert!(out.status.success(), "rins up failed:\n{}", stderr(&out));
-    let s = last_json(&out);
     let faults = gnss_faults(&s);
     assert_eq!(faults.len(), 2, "{s}");
     let (jump, drift) = (&faults[0], &faults[1]);
@@ -69,23 +76,7 @@ fn a_jump_is_rejected_within_a_second_and_a_drift_within_30_s() {
 /// A 60 s outage: reported as such, the solution coasts, and the drift at its end is reported.
 #[test]
 fn an_outage_coasts_and_reports_its_drift() {
-    let ipc = Isolated::new("gnss_outage");
-    let out = ipc.run_with_timeout(
-        &[
-            "up",
-            "--scenario",
-            "uav",
-            "--gnss",
-            "--duration",
-            "95",
-            "--json",
-            "--inject",
-            "gnss:outage=60@30s",
-        ],
-        std::time::Duration::from_secs(240),
-    );
-    assert!(out.status.success(), "rins up failed:\n{}", stderr(&out));
-    let s = last_json(&out);
+    let s = fly("gnss_outage", "95", &["gnss:outage=60@30s"]);
     let faults = gnss_faults(&s);
     assert_eq!(faults.len(), 1, "{s}");
     let outage = &faults[0];

@@ -49,6 +49,18 @@ impl LocalOrigin {
     }
 }
 
+impl LocalOrigin {
+    /// The geodetic position `ned` metres (north, east, down) from the origin: the inverse of
+    /// [`LocalOrigin::ned`].
+    pub fn geodetic(&self, ned: [f64; 3]) -> [f64; 3] {
+        [
+            self.latitude_rad + ned[0] / self.north_per_rad,
+            self.longitude_rad + ned[1] / self.east_per_rad,
+            self.altitude_m - ned[2],
+        ]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -72,5 +84,15 @@ mod tests {
         let o = LocalOrigin::new(0.0, std::f64::consts::PI - 1e-6, 0.0);
         let [_, e, _] = o.ned(0.0, -std::f64::consts::PI + 1e-6, 0.0);
         assert!((e - 2e-6 * 6_378_137.0).abs() < 1e-6, "{e}");
+    }
+
+    #[test]
+    fn geodetic_is_the_inverse_of_ned() {
+        let o = LocalOrigin::new(0.7, -1.2, 120.0);
+        let [lat, lon, alt] = o.geodetic([350.0, -120.0, 4.5]);
+        let back = o.ned(lat, lon, alt);
+        for (b, want) in back.iter().zip([350.0, -120.0, 4.5]) {
+            assert!((b - want).abs() < 1e-9, "{back:?}");
+        }
     }
 }

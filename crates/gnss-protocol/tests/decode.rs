@@ -4,7 +4,7 @@
 use ipc_types::{GnssFix, GnssFixType, GnssProtocol};
 use proptest::prelude::*;
 use rins_gnss_protocol::decode::GnssDecoder;
-use rins_gnss_protocol::encode::{ReceiverEpoch, write_nav_pvt, write_nmea_epoch};
+use rins_gnss_protocol::encode::{write_nav_pvt, write_nmea_epoch};
 
 fn decode_all(bytes: &[u8]) -> (Vec<GnssFix>, GnssDecoder) {
     let mut d = GnssDecoder::new();
@@ -135,10 +135,10 @@ fn an_implausible_value_under_a_valid_checksum_is_malformed() {
     assert_eq!(d.stats().malformed, 1);
 }
 
-fn epoch(i: u64) -> ReceiverEpoch {
-    ReceiverEpoch {
-        time_us: 45_296_000_000 + i * 200_000,
-        fix: GnssFixType::Fix3d,
+fn epoch(i: u64) -> GnssFix {
+    GnssFix {
+        receiver_time_us: 45_296_000_000 + i * 200_000,
+        fix_type: GnssFixType::Fix3d as u8,
         satellites: 11,
         latitude_rad: (-33.8688 + i as f64 * 1e-6).to_radians(),
         longitude_rad: (151.2093 - i as f64 * 1e-6).to_radians(),
@@ -148,6 +148,7 @@ fn epoch(i: u64) -> ReceiverEpoch {
         vertical_accuracy_m: 3.0,
         speed_accuracy_mps: 0.1,
         hdop: 0.8,
+        ..GnssFix::default()
     }
 }
 
@@ -186,7 +187,7 @@ fn the_simulated_receivers_epochs_read_back_within_their_resolution() {
             assert!((f.vertical_accuracy_m - 3.0).abs() < 1e-3);
             assert_eq!(
                 f.receiver_time_us % 86_400_000_000 / 10_000,
-                e.time_us / 10_000 % 8_640_000
+                e.receiver_time_us / 10_000 % 8_640_000
             );
             // NMEA carries no vertical speed.
             let vd = if ubx { 0.5 } else { 0.0 };
@@ -202,8 +203,8 @@ fn the_simulated_receivers_epochs_read_back_within_their_resolution() {
 fn an_epoch_without_a_fix_is_published_as_such() {
     let mut out = Vec::new();
     write_nmea_epoch(
-        &ReceiverEpoch {
-            fix: GnssFixType::NoFix,
+        &GnssFix {
+            fix_type: GnssFixType::NoFix as u8,
             ..epoch(0)
         },
         &mut out,

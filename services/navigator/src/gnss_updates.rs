@@ -198,9 +198,8 @@ impl AidedNavigator {
         // Move by the innovation (fix − predicted antenna), then forget the old uncertainty.
         let d = fix.innovation;
         let s = ekf.state_mut();
-        s.lat += d.x / (rins_earth::meridian_radius(s.lat) + s.alt);
-        s.lon += d.y / ((rins_earth::prime_vertical_radius(s.lat) + s.alt) * s.lat.cos());
-        s.alt -= d.z;
+        [s.lat, s.lon, s.alt] =
+            rins_earth::LocalOrigin::new(s.lat, s.lon, s.alt).geodetic(d.into());
         for (k, sigma) in [sh, sh, sv].into_iter().enumerate() {
             ekf.reset_component(POS + k, sigma * sigma);
         }

@@ -15,7 +15,7 @@ use std::collections::VecDeque;
 use nalgebra::{UnitQuaternion, Vector3};
 
 use crate::ekf::{CorrectionTotals, ErrorStateEkf};
-use rins_earth::{meridian_radius, prime_vertical_radius};
+use rins_earth::LocalOrigin;
 
 /// Entries kept: with one per millisecond, a second of history, beyond any receiver latency.
 pub const CAPACITY: usize = 1024;
@@ -69,11 +69,7 @@ impl PastState {
 
     /// `to − self` in local NED metres at this state's position.
     pub fn ned_to(&self, lat: f64, lon: f64, alt: f64) -> Vector3<f64> {
-        let north = (lat - self.lat) * (meridian_radius(self.lat) + self.alt);
-        let east = crate::attitude::wrap_pi(lon - self.lon)
-            * (prime_vertical_radius(self.lat) + self.alt)
-            * self.lat.cos();
-        Vector3::new(north, east, self.alt - alt)
+        Vector3::from(LocalOrigin::new(self.lat, self.lon, self.alt).ned(lat, lon, alt))
     }
 }
 
@@ -168,11 +164,11 @@ impl StateHistory {
 
 /// `a` moved on by `dt_s` at its velocity (north/east into latitude/longitude).
 fn extrapolate(a: &Entry, dt_s: f64) -> Entry {
-    let d = a.velocity_ned * dt_s;
+    let [lat, lon, alt] = moved(a, a.velocity_ned * dt_s);
     Entry {
-        lat: a.lat + d.x / (meridian_radius(a.lat) + a.alt),
-        lon: a.lon + d.y / ((prime_vertical_radius(a.lat) + a.alt) * a.lat.cos()),
-        alt: a.alt - d.z,
+        lat,
+        lon,
+        alt,
         totals: CorrectionTotals {
             elapsed_s: a.totals.elapsed_s + dt_s,
             ..a.totals
@@ -200,16 +196,22 @@ fn interpolate(a: &Entry, b: &Entry, w: f64) -> Entry {
     }
 }
 
+/// The position of `e` moved by `d` NED metres.
+fn moved(e: &Entry, d: Vector3<f64>) -> [f64; 3] {
+    LocalOrigin::new(e.lat, e.lon, e.alt).geodetic(d.into())
+}
+
 /// `e` with the corrections made after it: see the module documentation.
 fn corrected(e: &Entry, now: &CorrectionTotals) -> PastState {
     let then = &e.totals;
     let dv = now.velocity_ned_mps - then.velocity_ned_mps;
     let dp = (now.position_ned_m - then.position_ned_m)
         - ((now.velocity_time - then.velocity_time) - dv * then.elapsed_s);
+    let [lat, lon, alt] = moved(e, dp);
     PastState {
-        lat: e.lat + dp.x / (meridian_radius(e.lat) + e.alt),
-        lon: e.lon + dp.y / ((prime_vertical_radius(e.lat) + e.alt) * e.lat.cos()),
-        alt: e.alt - dp.z,
+        lat,
+        lon,
+        alt,
         velocity_ned: e.velocity_ned + dv,
         attitude: e.attitude,
         rate_body: e.rate_body,

@@ -4,13 +4,13 @@
 
 use std::collections::VecDeque;
 
-use ipc_types::{GnssFixType, SimFault};
+use ipc_types::{GnssFix, GnssFixType, PAYLOAD_VERSION, SimFault};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
-use rins_earth::{meridian_radius, prime_vertical_radius};
-use rins_gnss_protocol::encode::{ReceiverEpoch, write_nav_pvt, write_nmea_epoch};
+use rins_earth::LocalOrigin;
+use rins_gnss_protocol::encode::{write_nav_pvt, write_nmea_epoch};
 
 use crate::gnss_config::{GnssReceiverConfig, ReceiverProtocol};
 use crate::simulator::TruthSample;
@@ -47,8 +47,8 @@ pub struct GnssReceiver {
     latency_us: u64,
     next_epoch_us: u64,
     /// Measured epochs waiting for their output time (µs).
-    queue: VecDeque<(u64, ReceiverEpoch)>,
-    last: Option<ReceiverEpoch>,
+    queue: VecDeque<(u64, GnssFix)>,
+    last: Option<GnssFix>,
     faults: Faults,
 }
 
@@ -92,7 +92,7 @@ impl GnssReceiver {
     }
 
     /// The epoch the receiver reports for the instant of `truth`.
-    pub fn measure(&mut self, truth: &TruthSample) -> ReceiverEpoch {
+    pub fn measure(&mut self, truth: &TruthSample) -> GnssFix {
         let t = truth.device_time_us;
         let f = &mut self.faults;
         if f.outage_until_us.is_some_and(|u| u.is_some_and(|u| t >= u)) {
@@ -117,21 +117,25 @@ impl GnssReceiver {
         let north = arm.x + f.jump_north_m + drift_m + c.sigma_horizontal_m * normal();
         let east = arm.y + c.sigma_horizontal_m * normal();
         let down = arm.z + c.sigma_vertical_m * normal();
-        let (lat, alt) = (truth.latitude_rad, truth.altitude_m);
+        let here = LocalOrigin::new(truth.latitude_rad, truth.longitude_rad, truth.altitude_m);
+        let [latitude_rad, longitude_rad, altitude_m] = here.geodetic([north, east, down]);
         let v = truth.velocity_ned_mps;
         let outage = f.outage_until_us.is_some();
-        let epoch = ReceiverEpoch {
-            time_us: t + RECEIVER_CLOCK_OFFSET_US,
-            fix: if outage {
-                GnssFixType::NoFix
-            } else {
-                GnssFixType::Fix3d
-            },
+        let fix_type = if outage {
+            GnssFixType::NoFix
+        } else {
+            GnssFixType::Fix3d
+        };
+        let epoch = GnssFix {
+            version: PAYLOAD_VERSION,
+            receiver_time_us: t + RECEIVER_CLOCK_OFFSET_US,
+            fix_type: fix_type as u8,
+            velocity_valid: 1,
+            accuracy_reported: 1,
             satellites: if outage { 0 } else { 12 },
-            latitude_rad: lat + north / (meridian_radius(lat) + alt),
-            longitude_rad: truth.longitude_rad
-                + east / ((prime_vertical_radius(lat) + alt) * lat.cos()),
-            altitude_m: alt - down,
+            latitude_rad,
+            longitude_rad,
+            altitude_m,
             velocity_ned_mps: [
                 v[0] + c.sigma_velocity_mps * normal(),
                 v[1] + c.sigma_velocity_mps * normal(),
@@ -141,6 +145,7 @@ impl GnssReceiver {
             vertical_accuracy_m: c.sigma_vertical_m,
             speed_accuracy_mps: c.sigma_velocity_mps,
             hdop: 0.8,
+            ..GnssFix::default()
         };
         self.last = Some(epoch);
         epoch
@@ -197,8 +202,8 @@ mod tests {
         }
     }
 
-    fn north_m(e: &ReceiverEpoch) -> f64 {
-        (e.latitude_rad - LAT) * (meridian_radius(LAT) + 100.0)
+    fn north_m(e: &GnssFix) -> f64 {
+        LocalOrigin::new(LAT, 0.0, 100.0).ned(e.latitude_rad, e.longitude_rad, 100.0)[0]
     }
 
     #[test]
@@ -233,13 +238,22 @@ mod tests {
         assert!((north_m(&rx.measure(&truth(12_000_000))) - 5.0).abs() < 1e-6);
         rx.apply(SimFault::Clear, 0.0, 13_000_000).unwrap();
         rx.apply(SimFault::GnssOutage, 2.0, 13_000_000).unwrap();
-        assert_eq!(rx.measure(&truth(13_000_000)).fix, GnssFixType::NoFix);
-        assert_eq!(rx.measure(&truth(15_000_000)).fix, GnssFixType::Fix3d);
+        assert_eq!(
+            rx.measure(&truth(13_000_000)).fix_type,
+            GnssFixType::NoFix as u8
+        );
+        assert_eq!(
+            rx.measure(&truth(15_000_000)).fix_type,
+            GnssFixType::Fix3d as u8
+        );
         let before = rx.measure(&truth(16_000_000));
         rx.apply(SimFault::GnssFreeze, 0.0, 16_000_000).unwrap();
         assert_eq!(rx.measure(&truth(20_000_000)), before);
         rx.apply(SimFault::Clear, 0.0, 21_000_000).unwrap();
-        assert_ne!(rx.measure(&truth(21_000_000)).time_us, before.time_us);
+        assert_ne!(
+            rx.measure(&truth(21_000_000)).receiver_time_us,
+            before.receiver_time_us
+        );
         assert!(rx.apply(SimFault::Dead, 0.0, 0).is_err());
         assert!(rx.apply(SimFault::GnssOutage, -1.0, 0).is_err());
     }

@@ -4,7 +4,9 @@ use std::io::Write;
 
 use ipc_types::GnssFixType;
 
-use super::ReceiverEpoch;
+use ipc_types::GnssFix;
+
+use super::fix_type;
 
 /// Microseconds in a day.
 const DAY_US: u64 = 86_400_000_000;
@@ -14,12 +16,12 @@ const KNOTS_PER_MPS: f64 = 3600.0 / 1852.0;
 const DATE: &str = "011226";
 
 /// Appends the epoch's GGA, RMC, GST and VTG sentences to `out`.
-pub fn write_nmea_epoch(epoch: &ReceiverEpoch, out: &mut Vec<u8>) {
-    let t = epoch.time_us % DAY_US;
+pub fn write_nmea_epoch(epoch: &GnssFix, out: &mut Vec<u8>) {
+    let t = epoch.receiver_time_us % DAY_US;
     let (h, m) = (t / 3_600_000_000, (t / 60_000_000) % 60);
     let s = (t % 60_000_000) / 10_000;
-    let has_fix = epoch.fix != GnssFixType::NoFix;
-    let quality = match epoch.fix {
+    let has_fix = fix_type(epoch) != GnssFixType::NoFix;
+    let quality = match fix_type(epoch) {
         GnssFixType::NoFix | GnssFixType::Fix2d => 0,
         GnssFixType::Fix3d => 1,
         GnssFixType::Differential => 2,

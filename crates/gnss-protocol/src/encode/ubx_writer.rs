@@ -3,17 +3,20 @@
 
 use ipc_types::GnssFixType;
 
-use super::ReceiverEpoch;
+use ipc_types::GnssFix;
+
+use super::fix_type;
 
 /// Milliseconds in a GPS week.
 const WEEK_MS: u64 = 604_800_000;
 const PAYLOAD_LEN: usize = 92;
 
 /// Appends the epoch as one NAV-PVT frame to `out`.
-pub fn write_nav_pvt(epoch: &ReceiverEpoch, out: &mut Vec<u8>) {
+pub fn write_nav_pvt(epoch: &GnssFix, out: &mut Vec<u8>) {
     let mut p = [0u8; PAYLOAD_LEN];
-    let itow = ((epoch.time_us / 1_000) % WEEK_MS) as u32;
-    let (fix_type, flags): (u8, u8) = match epoch.fix {
+    let itow = ((epoch.receiver_time_us / 1_000) % WEEK_MS) as u32;
+    let kind = fix_type(epoch);
+    let (fix_number, flags): (u8, u8) = match kind {
         GnssFixType::NoFix => (0, 0),
         GnssFixType::DeadReckoning => (1, 0x01),
         GnssFixType::Fix2d => (2, 0x01),
@@ -27,10 +30,10 @@ pub fn write_nav_pvt(epoch: &ReceiverEpoch, out: &mut Vec<u8>) {
     let deg7 = |rad: f64| (rad.to_degrees() * 1e7).round() as i32;
     let [vn, ve, vd] = epoch.velocity_ned_mps;
     put(&mut p, 0, &itow.to_le_bytes());
-    p[20] = fix_type;
+    p[20] = fix_number;
     p[21] = flags;
     p[23] = epoch.satellites;
-    if epoch.fix != GnssFixType::NoFix {
+    if kind != GnssFixType::NoFix {
         put(&mut p, 24, &deg7(epoch.longitude_rad).to_le_bytes());
         put(&mut p, 28, &deg7(epoch.latitude_rad).to_le_bytes());
         put(&mut p, 32, &mm(epoch.altitude_m).to_le_bytes());

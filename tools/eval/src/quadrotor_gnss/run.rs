@@ -3,7 +3,7 @@
 //! the receiver cut from `gnss_until_s` on.
 
 use nalgebra::Vector3;
-use rins_earth::{meridian_radius, prime_vertical_radius};
+use rins_earth::LocalOrigin;
 use rins_navigator::gnss_updates::{GnssMeasurement, GnssOutcome};
 use rins_navigator::inertial_core::AidedConfig;
 use rins_navigator::inertial_core::AidedNavigator;
@@ -53,18 +53,12 @@ pub fn navigate_with_gnss(
     config.gnss.enabled = true;
     config.gnss.delay_s = 0.0;
     let [lat0, lon0, alt0] = config.origin;
-    let (rm, rn) = (
-        meridian_radius(lat0) + alt0,
-        prime_vertical_radius(lat0) + alt0,
-    );
-    let to_geo = |ned: [f64; 3]| {
-        [
-            lat0 + ned[0] / rm,
-            lon0 + ned[1] / (rn * lat0.cos()),
-            alt0 - ned[2],
-        ]
+    let origin = LocalOrigin::new(lat0, lon0, alt0);
+    let to_geo = |ned: [f64; 3]| origin.geodetic(ned);
+    let to_local = |s: &NominalState| {
+        let [n, e, _] = origin.ned(s.lat, s.lon, s.alt);
+        [n, e]
     };
-    let to_local = |s: &NominalState| [(s.lat - lat0) * rm, (s.lon - lon0) * rn * lat0.cos()];
     // Device time: µs since one second before t0, so that every time is positive.
     let us = |t_s: f64| ((t_s - start.t_s + 1.0) * 1e6).round().max(0.0) as u64;
 
