@@ -174,6 +174,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
                 program: exe.clone(),
                 args: child_args,
                 policy: cfg.watchdog.policy_for(name),
+                stops_last: false,
             })?;
         }
         if let Some(file) = &args.record {
@@ -191,6 +192,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
                 program: exe.clone(),
                 args: sim_args(&cfg, &config_args, &link, &gnss_link, args),
                 policy: cfg.watchdog.policy_for(ServiceKind::Simulator.name()),
+                stops_last: true,
             })?;
             if !wait_for_path(&link, &mut supervisor, &shutdown)? {
                 return Ok(());

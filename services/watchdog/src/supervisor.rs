@@ -21,6 +21,9 @@ pub struct ChildSpec {
     pub args: Vec<String>,
     /// How it is restarted.
     pub policy: RestartPolicy,
+    /// Stopped only after every other child has stopped: a stand-in for the device (the simulator)
+    /// goes last, so the services reading it do not see their device vanish while they stop.
+    pub stops_last: bool,
 }
 
 struct Managed {
@@ -235,9 +238,15 @@ impl Supervisor {
             .collect()
     }
 
-    /// SIGTERM to every child, in reverse start order; SIGKILL to those still running after `grace`.
+    /// SIGTERM to every child, in reverse start order, the `stops_last` children after the others
+    /// have gone; SIGKILL to those still running after `grace` (each phase has its own grace).
     pub fn stop_all(&mut self, grace: Duration) {
-        for m in self.children.iter().rev() {
+        self.stop_where(grace, |spec| !spec.stops_last);
+        self.stop_where(grace, |_| true);
+    }
+
+    fn stop_where(&mut self, grace: Duration, selected: impl Fn(&ChildSpec) -> bool) {
+        for m in self.children.iter().rev().filter(|m| selected(&m.spec)) {
             if let Some(child) = &m.child {
                 // SAFETY: plain kill(2) on a pid we own and have not reaped yet.
                 unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) };
@@ -246,7 +255,7 @@ impl Supervisor {
         let deadline = Instant::now() + grace;
         loop {
             let mut running = 0;
-            for m in &mut self.children {
+            for m in self.children.iter_mut().filter(|m| selected(&m.spec)) {
                 if let Some(child) = &mut m.child {
                     match child.try_wait() {
                         Ok(Some(_)) | Err(_) => m.child = None,
@@ -262,7 +271,7 @@ impl Supervisor {
             }
             std::thread::sleep(Duration::from_millis(5));
         }
-        for m in &mut self.children {
+        for m in self.children.iter_mut().filter(|m| selected(&m.spec)) {
             if let Some(mut child) = m.child.take() {
                 tracing::warn!(child = %m.spec.name, "did not stop in time; killing");
                 let _ = child.kill();

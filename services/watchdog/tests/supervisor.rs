@@ -14,6 +14,7 @@ fn shell(name: &str, script: &str, policy: RestartPolicy) -> ChildSpec {
         program: PathBuf::from("/bin/sh"),
         args: vec!["-c".to_string(), script.to_string()],
         policy,
+        stops_last: false,
     }
 }
 
@@ -127,4 +128,39 @@ fn a_zero_limit_gives_up_at_the_first_exit() {
         "{events:?}"
     );
     assert_eq!(supervisor.restarts(), 0);
+}
+
+#[test]
+fn the_device_stand_in_stops_after_the_services_reading_it() {
+    let dir = std::env::temp_dir().join(format!("rins-stop-order-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let order = dir.join("order");
+    // Each child notes its name when SIGTERM reaches it, then exits.
+    let noting = |name: &str| {
+        format!(
+            "trap 'echo {name} >> {}; exit 0' TERM; while :; do sleep 0.01; done",
+            order.display()
+        )
+    };
+    let mut supervisor = Supervisor::new();
+    for name in ["acquisition", "fusion"] {
+        supervisor
+            .start(shell(name, &noting(name), RestartPolicy::default()))
+            .expect("start a service");
+    }
+    // Started last, as `rins up` starts the simulator: without `stops_last` it would be signalled first.
+    supervisor
+        .start(ChildSpec {
+            stops_last: true,
+            ..shell("sim", &noting("sim"), RestartPolicy::default())
+        })
+        .expect("start the simulator");
+    std::thread::sleep(Duration::from_millis(100));
+    supervisor.stop_all(Duration::from_secs(5));
+    let noted = std::fs::read_to_string(&order).expect("the children noted their stop");
+    let _ = std::fs::remove_dir_all(&dir);
+    let noted: Vec<&str> = noted.lines().collect();
+    assert_eq!(noted.len(), 3, "{noted:?}");
+    assert_eq!(noted.last(), Some(&"sim"), "{noted:?}");
+    assert!(supervisor.running().is_empty());
 }
