@@ -209,11 +209,27 @@ pub struct EvalQuadrotorArgs {
     pub common: EvalProfileArgs,
 }
 
+/// The estimator a foot-mounted evaluation shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum FootMethodArg {
+    /// The navigator with the pedestrian profile.
+    Rins,
+    /// The peer's published method: SHOE detector and zero-velocity EKF, one threshold for all
+    /// trials.
+    Reference,
+}
+
 /// Options of `rins eval pyshoe`.
 #[derive(Debug, Args)]
 pub struct EvalPyshoeArgs {
     /// Directory of trials (`*.csv`, with the peer's figures in a `.json` beside each).
     pub dir: PathBuf,
+    /// The estimator whose figures, means and plots are shown (both are always run).
+    #[arg(long, value_enum, default_value = "rins")]
+    pub method: FootMethodArg,
+    /// Write one PNG per trial into this directory.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
     /// Output format and navigator profile.
     #[command(flatten)]
     pub common: EvalProfileArgs,
@@ -225,6 +241,12 @@ pub struct EvalXioArgs {
     /// Walk files (`Time (s),Gyroscope X (deg/s),…` CSV).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
+    /// The estimator evaluated.
+    #[arg(long, value_enum, default_value = "rins")]
+    pub method: FootMethodArg,
+    /// Write one PNG per walk into this directory.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
     /// Output format and navigator profile.
     #[command(flatten)]
     pub common: EvalProfileArgs,

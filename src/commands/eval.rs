@@ -4,8 +4,11 @@
 use anyhow::Result;
 use rins_eval::fdi::{FdiRequest, draw_roc, evaluate, to_table};
 
+use rins_eval::foot::FootMethod;
+
 use crate::cli::{
-    EvalFdiArgs, EvalProfileArgs, EvalPyshoeArgs, EvalQuadrotorArgs, EvalXioArgs, QuadrotorMode,
+    EvalFdiArgs, EvalProfileArgs, EvalPyshoeArgs, EvalQuadrotorArgs, EvalXioArgs, FootMethodArg,
+    QuadrotorMode,
 };
 use crate::config;
 
@@ -51,11 +54,31 @@ fn print<T: serde::Serialize>(json: bool, report: &T, table: impl Fn(&T) -> Stri
     Ok(())
 }
 
+fn foot_method(m: FootMethodArg) -> FootMethod {
+    match m {
+        FootMethodArg::Rins => FootMethod::Rins,
+        FootMethodArg::Reference => FootMethod::Reference,
+    }
+}
+
+fn plotted(what: &str, dir: Option<&std::path::Path>) {
+    if let Some(dir) = dir {
+        eprintln!("eval {what}: one plot per trial in {}", dir.display());
+    }
+}
+
 pub fn run_pyshoe(args: &EvalPyshoeArgs) -> Result<()> {
     let aided = pedestrian(&args.common)?;
     let mut bar = super::progress::Progress::new("eval pyshoe");
-    let report = rins_eval::foot::evaluate_pyshoe(&args.dir, &aided, &mut |d, t| bar.set(d, t))?;
+    let report = rins_eval::foot::evaluate_pyshoe(
+        &args.dir,
+        &aided,
+        foot_method(args.method),
+        args.plot.as_deref(),
+        &mut |d, t| bar.set(d, t),
+    )?;
     bar.finish();
+    plotted("pyshoe", args.plot.as_deref());
     print(
         args.common.json,
         &report,
@@ -66,8 +89,15 @@ pub fn run_pyshoe(args: &EvalPyshoeArgs) -> Result<()> {
 pub fn run_xio(args: &EvalXioArgs) -> Result<()> {
     let aided = pedestrian(&args.common)?;
     let mut bar = super::progress::Progress::new("eval xio");
-    let report = rins_eval::foot::evaluate_xio(&args.files, &aided, &mut |d, t| bar.set(d, t))?;
+    let report = rins_eval::foot::evaluate_xio(
+        &args.files,
+        &aided,
+        foot_method(args.method),
+        args.plot.as_deref(),
+        &mut |d, t| bar.set(d, t),
+    )?;
     bar.finish();
+    plotted("xio", args.plot.as_deref());
     print(
         args.common.json,
         &report,

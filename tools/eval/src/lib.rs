@@ -17,6 +17,7 @@ pub mod fdi;
 pub mod foot;
 pub mod installation;
 pub mod integrity_tally;
+pub mod leave_one_out;
 pub mod mc;
 pub mod quadrotor_ahrs;
 pub mod quadrotor_gnss;

@@ -29,8 +29,15 @@ pub struct FootSample {
 /// What others obtained on the same recording, to compare against.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum PeerResult {
-    /// 2-D position RMSE against the reference trajectory, m.
-    Rmse2dM(f64),
+    /// The peer's averaged 2-D error against the reference trajectory ("ARMSE", see
+    /// `foot::metrics::peer_armse_2d`), its threshold tuned per trial, m: of its best detector
+    /// on the trial, and of its SHOE detector when given.
+    Armse2d {
+        /// The best detector's figure.
+        best_m: f64,
+        /// The SHOE detector's figure.
+        shoe_m: Option<f64>,
+    },
     /// Distance between the start and end positions of a closed loop, m.
     EndErrorM(f64),
 }
@@ -296,7 +303,9 @@ mod tests {
                     trial.truth_m.as_ref().map(Vec::len),
                     Some(trial.samples.len())
                 );
-                assert!(matches!(trial.peer, Some(PeerResult::Rmse2dM(r)) if r > 0.0 && r < 1.0));
+                assert!(
+                    matches!(trial.peer, Some(PeerResult::Armse2d { best_m, .. }) if best_m > 0.0 && best_m < 1.0)
+                );
                 assert!(trial.duration_s() > 10.0);
                 assert_eq!(
                     trial.turned_over,

@@ -93,7 +93,7 @@ pub fn load_trial(path: &Path) -> Result<FootTrial, DatasetError> {
 pub(crate) fn parse_trial(
     path: &Path,
     text: &str,
-    peer_rmse_2d_m: Option<f64>,
+    peer: Option<PeerResult>,
 ) -> Result<FootTrial, DatasetError> {
     let rows = parse_numeric(path, text, &HEADER)?;
     // Gravity dominates the mean specific force of a walk: its sign on z tells which way up the
@@ -109,13 +109,7 @@ pub(crate) fn parse_trial(
         })
         .collect();
     let truth = rows.iter().map(|r| [r[7], r[8], r[9]]).collect();
-    let trial = assemble(
-        path,
-        samples,
-        &data_lines(text),
-        Some(truth),
-        peer_rmse_2d_m.map(PeerResult::Rmse2dM),
-    )?;
+    let trial = assemble(path, samples, &data_lines(text), Some(truth), peer)?;
     Ok(FootTrial {
         turned_over,
         ..trial
@@ -129,9 +123,10 @@ fn line_of(text: &str, needle: &str) -> usize {
         .map_or(1, |i| i + 1)
 }
 
-/// The peer's best 2-D RMSE, m, from the JSON text of a trial: the figure of `best_detector`,
-/// or the smallest when that key is absent. `None` when the file gives no figures.
-pub(crate) fn parse_peer(path: &Path, text: &str) -> Result<Option<f64>, DatasetError> {
+/// The peer's figures, m, from the JSON text of a trial: the best one (that of `best_detector`,
+/// or the smallest when that key is absent) and the SHOE detector's. `None` when the file gives
+/// no figures.
+pub(crate) fn parse_peer(path: &Path, text: &str) -> Result<Option<PeerResult>, DatasetError> {
     let file: PeerFile = serde_json::from_str(text).map_err(|e| {
         let message = e.to_string();
         let position = format!(" at line {} column {}", e.line(), e.column());
@@ -162,15 +157,19 @@ pub(crate) fn parse_peer(path: &Path, text: &str) -> Result<Option<f64>, Dataset
             format!("RMSE of {name} = {rmse}: not a distance"),
         ));
     }
-    match file.best_detector {
-        Some(best) => per_detector.get(&best).copied().map(Some).ok_or_else(|| {
+    let best = match file.best_detector {
+        Some(best) => Some(per_detector.get(&best).copied().ok_or_else(|| {
             malformed(
                 "\"best_detector\"",
                 format!("best_detector {best:?} has no RMSE"),
             )
-        }),
-        None => Ok(per_detector.values().copied().reduce(f64::min)),
-    }
+        })?),
+        None => per_detector.values().copied().reduce(f64::min),
+    };
+    Ok(best.map(|best_m| PeerResult::Armse2d {
+        best_m,
+        shoe_m: per_detector.get("shoe").copied(),
+    }))
 }
 
 #[cfg(test)]
@@ -191,7 +190,15 @@ mod tests {
     #[test]
     fn rows_are_taken_as_recorded_with_truth_per_sample() {
         let text = trial_text(2.5);
-        let trial = parse_trial(Path::new("d/2017-11-22-11-22-03.csv"), &text, Some(0.03)).unwrap();
+        let trial = parse_trial(
+            Path::new("d/2017-11-22-11-22-03.csv"),
+            &text,
+            Some(PeerResult::Armse2d {
+                best_m: 0.03,
+                shoe_m: None,
+            }),
+        )
+        .unwrap();
         assert_eq!(trial.name, "2017-11-22-11-22-03");
         assert_eq!(trial.samples.len(), 501);
         assert_eq!(trial.samples[0].accel_mps2, [-0.1, 0.2, -9.8]);
@@ -199,7 +206,13 @@ mod tests {
         let truth = trial.truth_m.as_ref().unwrap();
         assert_eq!(truth.len(), trial.samples.len());
         assert_eq!(truth[0], [1.0, 2.0, 0.1]);
-        assert_eq!(trial.peer, Some(PeerResult::Rmse2dM(0.03)));
+        assert_eq!(
+            trial.peer,
+            Some(PeerResult::Armse2d {
+                best_m: 0.03,
+                shoe_m: None
+            })
+        );
         assert_eq!(trial.dropped_duplicates, 0);
         assert!((trial.rate_hz - 200.0).abs() < 1e-6, "{}", trial.rate_hz);
     }
@@ -249,11 +262,17 @@ mod tests {
  },
  "best_detector": "ared"
 }"#;
-        assert_eq!(parse_peer(p, json).unwrap(), Some(0.04));
+        let figures = |best_m| {
+            Some(PeerResult::Armse2d {
+                best_m,
+                shoe_m: Some(0.042),
+            })
+        };
+        assert_eq!(parse_peer(p, json).unwrap(), figures(0.04));
         let without_best = json.replace(",\n \"best_detector\": \"ared\"", "");
-        assert_eq!(parse_peer(p, &without_best).unwrap(), Some(0.04));
+        assert_eq!(parse_peer(p, &without_best).unwrap(), figures(0.04));
         let shoe = json.replace("\"ared\"\n", "\"shoe\"\n");
-        assert_eq!(parse_peer(p, &shoe).unwrap(), Some(0.042));
+        assert_eq!(parse_peer(p, &shoe).unwrap(), figures(0.042));
         assert_eq!(parse_peer(p, r#"{"imu": "x"}"#).unwrap(), None);
         assert_eq!(
             parse_peer(p, r#"{"peer_2d_rmse_m_per_detector_tuned_per_trial": {}}"#).unwrap(),
@@ -300,7 +319,13 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
 
         assert_eq!(listed.unwrap(), vec![dir.join("a.csv"), dir.join("b.csv")]);
-        assert_eq!(a.unwrap().peer, Some(PeerResult::Rmse2dM(0.031)));
+        assert_eq!(
+            a.unwrap().peer,
+            Some(PeerResult::Armse2d {
+                best_m: 0.031,
+                shoe_m: Some(0.032)
+            })
+        );
         assert_eq!(b.unwrap().peer, None);
         assert!(
             matches!(missing, Err(DatasetError::MissingFile { .. })),

@@ -2,42 +2,108 @@
 
 use std::fmt::Write;
 
-use super::{PyshoeReport, XioReport};
+use super::{FootMethod, PyshoeReport, Skipped, XioReport};
+use crate::integrity_tally::IntegritySummary;
 
-fn opt(v: Option<f64>, scale: f64) -> String {
-    v.map_or_else(|| "-".into(), |x| format!("{:.3}", x * scale))
+fn opt(v: Option<f64>) -> String {
+    v.map_or_else(|| "-".into(), |x| format!("{x:.3}"))
 }
 
-/// The pyshoe evaluation as a text table: one line per trial, then the mean 2-D RMSE beside the
-/// peer's.
+fn method_name(m: FootMethod) -> &'static str {
+    match m {
+        FootMethod::Rins => "rins",
+        FootMethod::Reference => "the peer's method (SHOE + ZUPT EKF, one threshold)",
+    }
+}
+
+fn integrity(i: &Option<IntegritySummary>) -> String {
+    i.as_ref().map_or_else(
+        || "-".into(),
+        |i| format!("{:.1}% {}", 100.0 * i.ok_fraction, i.reasons),
+    )
+}
+
+fn skipped(s: &mut String, list: &[Skipped]) {
+    for k in list {
+        let _ = writeln!(s, "skipped {}: {}", k.file, k.reason);
+    }
+}
+
+/// The pyshoe evaluation as a text table: one line per trial, then the means on both metrics.
 pub fn pyshoe_table(r: &PyshoeReport) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<22} {:>7} {:>10} {:>14} {:>9} {:>8} {:>9} {:>6}  integrity reasons",
-        "trial", "s", "rmse2d m", "peer(tuned) m", "heading°", "stance", "zupt rej", "ok"
+        "evaluated: {} (ARMSE: the peer's metric; thresholds chosen leave-one-trial-out)\n",
+        method_name(r.method)
+    );
+    let _ = writeln!(
+        s,
+        "{:<20} {:>5} {:>7} {:>7} {:>7} {:>7} {:>7} {:>5} {:>7} {:>7} {:>6} {:>6}  integrity",
+        "trial",
+        "s",
+        "rmse2d",
+        "ARMSE",
+        "peer",
+        "p.shoe",
+        "ref",
+        "beat",
+        "stride",
+        "mov.st",
+        "on ms",
+        "end ms"
     );
     for t in &r.trials {
         let _ = writeln!(
             s,
-            "{:<22} {:>7.1} {:>10.3} {:>14} {:>9.1} {:>7.0}% {:>9} {:>5.1}%  {}",
+            "{:<20} {:>5.1} {:>7.3} {:>7.3} {:>7} {:>7} {:>7.3} {:>5} {:>7.3} {:>6.0}% {:>6.0} {:>6.0}  {}",
             t.trial,
             t.seconds,
             t.rmse_2d_m,
-            opt(t.peer_rmse_2d_m, 1.0),
-            t.heading_fit_deg,
-            100.0 * t.stance_fraction,
-            t.zupt_rejected,
-            100.0 * t.integrity.ok_fraction,
-            t.integrity.reasons
+            t.armse_m,
+            opt(t.peer_armse_m),
+            opt(t.peer_shoe_armse_m),
+            t.reference_armse_m,
+            match t.better_than_peer {
+                Some(true) => "yes",
+                Some(false) => "no",
+                None => "-",
+            },
+            t.strides.length_ratio,
+            100.0 * t.strides.stance_while_moving,
+            1e3 * t.strides.onset_delay_s,
+            1e3 * t.strides.end_delay_s,
+            integrity(&t.integrity)
         );
     }
+    skipped(&mut s, &r.skipped);
     let _ = writeln!(
         s,
-        "\nmean 2-D RMSE: {:.3} m over {} trials (peer, threshold tuned per trial: {})",
-        r.mean_rmse_m,
+        "\nover {} trials: our RMSE {:.3} m; ARMSE {:.3} m against the peer's tuned-per-trial {} m \
+         (its SHOE alone {} m); better than the peer on {} of {}",
         r.trials.len(),
-        opt(r.peer_mean_rmse_m, 1.0)
+        r.mean_rmse_m,
+        r.mean_armse_m,
+        opt(r.peer_mean_armse_m),
+        opt(r.peer_shoe_mean_armse_m),
+        r.trials_better_than_peer,
+        r.trials_compared
+    );
+    let _ = writeln!(
+        s,
+        "ARMSE by estimator: rins {:.3} m (profile as configured {:.3} m; threshold chosen on all \
+         trials {:.3e}), the peer's method with one threshold {:.3} m (chosen on all trials \
+         {:.3e})",
+        r.rins_mean_armse_m,
+        r.rins_profile_mean_armse_m,
+        r.rins_threshold_all,
+        r.reference_mean_armse_m,
+        r.reference_threshold_all
+    );
+    let _ = writeln!(
+        s,
+        "strides: estimated / true length {:.3} on average (stride = foot-down to foot-down)",
+        r.mean_stride_length_ratio
     );
     s
 }
@@ -45,26 +111,27 @@ pub fn pyshoe_table(r: &PyshoeReport) -> String {
 /// The x-io evaluation as a text table: one line per walk with its end-point error.
 pub fn xio_table(r: &XioReport) -> String {
     let mut s = String::new();
+    let _ = writeln!(s, "evaluated: {}\n", method_name(r.method));
     let _ = writeln!(
         s,
-        "{:<14} {:>7} {:>10} {:>11} {:>10} {:>9} {:>8} {:>8} {:>6}  integrity reasons",
-        "walk", "s", "end err m", "distance m", "% dist", "peer m", "stance", "dup rows", "ok"
+        "{:<14} {:>7} {:>10} {:>11} {:>10} {:>9} {:>8} {:>8}  integrity",
+        "walk", "s", "end err m", "distance m", "% dist", "peer m", "stance", "dup rows"
     );
     for t in &r.trials {
         let _ = writeln!(
             s,
-            "{:<14} {:>7.1} {:>10.3} {:>11.1} {:>9.2}% {:>9} {:>7.0}% {:>8} {:>5.1}%  {}",
+            "{:<14} {:>7.1} {:>10.3} {:>11.1} {:>9.2}% {:>9} {:>7.0}% {:>8}  {}",
             t.trial,
             t.seconds,
             t.end_error_m,
             t.distance_m,
             t.pct_distance,
-            opt(t.peer_end_error_m, 1.0),
+            opt(t.peer_end_error_m),
             100.0 * t.stance_fraction,
             t.dropped_duplicate_rows,
-            100.0 * t.integrity.ok_fraction,
-            t.integrity.reasons
+            integrity(&t.integrity)
         );
     }
+    skipped(&mut s, &r.skipped);
     s
 }

@@ -14,6 +14,8 @@ pub struct FootRun {
     pub ned_m: Vec<[f64; 3]>,
     /// The position at the start of each stance phase.
     pub foot_down_m: Vec<[f64; 3]>,
+    /// The stance detector's decision per sample.
+    pub stance: Vec<bool>,
     /// Samples the stance detector fired on.
     pub stance_samples: usize,
     /// Zero-velocity updates the filter applied.
@@ -37,6 +39,7 @@ pub fn run_trial(trial: &FootTrial, config: &AidedConfig) -> FootRun {
     let mut nav = AidedNavigator::new(*config);
     let mut run = FootRun {
         ned_m: Vec::with_capacity(trial.samples.len()),
+        stance: Vec::with_capacity(trial.samples.len()),
         ..FootRun::default()
     };
     let t0 = trial.samples.first().map_or(0.0, |s| s.t_s);
@@ -70,6 +73,7 @@ pub fn run_trial(trial: &FootTrial, config: &AidedConfig) -> FootRun {
             }
         }
         in_stance = step.stance;
+        run.stance.push(step.stance);
         run.ned_m.push(p);
     }
     if let Some(ekf) = nav.ekf() {

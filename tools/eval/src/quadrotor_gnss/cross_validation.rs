@@ -35,18 +35,14 @@ pub struct Choice {
 /// For each flight, the candidate chosen on the others; `rejections[f][c]` is flight `f`'s
 /// rejection count under candidate `c`.
 pub fn choose(rejections: &[Vec<u64>]) -> Vec<Choice> {
-    (0..rejections.len())
-        .map(|held_out| {
-            let total = |c: usize| -> u64 {
-                rejections
-                    .iter()
-                    .enumerate()
-                    .filter(|(f, _)| *f != held_out)
-                    .map(|(_, r)| r[c])
-                    .sum()
-            };
-            // `min_by_key` keeps the first of equal keys: the most sensitive candidate.
-            let candidate = (0..CANDIDATES.len()).min_by_key(|&c| total(c)).unwrap_or(0);
+    let scores: Vec<Vec<f64>> = rejections
+        .iter()
+        .map(|r| r.iter().map(|&n| n as f64).collect())
+        .collect();
+    // Ties go to the earlier candidate: the most sensitive.
+    crate::leave_one_out::choose_without_each(&scores)
+        .into_iter()
+        .map(|candidate| {
             let (drift_slack, drift_threshold) = CANDIDATES[candidate];
             Choice {
                 candidate,

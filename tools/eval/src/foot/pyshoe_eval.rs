@@ -1,0 +1,348 @@
+//! `rins eval pyshoe DIR`: every trial through rins and through the peer's method, each scored on
+//! our metric and on the peer's, beside the peer's own per-trial-tuned figures.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, anyhow};
+use rins_navigator::inertial_core::AidedConfig;
+use serde::Serialize;
+
+use super::metrics::{aligned_rmse_2d, peer_armse_2d, round_mm};
+use super::plot::{TrialPlot, draw_trial};
+use super::reference::{ReferenceConfig, run_with_statistic, shoe_statistic};
+use super::run::run_trial;
+use super::strides::{StrideAnalysis, analyse};
+use super::{
+    FootMethod, Skipped, columns, mean, reference_thresholds, rins_candidates, seconds,
+    shoe_threshold,
+};
+use crate::datasets::foot::{FootTrial, PeerResult};
+use crate::datasets::pyshoe;
+use crate::integrity_tally::IntegritySummary;
+use crate::leave_one_out::{choose_on_all, choose_without_each};
+
+/// One pyshoe trial's figures.
+#[derive(Debug, Clone, Serialize)]
+pub struct PyshoeTrial {
+    /// The trial's name.
+    pub trial: String,
+    /// Length of the recording, s.
+    pub seconds: f64,
+    /// The peer's metric for the evaluated method, its threshold chosen on the other trials, m.
+    pub armse_m: f64,
+    /// Our metric for the evaluated method: 2-D RMSE from the navigator's alignment on, after a
+    /// least-squares fit of the start and the initial heading, m.
+    pub rmse_2d_m: f64,
+    /// rins on the peer's metric, threshold chosen on the other trials, m.
+    pub rins_armse_m: f64,
+    /// rins on the peer's metric with the profile exactly as configured, m.
+    pub rins_profile_armse_m: f64,
+    /// The SHOE threshold rins was scored with here.
+    pub rins_threshold: f64,
+    /// The peer's method on the peer's metric, threshold chosen on the other trials, m.
+    pub reference_armse_m: f64,
+    /// The threshold the peer's method was scored with here.
+    pub reference_threshold: f64,
+    /// The peer's best figure on this trial (its threshold and detector tuned for it), m.
+    pub peer_armse_m: Option<f64>,
+    /// The peer's SHOE figure on this trial (threshold tuned for it), m.
+    pub peer_shoe_armse_m: Option<f64>,
+    /// The evaluated method beat the peer's best on this trial (both rounded to 1 mm as the
+    /// peer reports).
+    pub better_than_peer: Option<bool>,
+    /// Rotation the peer's alignment applied to the estimate, degrees.
+    pub heading_deg: f64,
+    /// Stride lengths and stance timing against the truth.
+    pub strides: StrideAnalysis,
+    /// Fraction of the samples in stance, 0..=1.
+    pub stance_fraction: f64,
+    /// Zero-velocity updates the filter's χ² gate rejected (rins only).
+    pub zupt_rejected: u64,
+    /// How much of the walk the navigator judged usable (rins only).
+    pub integrity: Option<IntegritySummary>,
+}
+
+/// The pyshoe evaluation of a whole directory.
+#[derive(Debug, Clone, Serialize)]
+pub struct PyshoeReport {
+    /// The estimator of `armse_m`, `rmse_2d_m`, the strides and the plots.
+    pub method: FootMethod,
+    /// Every evaluated trial, in file order.
+    pub trials: Vec<PyshoeTrial>,
+    /// Files that could not be evaluated.
+    pub skipped: Vec<Skipped>,
+    /// Mean of our metric, m.
+    pub mean_rmse_m: f64,
+    /// Mean of the peer's metric for the evaluated method (held-out thresholds), m.
+    pub mean_armse_m: f64,
+    /// Mean of the peer's best per-trial-tuned figures, m (when every trial has one).
+    pub peer_mean_armse_m: Option<f64>,
+    /// Mean of the peer's per-trial-tuned SHOE figures, m (when every trial has one).
+    pub peer_shoe_mean_armse_m: Option<f64>,
+    /// Trials on which the evaluated method beat the peer's best (same metric, 1 mm rounding).
+    pub trials_better_than_peer: usize,
+    /// Trials with a peer figure.
+    pub trials_compared: usize,
+    /// rins, held-out thresholds, m.
+    pub rins_mean_armse_m: f64,
+    /// rins with the profile as configured, m.
+    pub rins_profile_mean_armse_m: f64,
+    /// The peer's method with one threshold for all trials, held out, m.
+    pub reference_mean_armse_m: f64,
+    /// The SHOE threshold of rins chosen on every trial (what a configuration would ship).
+    pub rins_threshold_all: f64,
+    /// The threshold of the peer's method chosen on every trial.
+    pub reference_threshold_all: f64,
+    /// Mean over the trials of Σ estimated / Σ true stride length.
+    pub mean_stride_length_ratio: f64,
+}
+
+/// What one estimator produced on one trial with one setting.
+struct Scored {
+    armse_m: f64,
+    rmse_2d_m: f64,
+    rotation_rad: f64,
+    ned_m: Vec<[f64; 3]>,
+    stance: Vec<bool>,
+    zupt_rejected: u64,
+    integrity: Option<IntegritySummary>,
+}
+
+fn horizontal(points: &[[f64; 3]]) -> Vec<[f64; 2]> {
+    points.iter().map(|p| [p[0], p[1]]).collect()
+}
+
+// The estimate's first two axes (north, east for rins; the level x, y of the peer's method, also
+// z down) against the export's Vicon x, y. With the Vicon z up, that pair is mirrored, so the
+// export's horizontal axes do not form the right-handed frame their z suggests; matched this way
+// every trial fits within centimetres (the peer's own evaluation pairs them the same way). Only a
+// rotation is ever fitted, never a reflection.
+fn score_rins(trial: &FootTrial, truth: &[[f64; 3]], config: &AidedConfig) -> Scored {
+    let run = run_trial(trial, config);
+    let truth_xy = horizontal(truth);
+    let estimate = horizontal(&run.ned_m);
+    let peer = peer_armse_2d(&estimate, &truth_xy);
+    let start = run.aligned_at.unwrap_or(run.ned_m.len());
+    let rmse = if start < estimate.len() {
+        aligned_rmse_2d(&estimate[start..], &truth_xy[start..]).0
+    } else {
+        f64::NAN
+    };
+    Scored {
+        armse_m: peer.armse_m,
+        rmse_2d_m: rmse,
+        rotation_rad: peer.rotation_rad,
+        zupt_rejected: run.zupt_rejected,
+        integrity: Some(run.integrity.summary()),
+        ned_m: run.ned_m,
+        stance: run.stance,
+    }
+}
+
+fn score_reference(
+    trial: &FootTrial,
+    truth: &[[f64; 3]],
+    statistic: &[f64],
+    threshold: f64,
+) -> Scored {
+    let (accel, gyro) = columns(trial);
+    let config = ReferenceConfig {
+        threshold,
+        ..ReferenceConfig::default()
+    };
+    let run = run_with_statistic(&accel, &gyro, statistic, &config);
+    let (estimate, truth_xy) = (horizontal(&run.position_m), horizontal(truth));
+    let peer = peer_armse_2d(&estimate, &truth_xy);
+    Scored {
+        armse_m: peer.armse_m,
+        rmse_2d_m: aligned_rmse_2d(&estimate, &truth_xy).0,
+        rotation_rad: peer.rotation_rad,
+        zupt_rejected: 0,
+        integrity: None,
+        ned_m: run.position_m,
+        stance: run.stance,
+    }
+}
+
+/// A loaded trial with its truth and the reference detector's statistic.
+struct Loaded {
+    trial: FootTrial,
+    truth: Vec<[f64; 3]>,
+    statistic: Vec<f64>,
+}
+
+fn load(file: &Path) -> Result<Loaded> {
+    let trial = pyshoe::load_trial(file)?;
+    let truth = trial
+        .truth_m
+        .clone()
+        .ok_or_else(|| anyhow!("{}: no truth positions", trial.name))?;
+    let (accel, gyro) = columns(&trial);
+    let r = ReferenceConfig::default();
+    let statistic = shoe_statistic(
+        &accel,
+        &gyro,
+        r.window,
+        r.detector_sigma_a,
+        r.detector_sigma_w,
+        r.g,
+    );
+    Ok(Loaded {
+        trial,
+        truth,
+        statistic,
+    })
+}
+
+/// Every trial of a pyshoe directory; `progress(done, total)` as the runs complete. Plots go to
+/// `plot_dir` when given.
+pub fn evaluate_pyshoe(
+    dir: &Path,
+    config: &AidedConfig,
+    method: FootMethod,
+    plot_dir: Option<&Path>,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<PyshoeReport> {
+    let files = pyshoe::list_trials(dir)
+        .with_context(|| format!("eval pyshoe: cannot list {}", dir.display()))?;
+    if files.is_empty() {
+        return Err(anyhow!("eval pyshoe: no *.csv trials in {}", dir.display()));
+    }
+    let mut skipped = Vec::new();
+    let mut loaded = Vec::new();
+    for file in &files {
+        match load(file) {
+            Ok(l) => loaded.push(l),
+            Err(e) => skipped.push(Skipped {
+                file: file.display().to_string(),
+                reason: format!("{e:#}"),
+            }),
+        }
+    }
+    if loaded.is_empty() {
+        return Err(anyhow!(
+            "eval pyshoe: no trial of {} could be read: {}",
+            dir.display(),
+            skipped.first().map_or("", |s| s.reason.as_str())
+        ));
+    }
+    let rins = rins_candidates(config);
+    let thresholds = reference_thresholds();
+    let total = loaded.len() * (rins.len() + thresholds.len() + 2);
+    let mut done = 0;
+    progress(done, total);
+    let mut rins_scores = Vec::with_capacity(loaded.len());
+    let mut reference_scores = Vec::with_capacity(loaded.len());
+    let mut profile_scores = Vec::with_capacity(loaded.len());
+    for l in &loaded {
+        let row: Vec<f64> = rins
+            .iter()
+            .map(|c| score_rins(&l.trial, &l.truth, c).armse_m)
+            .collect();
+        done += rins.len();
+        progress(done, total);
+        profile_scores.push(score_rins(&l.trial, &l.truth, config).armse_m);
+        rins_scores.push(row);
+        reference_scores.push(
+            thresholds
+                .iter()
+                .map(|&t| score_reference(&l.trial, &l.truth, &l.statistic, t).armse_m)
+                .collect::<Vec<f64>>(),
+        );
+        done += thresholds.len() + 1;
+        progress(done, total);
+    }
+    // The choice minimises the geometric mean of the ARMSE over the training trials: one trial
+    // that diverges under every setting (metres, where the others are centimetres) would
+    // otherwise decide alone.
+    let logs = |m: &[Vec<f64>]| -> Vec<Vec<f64>> {
+        m.iter()
+            .map(|r| r.iter().map(|v| v.max(1e-6).ln()).collect())
+            .collect()
+    };
+    let (rins_logs, reference_logs) = (logs(&rins_scores), logs(&reference_scores));
+    let rins_choice = choose_without_each(&rins_logs);
+    let reference_choice = choose_without_each(&reference_logs);
+    let mut trials = Vec::with_capacity(loaded.len());
+    for (i, l) in loaded.iter().enumerate() {
+        let rins_config = &rins[rins_choice[i]];
+        let reference_threshold = thresholds[reference_choice[i]];
+        let scored = match method {
+            FootMethod::Rins => score_rins(&l.trial, &l.truth, rins_config),
+            FootMethod::Reference => {
+                score_reference(&l.trial, &l.truth, &l.statistic, reference_threshold)
+            }
+        };
+        let (peer, peer_shoe) = match l.trial.peer {
+            Some(PeerResult::Armse2d { best_m, shoe_m }) => (Some(best_m), shoe_m),
+            _ => (None, None),
+        };
+        let times: Vec<f64> = l.trial.samples.iter().map(|s| s.t_s).collect();
+        if let Some(dir) = plot_dir {
+            draw_trial(
+                dir,
+                &TrialPlot {
+                    name: &l.trial.name,
+                    method,
+                    t_s: &times,
+                    estimate: &scored.ned_m,
+                    rotation_rad: scored.rotation_rad,
+                    truth: Some(&l.truth),
+                    stance: &scored.stance,
+                },
+            )?;
+        }
+        trials.push(PyshoeTrial {
+            trial: l.trial.name.clone(),
+            seconds: seconds(&l.trial),
+            armse_m: scored.armse_m,
+            rmse_2d_m: scored.rmse_2d_m,
+            rins_armse_m: rins_scores[i][rins_choice[i]],
+            rins_profile_armse_m: profile_scores[i],
+            rins_threshold: shoe_threshold(rins_config),
+            reference_armse_m: reference_scores[i][reference_choice[i]],
+            reference_threshold,
+            peer_armse_m: peer,
+            peer_shoe_armse_m: peer_shoe,
+            better_than_peer: peer.map(|p| round_mm(scored.armse_m) < p),
+            heading_deg: scored.rotation_rad.to_degrees(),
+            strides: analyse(&scored.ned_m, &scored.stance, &l.truth, &times),
+            stance_fraction: scored.stance.iter().filter(|&&s| s).count() as f64
+                / scored.stance.len().max(1) as f64,
+            zupt_rejected: scored.zupt_rejected,
+            integrity: scored.integrity,
+        });
+        done += 1;
+        progress(done, total);
+    }
+    let all = |f: &dyn Fn(&PyshoeTrial) -> Option<f64>| -> Option<f64> {
+        let v: Vec<f64> = trials.iter().filter_map(f).collect();
+        (v.len() == trials.len()).then(|| mean(v.into_iter()))
+    };
+    progress(total, total);
+    Ok(PyshoeReport {
+        method,
+        mean_rmse_m: mean(trials.iter().map(|t| t.rmse_2d_m)),
+        mean_armse_m: mean(trials.iter().map(|t| t.armse_m)),
+        peer_mean_armse_m: all(&|t| t.peer_armse_m),
+        peer_shoe_mean_armse_m: all(&|t| t.peer_shoe_armse_m),
+        trials_better_than_peer: trials
+            .iter()
+            .filter(|t| t.better_than_peer == Some(true))
+            .count(),
+        trials_compared: trials.iter().filter(|t| t.peer_armse_m.is_some()).count(),
+        rins_mean_armse_m: mean(trials.iter().map(|t| t.rins_armse_m)),
+        rins_profile_mean_armse_m: mean(trials.iter().map(|t| t.rins_profile_armse_m)),
+        reference_mean_armse_m: mean(trials.iter().map(|t| t.reference_armse_m)),
+        rins_threshold_all: shoe_threshold(&rins[choose_on_all(&rins_logs)]),
+        reference_threshold_all: thresholds[choose_on_all(&reference_logs)],
+        mean_stride_length_ratio: mean(
+            trials
+                .iter()
+                .map(|t| t.strides.length_ratio)
+                .filter(|r| r.is_finite()),
+        ),
+        trials,
+        skipped,
+    })
+}
