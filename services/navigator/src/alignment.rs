@@ -41,6 +41,10 @@ pub struct AlignConfig {
     pub max_specific_force_std_mps2: f64,
     /// Largest accepted standard deviation of any rate axis over the window, rad/s.
     pub max_rate_std_rps: f64,
+    /// Take the gyro bias from the window's mean rate. Off for a unit that is never still for
+    /// long (a foot before its first step): there the mean rate over a fraction of a second is
+    /// the foot's sway as much as the gyro's bias, and the filter starts from zero bias instead.
+    pub gyro_bias_from_window: bool,
 }
 
 impl Default for AlignConfig {
@@ -52,6 +56,7 @@ impl Default for AlignConfig {
             max_mean_rate_rps: 0.1,
             max_specific_force_std_mps2: 0.3,
             max_rate_std_rps: 0.05,
+            gyro_bias_from_window: true,
         }
     }
 }
@@ -319,7 +324,11 @@ impl StaticAligner {
             roll,
             pitch,
             yaw,
-            gyro_bias_rps: bias,
+            gyro_bias_rps: if c.gyro_bias_from_window {
+                bias
+            } else {
+                Vector3::zeros()
+            },
             mean_specific_force_mps2: f,
             mean_field_ut: mean_field,
             heading_aided: heading.is_some(),

@@ -46,6 +46,8 @@ pub struct NavigatorConfig {
     pub align_max_specific_force_std_mps2: f64,
     /// Alignment: largest accepted standard deviation of a rate axis, rad/s.
     pub align_max_rate_std_rps: f64,
+    /// Alignment: take the gyro bias from the window's mean rate (off: start from zero bias).
+    pub align_gyro_bias: bool,
     /// Error-state filter noise (`[navigator.ekf]`).
     pub ekf: EkfNoise,
     /// Zero-velocity updates (`[navigator.zupt]`).
@@ -84,6 +86,7 @@ impl Default for NavigatorConfig {
             align_max_rate_rps: align.max_mean_rate_rps,
             align_max_specific_force_std_mps2: align.max_specific_force_std_mps2,
             align_max_rate_std_rps: align.max_rate_std_rps,
+            align_gyro_bias: align.gyro_bias_from_window,
             ekf: EkfNoise::default(),
             zupt: ZuptConfig::default(),
             stance: StanceConfig::default(),
@@ -291,6 +294,7 @@ impl NavigatorConfig {
             max_mean_rate_rps: self.align_max_rate_rps,
             max_specific_force_std_mps2: self.align_max_specific_force_std_mps2,
             max_rate_std_rps: self.align_max_rate_std_rps,
+            gyro_bias_from_window: self.align_gyro_bias,
         }
     }
 

@@ -51,6 +51,30 @@ impl Scene {
 }
 
 #[test]
+fn without_the_window_bias_the_attitude_is_the_same_and_the_bias_zero() {
+    let scene = Scene {
+        attitude: quaternion_from_euler(0.05, -0.1, 1.0),
+        gyro_bias: Vector3::new(0.01, -0.02, 0.005),
+        declination: 0.0,
+        with_mag: true,
+    };
+    let mut with = StaticAligner::new(config());
+    let mut without = StaticAligner::new(AlignConfig {
+        gyro_bias_from_window: false,
+        ..config()
+    });
+    scene.fill(&mut with, &mut Noise::new(7));
+    scene.fill(&mut without, &mut Noise::new(7));
+    let (a, b) = (
+        with.finish(0.0).expect("aligns"),
+        without.finish(0.0).expect("aligns"),
+    );
+    assert_eq!(b.gyro_bias_rps, Vector3::zeros());
+    assert!(a.gyro_bias_rps.norm() > 0.02);
+    assert_eq!(a.attitude, b.attitude);
+}
+
+#[test]
 fn recovers_roll_pitch_heading_and_gyro_bias_within_noise_bounds() {
     let (roll, pitch, yaw) = (5f64.to_radians(), -8f64.to_radians(), 130f64.to_radians());
     let declination = 10f64.to_radians();
