@@ -60,6 +60,14 @@ pub struct StanceConfig {
     /// there pulls the position back along the whole stride through the velocity–position
     /// correlation, so brief detections are not trusted.
     pub min_samples: usize,
+    /// SHOE only: after this many samples without stance (0: never), the threshold is raised by
+    /// `raise_factor` until a window passes the unraised threshold again. A walk finds stance
+    /// every second; a run or a fast turn on the spot can go on for many seconds without a window
+    /// as quiet as a walking stance, and with no zero-velocity update at all the solution is
+    /// lost within seconds.
+    pub raise_after_samples: usize,
+    /// Factor on the SHOE threshold while raised (≥ 1).
+    pub raise_factor: f64,
 }
 
 impl Default for StanceConfig {
@@ -68,6 +76,8 @@ impl Default for StanceConfig {
         Self {
             window: 5,
             min_samples: 1,
+            raise_after_samples: 0,
+            raise_factor: 1.0,
             detector: StanceTest::Shoe {
                 accel_sigma_mps2: 0.01,
                 gyro_sigma_rps: 0.1_f64.to_radians(),
@@ -85,6 +95,9 @@ impl StanceConfig {
         }
         if !(1..=MAX_MIN_SAMPLES).contains(&self.min_samples) {
             return Err(("min_samples", self.min_samples as f64));
+        }
+        if !(self.raise_factor.is_finite() && self.raise_factor >= 1.0) {
+            return Err(("raise_factor", self.raise_factor));
         }
         match self.detector {
             StanceTest::Thresholds {
@@ -131,6 +144,10 @@ pub struct StanceDetector {
     last_statistic: f64,
     /// Consecutive positive decisions so far.
     run: usize,
+    /// Samples since the last stance decision.
+    since_stance: usize,
+    /// The SHOE threshold is raised (see [`StanceConfig::raise_after_samples`]).
+    raised: bool,
 }
 
 impl StanceDetector {
@@ -146,6 +163,8 @@ impl StanceDetector {
             head: 0,
             last_statistic: f64::NAN,
             run: 0,
+            since_stance: 0,
+            raised: false,
         }
     }
 
@@ -164,12 +183,40 @@ impl StanceDetector {
         pressure: Option<f64>,
         gravity: f64,
     ) -> bool {
-        if self.test(gyro, accel, pressure, gravity) {
+        let scale = if self.raised {
+            self.config.raise_factor
+        } else {
+            1.0
+        };
+        let positive = self.test(gyro, accel, pressure, gravity, scale);
+        if positive {
             self.run = self.run.saturating_add(1);
         } else {
             self.run = 0;
         }
-        self.run >= self.config.min_samples
+        let stance = self.run >= self.config.min_samples;
+        if stance {
+            self.since_stance = 0;
+            // Quiet enough for the unraised threshold: back to it.
+            if let StanceTest::Shoe { threshold, .. } = self.config.detector
+                && self.last_statistic < threshold
+            {
+                self.raised = false;
+            }
+        } else {
+            self.since_stance = self.since_stance.saturating_add(1);
+            if self.config.raise_after_samples > 0
+                && self.since_stance >= self.config.raise_after_samples
+            {
+                self.raised = true;
+            }
+        }
+        stance
+    }
+
+    /// Whether the SHOE threshold is raised now.
+    pub fn is_raised(&self) -> bool {
+        self.raised
     }
 
     /// The detector's test on the window ending with this sample.
@@ -179,6 +226,7 @@ impl StanceDetector {
         accel: [f64; 3],
         pressure: Option<f64>,
         gravity: f64,
+        shoe_scale: f64,
     ) -> bool {
         let w = self.config.window;
         self.ring[self.head] = Entry { gyro, accel };
@@ -229,7 +277,7 @@ impl StanceDetector {
                 }
                 t /= w as f64;
                 self.last_statistic = t;
-                t < threshold
+                t < threshold * shoe_scale
             }
         }
     }

@@ -14,6 +14,8 @@ fn shoe() -> StanceConfig {
             threshold: 1e5,
         },
         min_samples: 1,
+        raise_after_samples: 0,
+        raise_factor: 1.0,
     }
 }
 
@@ -61,6 +63,8 @@ fn magnitude_thresholds_need_every_sample_of_the_window() {
             gyro_max_rps: 0.2,
         },
         min_samples: 1,
+        raise_after_samples: 0,
+        raise_factor: 1.0,
     });
     assert!(!d.push([0.0; 3], REST_FORCE, None, G));
     assert!(!d.push([0.0; 3], REST_FORCE, None, G));
@@ -82,6 +86,8 @@ fn foot_pressure_decides_alone_and_a_missing_reading_is_swing() {
         window: 1,
         detector: StanceTest::Fsr { threshold: 0.5 },
         min_samples: 1,
+        raise_after_samples: 0,
+        raise_factor: 1.0,
     });
     assert!(d.push([5.0; 3], [9.0; 3], Some(0.8), G));
     assert!(!d.push([0.0; 3], REST_FORCE, Some(0.2), G));
@@ -103,6 +109,8 @@ fn bad_settings_name_the_field() {
             threshold: 1.0,
         },
         min_samples: 1,
+        raise_after_samples: 0,
+        raise_factor: 1.0,
     };
     assert_eq!(c.check().map_err(|e| e.0), Err("gyro_sigma_rps"));
     c = shoe();
@@ -117,6 +125,8 @@ fn stance_is_declared_only_after_min_samples_consecutive_detections() {
         window: 1,
         detector: StanceTest::Fsr { threshold: 0.5 },
         min_samples: 3,
+        raise_after_samples: 0,
+        raise_factor: 1.0,
     });
     // A two-sample touch is not stance; the third consecutive loaded sample is.
     assert!(!d.push([0.0; 3], REST_FORCE, Some(0.9), G));
@@ -128,4 +138,41 @@ fn stance_is_declared_only_after_min_samples_consecutive_detections() {
     assert!(d.push([0.0; 3], REST_FORCE, Some(0.9), G));
     // One unloaded sample ends it at once.
     assert!(!d.push([0.0; 3], REST_FORCE, Some(0.1), G));
+}
+
+#[test]
+fn a_long_run_without_stance_raises_the_threshold_until_a_quiet_window_returns() {
+    let mut d = StanceDetector::new(StanceConfig {
+        raise_after_samples: 20,
+        raise_factor: 10.0,
+        ..shoe()
+    });
+    // A running stance, never as quiet as a walking one: 0.9 rad/s → T = (0.9/σ_ω)² ≈ 2.7e5,
+    // between the threshold and ten times it.
+    let busy = [0.9, 0.0, 0.0];
+    let (t_busy, threshold) = ((0.9 / 0.1f64.to_radians()).powi(2), 1e5);
+    assert!(t_busy > threshold && t_busy < 10.0 * threshold);
+    for k in 0..19 {
+        assert!(!d.push(busy, REST_FORCE, None, G), "sample {k}");
+    }
+    assert!(!d.is_raised());
+    // The 20th sample without stance raises it: from the next sample on the busy stance passes.
+    assert!(!d.push(busy, REST_FORCE, None, G));
+    assert!(d.is_raised());
+    assert!(d.push(busy, REST_FORCE, None, G));
+    // Swing, then a busy stance again: still raised (the stance was not quiet).
+    for _ in 0..5 {
+        assert!(!d.push([6.0, 0.0, 0.0], [5.0, 0.0, -G], None, G));
+    }
+    let fired = (0..5).map(|_| d.push(busy, REST_FORCE, None, G)).last();
+    assert_eq!(fired, Some(true));
+    assert!(d.is_raised());
+    // A truly quiet window passes the base threshold and lowers it again.
+    for _ in 0..5 {
+        d.push([0.0; 3], REST_FORCE, None, G);
+    }
+    assert!(!d.is_raised());
+    let mut c = shoe();
+    c.raise_factor = 0.5;
+    assert_eq!(c.check(), Err(("raise_factor", 0.5)));
 }

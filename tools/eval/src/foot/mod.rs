@@ -46,7 +46,12 @@ pub struct Skipped {
 }
 
 /// Multiples of the profile's SHOE threshold tried for rins, smallest first.
-pub const RINS_THRESHOLD_FACTORS: [f64; 7] = [0.25, 0.35, 0.5, 0.7, 1.0, 1.4, 2.0];
+pub const RINS_THRESHOLD_FACTORS: [f64; 5] = [0.5, 0.7, 1.0, 1.4, 2.0];
+/// Raise factors tried for rins (`[navigator.stance] raise_factor`; 1 = never raised), each
+/// after the profile's `raise_after_samples` (1 s at 200 Hz when the profile leaves it off).
+pub const RINS_RAISE_FACTORS: [f64; 4] = [1.0, 2.0, 4.0, 8.0];
+/// `raise_after_samples` tried when the profile has none.
+pub const DEFAULT_RAISE_AFTER_SAMPLES: usize = 200;
 
 /// Thresholds tried for the reference method: 10^(6 + i/4), i = 0..=12 (1e6 … 1e9), the range
 /// in which the peer's per-trial optima of its SHOE detector lie.
@@ -57,21 +62,29 @@ pub fn reference_thresholds() -> Vec<f64> {
 }
 
 /// The rins candidates: the profile with its SHOE threshold scaled by each of
-/// [`RINS_THRESHOLD_FACTORS`]; the profile alone when its detector is not SHOE.
+/// [`RINS_THRESHOLD_FACTORS`] and raised by each of [`RINS_RAISE_FACTORS`]; the profile alone
+/// when its detector is not SHOE.
 pub fn rins_candidates(config: &AidedConfig) -> Vec<AidedConfig> {
-    match config.stance.detector {
-        StanceTest::Shoe { threshold, .. } => RINS_THRESHOLD_FACTORS
-            .iter()
-            .map(|f| {
-                let mut c = *config;
-                if let StanceTest::Shoe { threshold: t, .. } = &mut c.stance.detector {
-                    *t = threshold * f;
-                }
-                c
-            })
-            .collect(),
-        _ => vec![*config],
+    let StanceTest::Shoe { threshold, .. } = config.stance.detector else {
+        return vec![*config];
+    };
+    let raise_after = match config.stance.raise_after_samples {
+        0 => DEFAULT_RAISE_AFTER_SAMPLES,
+        n => n,
+    };
+    let mut out = Vec::new();
+    for raise in RINS_RAISE_FACTORS {
+        for f in RINS_THRESHOLD_FACTORS {
+            let mut c = *config;
+            if let StanceTest::Shoe { threshold: t, .. } = &mut c.stance.detector {
+                *t = threshold * f;
+            }
+            c.stance.raise_factor = raise;
+            c.stance.raise_after_samples = if raise > 1.0 { raise_after } else { 0 };
+            out.push(c);
+        }
     }
+    out
 }
 
 /// The SHOE threshold of a configuration (NaN for other detectors).

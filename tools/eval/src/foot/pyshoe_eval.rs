@@ -39,6 +39,8 @@ pub struct PyshoeTrial {
     pub rins_profile_armse_m: f64,
     /// The SHOE threshold rins was scored with here.
     pub rins_threshold: f64,
+    /// The stance threshold's raise factor rins was scored with here (1: never raised).
+    pub rins_raise_factor: f64,
     /// The peer's method on the peer's metric, threshold chosen on the other trials, m.
     pub reference_armse_m: f64,
     /// The threshold the peer's method was scored with here.
@@ -91,6 +93,8 @@ pub struct PyshoeReport {
     pub reference_mean_armse_m: f64,
     /// The SHOE threshold of rins chosen on every trial (what a configuration would ship).
     pub rins_threshold_all: f64,
+    /// The raise factor of rins chosen on every trial.
+    pub rins_raise_factor_all: f64,
     /// The threshold of the peer's method chosen on every trial.
     pub reference_threshold_all: f64,
     /// Mean over the trials of Σ estimated / Σ true stride length.
@@ -300,6 +304,7 @@ pub fn evaluate_pyshoe(
             rins_armse_m: rins_scores[i][rins_choice[i]],
             rins_profile_armse_m: profile_scores[i],
             rins_threshold: shoe_threshold(rins_config),
+            rins_raise_factor: rins_config.stance.raise_factor,
             reference_armse_m: reference_scores[i][reference_choice[i]],
             reference_threshold,
             peer_armse_m: peer,
@@ -335,6 +340,7 @@ pub fn evaluate_pyshoe(
         rins_profile_mean_armse_m: mean(trials.iter().map(|t| t.rins_profile_armse_m)),
         reference_mean_armse_m: mean(trials.iter().map(|t| t.reference_armse_m)),
         rins_threshold_all: shoe_threshold(&rins[choose_on_all(&rins_logs)]),
+        rins_raise_factor_all: rins[choose_on_all(&rins_logs)].stance.raise_factor,
         reference_threshold_all: thresholds[choose_on_all(&reference_logs)],
         mean_stride_length_ratio: mean(
             trials
