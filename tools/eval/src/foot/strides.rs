@@ -134,3 +134,50 @@ pub fn analyse(
         end_delay_s: delays(&ends, true),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Five 1 m strides along x at 200 Hz: 0.5 s of swing at 2 m/s, 0.5 s still.
+    fn walk() -> (Vec<[f64; 3]>, Vec<f64>, Vec<bool>) {
+        let (mut truth, mut t, mut still) = (Vec::new(), Vec::new(), Vec::new());
+        let mut x = 0.0;
+        for k in 0..(5 * 200 + 100) {
+            let phase = k % 200;
+            let moving = k < 5 * 200 && phase < 100;
+            if moving {
+                x += 2.0 / 200.0;
+            }
+            truth.push([x, 0.0, 0.0]);
+            t.push(k as f64 / 200.0);
+            still.push(!moving);
+        }
+        (truth, t, still)
+    }
+
+    #[test]
+    fn a_shrunk_estimate_reads_as_short_strides_and_a_late_stance_as_stance_while_moving() {
+        let (truth, t, still) = walk();
+        let shrunk: Vec<[f64; 3]> = truth.iter().map(|p| [0.95 * p[0], 0.0, 0.0]).collect();
+        // Stance exactly when the foot is still, from the first stride's landing on.
+        let stance: Vec<bool> = still
+            .iter()
+            .enumerate()
+            .map(|(k, &s)| s && k >= 100)
+            .collect();
+        let a = analyse(&shrunk, &stance, &truth, &t);
+        assert_eq!(a.strides, 4);
+        assert!((a.length_ratio - 0.95).abs() < 1e-9, "{a:?}");
+        // Only the samples where the smoothed speed straddles the change read as moving.
+        assert!(a.stance_while_moving < 0.05, "{a:?}");
+        // Stance held 20 samples (0.1 s) into every swing: those samples moved at 2 m/s.
+        let late: Vec<bool> = (0..stance.len())
+            .map(|k| stance[k] || (k >= 100 && k % 200 < 20 && k < 1000))
+            .collect();
+        let b = analyse(&truth, &late, &truth, &t);
+        assert!((b.length_ratio - 1.0).abs() < 1e-9, "{b:?}");
+        assert!(b.stance_while_moving > 0.1, "{b:?}");
+        assert!((b.end_delay_s - 0.1).abs() < 0.02, "{b:?}");
+    }
+}
