@@ -143,6 +143,15 @@ fn killing_either_navigator_lane_loses_no_sample_and_navigation_goes_on() {
     let _ = echo.wait();
     let summary = stop_up(&ipc, up);
     assert_eq!(num(&summary, "restarts"), 2.0, "{summary}");
+    // Both killed processes and both that replaced them are counted in the CPU figures.
+    let lane_incarnations: u64 = summary["processes"]
+        .as_array()
+        .expect("processes")
+        .iter()
+        .filter(|p| LANES.contains(&p["name"].as_str().unwrap_or("")))
+        .map(|p| p["incarnations"].as_u64().unwrap_or(0))
+        .sum();
+    assert_eq!(lane_incarnations, 4, "{summary}");
     // The taken-over solution is as good as the one it came from (same bound as the uav run).
     assert!(num(&summary, "att_err_deg_max") < 3.0, "{summary}");
 }

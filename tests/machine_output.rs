@@ -21,6 +21,37 @@ fn up_json_prints_one_json_document_and_the_status_lines_on_stderr() {
         summary["frames"].as_u64().is_some_and(|n| n > 0),
         "{summary}"
     );
+    // CPU time and peak memory of every process, from /proc: each service ran once, used some
+    // memory (a Rust process with iceoryx2 is megabytes), and no more than the whole machine.
+    let processes = summary["processes"].as_array().expect("processes");
+    for name in [
+        "acquisition",
+        "fusion",
+        "navigator",
+        "navigator-standby",
+        "altimeter",
+        "sim",
+        "watchdog",
+    ] {
+        let p = processes
+            .iter()
+            .find(|p| p["name"] == name)
+            .unwrap_or_else(|| panic!("no {name} in {summary}"));
+        assert_eq!(p["incarnations"].as_u64(), Some(1), "{summary}");
+        assert!(
+            p["peak_rss_kib"].as_u64().is_some_and(|k| k > 1024),
+            "{summary}"
+        );
+        assert!(p["cpu_s"].as_f64().is_some_and(|c| c >= 0.0), "{summary}");
+    }
+    let cores = std::thread::available_parallelism().map_or(1, usize::from) as f64;
+    let pipeline = summary["pipeline_cpu_pct"]
+        .as_f64()
+        .expect("pipeline_cpu_pct");
+    assert!(
+        pipeline > 0.0 && pipeline <= 100.0 * cores + 5.0,
+        "{summary}"
+    );
     // The once-a-second status lines are still there, on stderr.
     let err = stderr(&out);
     assert!(

@@ -13,6 +13,7 @@ pub mod link;
 pub mod monitor;
 pub mod output_deadline;
 pub mod process_graph;
+pub mod process_usage;
 pub mod redundancy_view;
 pub mod restart_policy;
 pub mod restart_timing;

@@ -4,6 +4,7 @@ use std::time::Duration;
 
 use crate::link::link_error_name;
 use crate::monitor::Monitor;
+use crate::process_usage::pipeline_cpu_pct;
 use crate::restart_timing::RestartTiming;
 use crate::summary::Summary;
 use crate::supervisor::Supervisor;
@@ -18,6 +19,7 @@ pub fn summarise(
     simulate: bool,
 ) -> Summary {
     let (restart_worst, restart_measurements) = timing.worst();
+    let usage = supervisor.usage(elapsed);
     let device = monitor.device_counters();
     let acc = &monitor.accuracy;
     let sim = |v: Option<f64>| if simulate { v } else { None };
@@ -66,6 +68,8 @@ pub fn summarise(
         horiz_end_err_m: sim(acc.horizontal.end_error_m()),
         horiz_end_err_pct: sim(acc.horizontal.end_error_pct()),
         shm_leaked: 0,
+        pipeline_cpu_pct: pipeline_cpu_pct(&usage),
+        processes: usage,
         faults: monitor.faults.records().to_vec(),
         false_alarms: monitor.faults.false_alarms(),
     }

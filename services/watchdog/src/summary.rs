@@ -3,6 +3,7 @@
 use serde::Serialize;
 
 use crate::fault_tracking::FaultRecord;
+use crate::process_usage::ProcessUsage;
 
 /// Navigation samples per integrity level.
 #[derive(Debug, Clone, Copy, Default, Serialize, PartialEq, Eq)]
@@ -121,6 +122,11 @@ pub struct Summary {
     pub horiz_end_err_pct: Option<f64>,
     /// Shared-memory entries of this deployment left after shutdown.
     pub shm_leaked: u64,
+    /// CPU time and peak resident memory per process (`watchdog` is `rins up` itself), from
+    /// `/proc`.
+    pub processes: Vec<ProcessUsage>,
+    /// The CPU of every process but the simulator, % of one core over the run.
+    pub pipeline_cpu_pct: f64,
     /// Every fault injected (scheduled or at run time), with detection and isolation times.
     pub faults: Vec<FaultRecord>,
     /// Channels leaving Ok, or faults detected but not isolated, on a sensor type with no

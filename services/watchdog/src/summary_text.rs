@@ -10,6 +10,15 @@ pub fn summary_text(s: &Summary) -> String {
         "summary: {:.1} s, {} IMU frames, {} dropped, {} lost on the line, {} CRC errors, {} restarts, {} shared-memory entries left\n",
         s.duration_s, s.frames, s.dropped, s.lost_frames, s.crc_errors, s.restarts, s.shm_leaked
     );
+    if !s.processes.is_empty() {
+        let peak: u64 = s.processes.iter().map(|p| p.peak_rss_kib).sum();
+        out.push_str(&format!(
+            "  CPU: {:.1} % of one core without the simulator; peak memory {:.1} MiB over {} processes\n",
+            s.pipeline_cpu_pct,
+            peak as f64 / 1024.0,
+            s.processes.len()
+        ));
+    }
     if let (Some(rms), Some(max)) = (s.att_err_deg_rms, s.att_err_deg_max) {
         out.push_str(&format!(
             "  attitude error after alignment: RMS {rms:.2}°, max {max:.2}°\n"
@@ -108,6 +117,8 @@ mod tests {
             horiz_end_err_m: Some(1.11),
             horiz_end_err_pct: Some(0.882),
             shm_leaked: 0,
+            processes: Vec::new(),
+            pipeline_cpu_pct: 0.0,
             faults: Vec::new(),
             false_alarms: 0,
         }

@@ -83,6 +83,7 @@ pub fn supervise(run: &Supervision<'_>, watch: Watch<'_>) -> Result<()> {
             on_child_event(event, run.settings, monitor, timing)?;
         }
         status.print_if_due(run.started, monitor);
+        supervisor.sample_usage_if_due(Instant::now());
         std::thread::sleep(LOOP_PERIOD);
     }
     Ok(())

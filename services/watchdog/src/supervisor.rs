@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 
+use crate::process_usage::{ProcessUsage, UsageTracker, ticks_per_second};
 use crate::restart_policy::{GiveUp, RestartPolicy, RestartWindow};
 
 /// How to start one child, and how to restart it.
@@ -37,10 +38,20 @@ struct Managed {
     given_up: bool,
 }
 
+/// Every running child (name, pid) and this process as `watchdog`. A child is listed only while
+/// it has not been reaped, so its pid cannot have been reused by another process.
+fn processes(children: &[Managed]) -> impl Iterator<Item = (&str, u32)> {
+    children
+        .iter()
+        .filter_map(|m| m.child.as_ref().map(|c| (m.spec.name.as_str(), c.id())))
+        .chain(std::iter::once(("watchdog", std::process::id())))
+}
+
 /// The children of the watchdog: started, reaped, restarted, stopped.
 #[derive(Default)]
 pub struct Supervisor {
     children: Vec<Managed>,
+    usage: UsageTracker,
 }
 
 /// One child as [`Supervisor::children`] reports it.
@@ -238,9 +249,22 @@ impl Supervisor {
             .collect()
     }
 
+    /// Samples the CPU time and peak memory of every running child and of this process, at most
+    /// once per [`crate::process_usage::SAMPLE_PERIOD`].
+    pub fn sample_usage_if_due(&mut self, now: Instant) {
+        self.usage.sample_if_due(now, processes(&self.children));
+    }
+
+    /// CPU time and peak memory per process over `elapsed` (the run), this process as `watchdog`.
+    pub fn usage(&self, elapsed: Duration) -> Vec<ProcessUsage> {
+        self.usage.totals(ticks_per_second(), elapsed)
+    }
+
     /// SIGTERM to every child, in reverse start order, the `stops_last` children after the others
     /// have gone; SIGKILL to those still running after `grace` (each phase has its own grace).
     pub fn stop_all(&mut self, grace: Duration) {
+        // The last reading of each child, while it still runs.
+        self.usage.sample(processes(&self.children));
         self.stop_where(grace, |spec| !spec.stops_last);
         self.stop_where(grace, |_| true);
     }
