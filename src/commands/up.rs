@@ -174,7 +174,8 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
                 program: exe.clone(),
                 args: child_args,
                 policy: cfg.watchdog.policy_for(name),
-                stops_last: false,
+                // The readers of a device stop first, the services downstream after them.
+                stops_last: !matches!(kind, ServiceKind::Acquisition | ServiceKind::Gnss),
             })?;
         }
         if let Some(file) = &args.record {

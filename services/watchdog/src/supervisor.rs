@@ -22,8 +22,9 @@ pub struct ChildSpec {
     pub args: Vec<String>,
     /// How it is restarted.
     pub policy: RestartPolicy,
-    /// Stopped only after every other child has stopped: a stand-in for the device (the simulator)
-    /// goes last, so the services reading it do not see their device vanish while they stop.
+    /// Stopped only after every child without it has stopped. `rins up` stops the device's
+    /// readers first: no sample is published after its consumers are gone, and no reader sees its
+    /// device (the simulator) vanish while it stops.
     pub stops_last: bool,
 }
 
