@@ -100,10 +100,6 @@ fn mean(values: impl Iterator<Item = f64>) -> f64 {
     if n == 0 { f64::NAN } else { sum / n as f64 }
 }
 
-fn seconds(trial: &FootTrial) -> f64 {
-    trial.duration_s()
-}
-
 /// The accelerometer and gyro columns of a trial.
 fn columns(trial: &FootTrial) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
     (

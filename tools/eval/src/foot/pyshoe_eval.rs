@@ -13,8 +13,7 @@ use super::reference::{ReferenceConfig, run_with_statistic, shoe_statistic};
 use super::run::run_trial;
 use super::strides::{StrideAnalysis, analyse};
 use super::{
-    FootMethod, Skipped, columns, mean, reference_thresholds, rins_candidates, seconds,
-    shoe_threshold,
+    FootMethod, Skipped, columns, mean, reference_thresholds, rins_candidates, shoe_threshold,
 };
 use crate::datasets::foot::{FootTrial, PeerResult};
 use crate::datasets::pyshoe;
@@ -298,7 +297,7 @@ pub fn evaluate_pyshoe(
         }
         trials.push(PyshoeTrial {
             trial: l.trial.name.clone(),
-            seconds: seconds(&l.trial),
+            seconds: l.trial.duration_s(),
             armse_m: scored.armse_m,
             rmse_2d_m: scored.rmse_2d_m,
             rins_armse_m: rins_scores[i][rins_choice[i]],

@@ -11,7 +11,7 @@ use super::metrics::path_length_2d;
 use super::plot::{TrialPlot, draw_trial};
 use super::reference::{ReferenceConfig, run_reference};
 use super::run::run_trial;
-use super::{FootMethod, Skipped, columns, seconds};
+use super::{FootMethod, Skipped, columns};
 use crate::datasets::foot::{FootTrial, PeerResult};
 use crate::datasets::xio;
 use crate::integrity_tally::IntegritySummary;
@@ -140,7 +140,7 @@ pub fn evaluate_xio_walk(
     }
     Ok(XioWalk {
         trial: trial.name.clone(),
-        seconds: seconds(trial),
+        seconds: trial.duration_s(),
         end_error_m: end_error,
         distance_m: distance,
         pct_distance: 100.0 * end_error / distance.max(f64::MIN_POSITIVE),
