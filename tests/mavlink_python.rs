@@ -1,7 +1,7 @@
 //! The MAVLink output as a ground station sees it: pymavlink receives the stream of a running
 //! pipeline and checks the message set, the rates, the attitude and covariance against the
 //! solution, TIMESYNC, a refused command, the STATUSTEXT of a dead gyro and the reset counter of a
-//! killed navigator lane, and re-admission commands acknowledged with fusion's answer
+//! killed navigator lane (the one delivering), and re-admission commands acknowledged with fusion's answer
 //! (python/tests/mavlink_stream.py says how each is checked).
 
 mod common;
