@@ -39,6 +39,10 @@ pub enum Command {
         /// A GNSS receiver is fitted: turns on `[gnss]`, `[navigator.gnss]` and `[sim.gnss]`.
         #[arg(long)]
         gnss: bool,
+        /// IMU sample rate, Hz (overrides sim.imu_rate_hz, fusion.sample_rate_hz and
+        /// fusion.kalman.sample_period_s together).
+        #[arg(long, value_name = "HZ")]
+        imu_rate: Option<f64>,
     },
     /// Run the device simulator on a pseudo-terminal.
     Sim(SimArgs),
@@ -99,14 +103,7 @@ pub enum Command {
         timeout: f64,
     },
     /// Measure latency from serial receive through every stage to the navigation state.
-    Latency {
-        /// How long to measure, s.
-        #[arg(long, allow_negative_numbers = true, default_value_t = 5.0)]
-        seconds: f64,
-        /// One JSON object instead of the table.
-        #[arg(long)]
-        json: bool,
-    },
+    Latency(LatencyArgs),
     /// What the configured gyro and accelerometer geometries can do: noise per axis, parity, FDI.
     Geometry {
         /// Configuration file whose geometries are reported (default: the built-in configuration).
@@ -391,6 +388,10 @@ pub struct UpArgs {
     /// `[gnss] port` names one) and turns on the navigator's GNSS updates.
     #[arg(long)]
     pub gnss: bool,
+    /// IMU sample rate of the simulated block and every stage, Hz (overrides sim.imu_rate_hz,
+    /// fusion.sample_rate_hz and fusion.kalman.sample_period_s together).
+    #[arg(long, value_name = "HZ")]
+    pub imu_rate: Option<f64>,
     /// Record every topic into this MCAP file from the start (replaced if it exists), as
     /// `rins record` does.
     #[arg(long, value_name = "FILE")]
@@ -476,6 +477,10 @@ pub struct SimArgs {
     /// Simulator random seed (overrides sim.seed).
     #[arg(long)]
     pub seed: Option<u64>,
+    /// IMU sample rate, Hz (overrides sim.imu_rate_hz, fusion.sample_rate_hz and
+    /// fusion.kalman.sample_period_s together).
+    #[arg(long, value_name = "HZ")]
+    pub imu_rate: Option<f64>,
     /// Configuration file (default: the built-in configuration).
     #[arg(long)]
     pub config: Option<PathBuf>,
@@ -616,4 +621,28 @@ pub struct ReplayArgs {
     /// `nav_samples_different`, ...).
     #[arg(long)]
     pub json: bool,
+}
+
+/// `rins latency`.
+#[derive(Debug, Args)]
+pub struct LatencyArgs {
+    /// How long to measure, s.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 5.0)]
+    pub seconds: f64,
+    /// One JSON object instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// Also write every sample's path as Chrome Trace Event JSON (opens in the Perfetto UI): one
+    /// track per process, one flow arrow per sample from serial receive to this consumer.
+    #[arg(long, value_name = "FILE.json")]
+    pub trace: Option<PathBuf>,
+    /// Also write HDR histogram interval logs, one histogram per hop and interval (ns).
+    #[arg(long, value_name = "FILE")]
+    pub hdr: Option<PathBuf>,
+    /// Length of one HDR log interval, s.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
+    pub hdr_interval: f64,
+    /// Replace the trace or HDR file if it exists (a symbolic link is replaced, never followed).
+    #[arg(long)]
+    pub overwrite: bool,
 }

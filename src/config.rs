@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use anyhow::{Result, anyhow};
+use anyhow::{Result, anyhow, bail};
 use rins_acquisition::config::AcquisitionConfig;
 use rins_altimeter::AltimeterConfig;
 use rins_fusion::FusionConfig;
@@ -16,6 +16,11 @@ use rins_watchdog::config::WatchdogConfig;
 use serde::{Deserialize, Serialize};
 
 use crate::cli::ScenarioArg;
+
+/// The IMU rates `--imu-rate` accepts, Hz: from a slow block to what the pipeline carries.
+pub const MIN_IMU_RATE_HZ: f64 = 50.0;
+/// See [`MIN_IMU_RATE_HZ`].
+pub const MAX_IMU_RATE_HZ: f64 = 16_000.0;
 
 /// The configuration used when no file is given (also shipped as `config/rins.toml`).
 pub const BUILT_IN: &str = include_str!("../config/rins.toml");
@@ -194,6 +199,22 @@ impl RinsConfig {
             rins_sim::Scenario::Walk => "walk",
             rins_sim::Scenario::Calibrate => "calibrate",
         }
+    }
+
+    /// The block's IMU sample rate, `hz`, everywhere the configuration states it: the
+    /// simulator's rate, fusion's nominal rate and its Kalman filter's period. The other
+    /// simulated sensors keep their rates (capped at the IMU's).
+    pub fn set_imu_rate(&mut self, hz: f64) -> Result<()> {
+        if !(hz.is_finite() && (MIN_IMU_RATE_HZ..=MAX_IMU_RATE_HZ).contains(&hz)) {
+            bail!("--imu-rate {hz}: must be {MIN_IMU_RATE_HZ}..={MAX_IMU_RATE_HZ} Hz");
+        }
+        self.sim.imu_rate_hz = hz;
+        self.sim.baro_rate_hz = self.sim.baro_rate_hz.min(hz);
+        self.sim.mag_rate_hz = self.sim.mag_rate_hz.min(hz);
+        self.sim.aux_rate_hz = self.sim.aux_rate_hz.min(hz);
+        self.fusion.sample_rate_hz = hz;
+        self.fusion.kalman.sample_period_s = 1.0 / hz;
+        self.validate().map_err(|e| anyhow!("--imu-rate {hz}: {e}"))
     }
 
     /// Sets the simulator scenario from the command line's choice.

@@ -2,7 +2,13 @@
 
 mod common;
 
-use common::{Isolated, last_json, spawn_up, stop_up};
+use std::collections::HashMap;
+use std::path::Path;
+
+use common::{Isolated, Scratch, last_json, spawn_up, stop_up};
+use hdrhistogram::Histogram;
+use hdrhistogram::serialization::Deserializer;
+use hdrhistogram::serialization::interval_log::{IntervalLogIterator, LogEntry};
 
 #[test]
 fn echo_and_latency_read_a_running_pipeline() {
@@ -69,7 +75,19 @@ fn echo_and_latency_read_a_running_pipeline() {
         String::from_utf8_lossy(&closed.stderr)
     );
 
-    let latency = ipc.run(&["latency", "--seconds", "2", "--json"]);
+    let scratch = Scratch::new("tools", "latency");
+    let trace_path = scratch.path().join("trace.json");
+    let hdr_path = scratch.path().join("latency.hdr");
+    let latency = ipc.run(&[
+        "latency",
+        "--seconds",
+        "2",
+        "--json",
+        "--trace",
+        trace_path.to_str().unwrap(),
+        "--hdr",
+        hdr_path.to_str().unwrap(),
+    ]);
     assert!(
         latency.status.success(),
         "{}",
@@ -94,10 +112,83 @@ fn echo_and_latency_read_a_running_pipeline() {
         end_to_end["max_us"].as_f64().unwrap(),
     );
     assert!(p50 > 0.0 && p50 <= p99 && p99 <= max, "{end_to_end}");
+    let received = hops
+        .iter()
+        .find(|h| h["hop"] == "navigator published -> consumer received")
+        .expect("consumer hop")["samples"]
+        .as_u64()
+        .unwrap();
+    check_trace(&trace_path, received);
+    check_hdr_log(&hdr_path, end_to_end["samples"].as_u64().unwrap());
 
     // SIGTERM is how an operator stops the pipeline: it must shut down cleanly and still report.
     let summary = stop_up(&ipc, up);
     assert_eq!(summary["dropped"], 0, "{summary}");
+}
+
+/// The trace parses as Chrome Trace Event JSON and draws one flow per sample the consumer took:
+/// each starts at acquisition (serial receive), steps through fusion and the navigator and ends at
+/// the consumer, in time order.
+fn check_trace(path: &Path, received: u64) {
+    let text = std::fs::read_to_string(path).expect("the trace file");
+    let trace: serde_json::Value = serde_json::from_str(&text).expect("trace JSON");
+    let events = trace["traceEvents"].as_array().expect("traceEvents");
+    let drawn = trace["otherData"]["samples"].as_u64().unwrap();
+    let incomplete = trace["otherData"]["samples_incomplete"].as_u64().unwrap();
+    assert_eq!(drawn + incomplete, received, "{}", trace["otherData"]);
+    // Every stage stamps every sample of a healthy pipeline.
+    assert!(incomplete * 100 <= received, "{}", trace["otherData"]);
+    let mut flows: HashMap<u64, Vec<(String, u64, f64)>> = HashMap::new();
+    for e in events.iter().filter(|e| e["cat"] == "sample") {
+        flows.entry(e["id"].as_u64().unwrap()).or_default().push((
+            e["ph"].as_str().unwrap().to_string(),
+            e["pid"].as_u64().unwrap(),
+            e["ts"].as_f64().unwrap(),
+        ));
+    }
+    assert_eq!(flows.len() as u64, drawn);
+    for (id, path) in &flows {
+        let phases: Vec<(&str, u64)> = path
+            .iter()
+            .map(|(ph, pid, _)| (ph.as_str(), *pid))
+            .collect();
+        assert_eq!(
+            phases,
+            [("s", 1), ("t", 2), ("t", 3), ("f", 4)],
+            "flow {id}"
+        );
+        assert!(
+            path.windows(2).all(|w| w[0].2 <= w[1].2),
+            "flow {id}: {path:?}"
+        );
+    }
+    let slices = events.iter().filter(|e| e["ph"] == "X").count() as u64;
+    assert_eq!(slices, 4 * drawn);
+}
+
+/// The HDR log holds intervals of every hop whose counts add up to the run's.
+fn check_hdr_log(path: &Path, end_to_end: u64) {
+    use base64::Engine;
+    let bytes = std::fs::read(path).expect("the HDR log");
+    let mut intervals = 0;
+    let mut counted = 0;
+    for entry in IntervalLogIterator::new(&bytes) {
+        if let LogEntry::Interval(i) = entry.expect("a well-formed log entry")
+            && i.tag().map(|t| t.as_str()) == Some("serial_rx_nav_state_published")
+        {
+            intervals += 1;
+            let raw = base64::engine::general_purpose::STANDARD
+                .decode(i.encoded_histogram())
+                .expect("base64 histogram");
+            let h: Histogram<u64> = Deserializer::new()
+                .deserialize(&mut raw.as_slice())
+                .expect("a histogram");
+            counted += h.len();
+        }
+    }
+    // 2 s in 1 s intervals (the last one cut short).
+    assert!((2..=3).contains(&intervals), "{intervals} intervals");
+    assert_eq!(counted, end_to_end);
 }
 
 #[test]

@@ -40,7 +40,9 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             port,
             mavlink,
             gnss,
-        } => service::run(name, config.as_deref(), port, mavlink, gnss).map(|()| ExitCode::SUCCESS),
+            imu_rate,
+        } => service::run(name, config.as_deref(), port, mavlink, gnss, imu_rate)
+            .map(|()| ExitCode::SUCCESS),
         Command::Sim(args) => {
             rins_runtime::logging::init("sim");
             sim::run(&args).map(|()| ExitCode::SUCCESS)
@@ -61,9 +63,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Readmit { channel, timeout } => {
             readmit::run(&channel, timeout).map(|()| ExitCode::SUCCESS)
         }
-        Command::Latency { seconds, json } => {
-            latency::run(seconds, json).map(|()| ExitCode::SUCCESS)
-        }
+        Command::Latency(args) => latency::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Geometry { config, json } => {
             geometry::run(config.as_deref(), json).map(|()| ExitCode::SUCCESS)
         }

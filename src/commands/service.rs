@@ -12,19 +12,23 @@ use crate::config;
 
 /// Runs service `name` with the configuration at `config_path` (the built-in one when none) and,
 /// for acquisition (or the gnss service), the serial device `port`; for the MAVLink output, the
-/// endpoint `mavlink`; with `gnss`, a GNSS receiver fitted.
+/// endpoint `mavlink`; with `gnss`, a GNSS receiver fitted; `imu_rate` the block's sample rate.
 pub fn run(
     name: ServiceName,
     config_path: Option<&Path>,
     port: Option<String>,
     mavlink: Option<String>,
     gnss: bool,
+    imu_rate: Option<f64>,
 ) -> Result<()> {
     let process = name.kind().name();
     rins_runtime::logging::init(process);
     let mut cfg = config::load(config_path)?;
     if gnss {
         cfg.enable_gnss();
+    }
+    if let Some(hz) = imu_rate {
+        cfg.set_imu_rate(hz)?;
     }
     match (name, port) {
         (ServiceName::Gnss, Some(port)) => cfg.gnss.port = Some(port),

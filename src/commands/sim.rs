@@ -17,6 +17,9 @@ pub fn run(args: &SimArgs) -> Result<()> {
     if let Some(scenario) = args.scenario {
         cfg.set_scenario(scenario);
     }
+    if let Some(hz) = args.imu_rate {
+        cfg.set_imu_rate(hz)?;
+    }
     if let Some(seed) = args.seed {
         cfg.sim.seed = seed;
     }

@@ -37,6 +37,9 @@ fn apply_overrides(cfg: &mut RinsConfig, args: &UpArgs) -> Result<()> {
     if let Some(seed) = args.seed {
         cfg.sim.seed = seed;
     }
+    if let Some(hz) = args.imu_rate {
+        cfg.set_imu_rate(hz)?;
+    }
     if let Some(duration) = args.duration
         && !(duration.is_finite() && duration > 0.0)
     {
@@ -159,6 +162,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
             if args.gnss {
                 child_args.push("--gnss".to_string());
             }
+            child_args.extend(imu_rate_args(args));
             if kind == ServiceKind::Gnss
                 && let Some(gnss_port) = &cfg.gnss.port
             {
@@ -302,6 +306,13 @@ fn stop_recorder(child: std::process::Child) {
     }
 }
 
+/// `--imu-rate HZ` for a child when the run has one: the simulator and every stage agree on it.
+fn imu_rate_args(up: &UpArgs) -> Vec<String> {
+    up.imu_rate
+        .map(|hz| vec!["--imu-rate".to_string(), hz.to_string()])
+        .unwrap_or_default()
+}
+
 /// The simulator's command line: the scenario, seed and faults of this run, and its terminal
 /// links (the GNSS receiver's when one is simulated).
 fn sim_args(
@@ -313,6 +324,7 @@ fn sim_args(
 ) -> Vec<String> {
     let mut args = vec!["sim".to_string()];
     args.extend(config_args.iter().cloned());
+    args.extend(imu_rate_args(up));
     args.extend([
         "--scenario".to_string(),
         cfg.scenario_name().to_string(),

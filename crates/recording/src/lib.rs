@@ -39,5 +39,5 @@ pub use threaded::{
 pub use topics::{TOPICS, layout_of_topic};
 pub use writer::{
     ChannelId, MESSAGE_ENCODING, META_PAYLOAD_VERSION, META_SIZE, META_TYPE_NAME, RecordOptions,
-    RecordSummary, Recorder, SCHEMA_ENCODING, TopicSummary,
+    RecordSummary, Recorder, SCHEMA_ENCODING, TopicSummary, create_file,
 };

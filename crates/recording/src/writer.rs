@@ -330,7 +330,7 @@ fn channel_id(index: usize) -> ChannelId {
 /// on anything already there, links included. With `overwrite`, a file or link already there is
 /// removed first (the link itself, not its target); should someone plant another in between,
 /// `create_new` fails rather than follow it.
-fn create_file(path: &Path, overwrite: bool) -> Result<File, RecordError> {
+pub fn create_file(path: &Path, overwrite: bool) -> Result<File, RecordError> {
     let io = |source: std::io::Error| RecordError::Io {
         path: path.to_path_buf(),
         source,

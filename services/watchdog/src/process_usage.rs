@@ -1,5 +1,6 @@
-//! CPU time and peak memory of every process of the deployment, read from `/proc` for the run's
-//! summary: `utime + stime` of `/proc/PID/stat` and `VmHWM` of `/proc/PID/status`, sampled about
+//! CPU time, peak memory and wake-ups of every process of the deployment, read from `/proc` for
+//! the run's summary: `utime + stime` of `/proc/PID/stat`, `VmHWM` of `/proc/PID/status` and the
+//! context switches of each of its threads (`/proc/PID/task/TID/status`), sampled about
 //! once a second while the children run and once more just before they are stopped. A child that
 //! was restarted counts every incarnation, each up to its last sample (at most a second of CPU
 //! of an incarnation that died is not seen).
@@ -24,6 +25,60 @@ pub struct ProcessUsage {
     pub peak_rss_kib: u64,
     /// Processes counted (1 + restarts seen).
     pub incarnations: u32,
+    /// Times a thread of the process gave up the CPU to wait (`voluntary_ctxt_switches`, every
+    /// thread, every incarnation): one per sleep, so one per wake-up.
+    pub wakeups: u64,
+    /// Times a thread was taken off the CPU while it could still run
+    /// (`nonvoluntary_ctxt_switches`): preemptions.
+    pub preemptions: u64,
+}
+
+/// Context switches of one thread or a sum over threads.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ContextSwitches {
+    /// `voluntary_ctxt_switches`.
+    pub voluntary: u64,
+    /// `nonvoluntary_ctxt_switches`.
+    pub involuntary: u64,
+}
+
+impl ContextSwitches {
+    fn max(self, o: Self) -> Self {
+        Self {
+            voluntary: self.voluntary.max(o.voluntary),
+            involuntary: self.involuntary.max(o.involuntary),
+        }
+    }
+}
+
+/// The context switches in the text of `/proc/PID/task/TID/status`.
+pub fn context_switches(status: &str) -> Option<ContextSwitches> {
+    let field = |key: &str| -> Option<u64> {
+        let line = status.lines().find(|l| l.starts_with(key))?;
+        line[key.len()..].trim().parse().ok()
+    };
+    Some(ContextSwitches {
+        voluntary: field("voluntary_ctxt_switches:")?,
+        involuntary: field("nonvoluntary_ctxt_switches:")?,
+    })
+}
+
+/// The context switches of every thread of process `pid` (threads that ended are not counted).
+fn process_switches(pid: u32) -> Option<ContextSwitches> {
+    let mut total = ContextSwitches::default();
+    for task in std::fs::read_dir(format!("/proc/{pid}/task"))
+        .ok()?
+        .flatten()
+    {
+        let Ok(text) = std::fs::read_to_string(task.path().join("status")) else {
+            continue;
+        };
+        if let Some(c) = context_switches(&text) {
+            total.voluntary += c.voluntary;
+            total.involuntary += c.involuntary;
+        }
+    }
+    Some(total)
 }
 
 /// `utime + stime` in clock ticks from the text of `/proc/PID/stat`. The command name (field 2)
@@ -63,6 +118,7 @@ struct Seen {
     pid: u32,
     ticks: u64,
     peak_rss_kib: u64,
+    switches: ContextSwitches,
 }
 
 /// The samples of every process seen.
@@ -105,12 +161,20 @@ impl UsageTracker {
             ) else {
                 continue;
             };
-            self.record(name, pid, ticks, rss);
+            let switches = process_switches(pid).unwrap_or_default();
+            self.record(name, pid, ticks, rss, switches);
         }
     }
 
     /// Records one reading of a process.
-    pub fn record(&mut self, name: &str, pid: u32, ticks: u64, peak_rss_kib: u64) {
+    pub fn record(
+        &mut self,
+        name: &str,
+        pid: u32,
+        ticks: u64,
+        peak_rss_kib: u64,
+        switches: ContextSwitches,
+    ) {
         match self
             .seen
             .iter_mut()
@@ -119,12 +183,14 @@ impl UsageTracker {
             Some(s) => {
                 s.ticks = s.ticks.max(ticks);
                 s.peak_rss_kib = s.peak_rss_kib.max(peak_rss_kib);
+                s.switches = s.switches.max(switches);
             }
             None => self.seen.push(Seen {
                 name: name.to_string(),
                 pid,
                 ticks,
                 peak_rss_kib,
+                switches,
             }),
         }
     }
@@ -139,6 +205,8 @@ impl UsageTracker {
                     u.cpu_s += cpu;
                     u.peak_rss_kib = u.peak_rss_kib.max(s.peak_rss_kib);
                     u.incarnations += 1;
+                    u.wakeups += s.switches.voluntary;
+                    u.preemptions += s.switches.involuntary;
                 }
                 None => out.push(ProcessUsage {
                     name: s.name.clone(),
@@ -146,6 +214,8 @@ impl UsageTracker {
                     cpu_pct: 0.0,
                     peak_rss_kib: s.peak_rss_kib,
                     incarnations: 1,
+                    wakeups: s.switches.voluntary,
+                    preemptions: s.switches.involuntary,
                 }),
             }
         }
@@ -159,6 +229,20 @@ impl UsageTracker {
         }
         out
     }
+}
+
+/// Wake-ups of every process but the simulator's per IMU frame acquisition published: how many
+/// times the pipeline's processes are woken to carry one sample (0 without frames).
+pub fn pipeline_wakeups_per_frame(usage: &[ProcessUsage], frames: u64) -> f64 {
+    if frames == 0 {
+        return 0.0;
+    }
+    let wakeups: u64 = usage
+        .iter()
+        .filter(|u| u.name != "sim")
+        .map(|u| u.wakeups)
+        .sum();
+    wakeups as f64 / frames as f64
 }
 
 /// The sum of `cpu_pct` over every process but the simulator's (`sim`): what the pipeline costs
@@ -190,12 +274,16 @@ mod tests {
 
     #[test]
     fn incarnations_add_up_and_the_simulator_is_left_out_of_the_pipeline() {
+        let cs = |voluntary, involuntary| ContextSwitches {
+            voluntary,
+            involuntary,
+        };
         let mut t = UsageTracker::new();
-        t.record("fusion", 10, 100, 4000);
-        t.record("fusion", 10, 250, 4100);
+        t.record("fusion", 10, 100, 4000, cs(1000, 5));
+        t.record("fusion", 10, 250, 4100, cs(2500, 9));
         // Restarted under a new pid.
-        t.record("fusion", 11, 50, 3900);
-        t.record("sim", 12, 1000, 8000);
+        t.record("fusion", 11, 50, 3900, cs(500, 1));
+        t.record("sim", 12, 1000, 8000, cs(9000, 0));
         let u = t.totals(100.0, Duration::from_secs(10));
         assert_eq!(u.len(), 2);
         assert_eq!(u[0].name, "fusion");
@@ -203,6 +291,23 @@ mod tests {
         assert!((u[0].cpu_pct - 30.0).abs() < 1e-9);
         assert_eq!((u[0].peak_rss_kib, u[0].incarnations), (4100, 2));
         assert!((pipeline_cpu_pct(&u) - 30.0).abs() < 1e-9);
+        assert_eq!((u[0].wakeups, u[0].preemptions), (3000, 10));
+        assert!((pipeline_wakeups_per_frame(&u, 1000) - 3.0).abs() < 1e-12);
+        assert_eq!(pipeline_wakeups_per_frame(&u, 0), 0.0);
+    }
+
+    #[test]
+    fn context_switches_are_read_from_a_task_status() {
+        let status =
+            "Name:\trins\nvoluntary_ctxt_switches:\t1234\nnonvoluntary_ctxt_switches:\t56\n";
+        assert_eq!(
+            context_switches(status),
+            Some(ContextSwitches {
+                voluntary: 1234,
+                involuntary: 56
+            })
+        );
+        assert_eq!(context_switches("Name:\tx\n"), None);
     }
 
     #[test]
@@ -212,5 +317,7 @@ mod tests {
         let u = t.totals(ticks_per_second(), Duration::from_secs(1));
         assert_eq!(u.len(), 1);
         assert!(u[0].peak_rss_kib > 0, "{u:?}");
+        // Every thread's counters are there to read.
+        assert!(process_switches(std::process::id()).is_some());
     }
 }

@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use crate::link::link_error_name;
 use crate::monitor::Monitor;
-use crate::process_usage::pipeline_cpu_pct;
+use crate::process_usage::{pipeline_cpu_pct, pipeline_wakeups_per_frame};
 use crate::restart_timing::RestartTiming;
 use crate::summary::Summary;
 use crate::supervisor::Supervisor;
@@ -69,6 +69,7 @@ pub fn summarise(
         horiz_end_err_pct: sim(acc.horizontal.end_error_pct()),
         shm_leaked: 0,
         pipeline_cpu_pct: pipeline_cpu_pct(&usage),
+        pipeline_wakeups_per_frame: pipeline_wakeups_per_frame(&usage, monitor.totals[0]),
         processes: usage,
         faults: monitor.faults.records().to_vec(),
         false_alarms: monitor.faults.false_alarms(),

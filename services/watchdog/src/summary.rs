@@ -127,6 +127,8 @@ pub struct Summary {
     pub processes: Vec<ProcessUsage>,
     /// The CPU of every process but the simulator, % of one core over the run.
     pub pipeline_cpu_pct: f64,
+    /// Wake-ups (voluntary context switches) of every process but the simulator per IMU frame.
+    pub pipeline_wakeups_per_frame: f64,
     /// Every fault injected (scheduled or at run time), with detection and isolation times.
     pub faults: Vec<FaultRecord>,
     /// Channels leaving Ok, or faults detected but not isolated, on a sensor type with no

@@ -13,8 +13,9 @@ pub fn summary_text(s: &Summary) -> String {
     if !s.processes.is_empty() {
         let peak: u64 = s.processes.iter().map(|p| p.peak_rss_kib).sum();
         out.push_str(&format!(
-            "  CPU: {:.1} % of one core without the simulator; peak memory {:.1} MiB over {} processes\n",
+            "  CPU: {:.1} % of one core without the simulator, {:.1} wake-ups per IMU frame; peak memory {:.1} MiB over {} processes\n",
             s.pipeline_cpu_pct,
+            s.pipeline_wakeups_per_frame,
             peak as f64 / 1024.0,
             s.processes.len()
         ));
@@ -119,6 +120,7 @@ mod tests {
             shm_leaked: 0,
             processes: Vec::new(),
             pipeline_cpu_pct: 0.0,
+            pipeline_wakeups_per_frame: 0.0,
             faults: Vec::new(),
             false_alarms: 0,
         }

@@ -20,8 +20,12 @@ use crate::restart_timing::RestartTiming;
 use crate::status::status_line;
 use crate::supervisor::{ChildEvent, Supervisor};
 
-/// Period of the supervision loop: topics drained and children checked this often.
-const LOOP_PERIOD: Duration = Duration::from_millis(1);
+/// Period of the supervision loop: topics drained and children checked this often. Each turn
+/// wakes the watchdog and asks every topic and child; at 1 ms that was the pipeline's largest CPU
+/// share (12 % of a core, more than any stage). At 5 ms a turn drains 5 samples of a 1 kHz topic
+/// (40 at 8 kHz) from a 512-sample queue, and restart and deadline times are measured to 5 ms,
+/// well inside their limits (0.5 s output deadline, 3 s heartbeat timeout).
+const LOOP_PERIOD: Duration = Duration::from_millis(5);
 
 /// What a run of the loop is bound by: the deployment, the watchdog's settings, when it started
 /// and when it ends.
