@@ -104,6 +104,12 @@ pub enum Command {
     },
     /// Measure latency from serial receive through every stage to the navigation state.
     Latency(LatencyArgs),
+    /// Benchmarks that start what they measure.
+    Bench {
+        /// Which benchmark.
+        #[command(subcommand)]
+        what: BenchCommand,
+    },
     /// What the configured gyro and accelerometer geometries can do: noise per axis, parity, FDI.
     Geometry {
         /// Configuration file whose geometries are reported (default: the built-in configuration).
@@ -645,4 +651,36 @@ pub struct LatencyArgs {
     /// Replace the trace or HDR file if it exists (a symbolic link is replaced, never followed).
     #[arg(long)]
     pub overwrite: bool,
+}
+
+/// `rins bench` benchmarks.
+#[derive(Debug, Subcommand)]
+pub enum BenchCommand {
+    /// Every IPC hop of the pipeline against the bare iceoryx2 hop with the same payload, the
+    /// same service settings and the same wait strategy, measured in one invocation.
+    Ipc(BenchIpcArgs),
+    /// The receiving process of the bare hops (started by `rins bench ipc`).
+    #[command(hide = true)]
+    IpcReceiver {
+        /// Longest wait for a phase to end, s.
+        #[arg(long, default_value_t = 60.0)]
+        phase_limit: f64,
+    },
+}
+
+/// `rins bench ipc`.
+#[derive(Debug, Args)]
+pub struct BenchIpcArgs {
+    /// Length of each measurement (each bare payload, then the pipeline), s.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 10.0)]
+    pub seconds: f64,
+    /// Sample rate of the bare hops and of the pipeline's IMU, Hz.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1000.0)]
+    pub rate: f64,
+    /// Time the pipeline runs after its first navigation output before it is measured, s.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 5.0)]
+    pub warmup: f64,
+    /// One JSON object as the last line of stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
 }

@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+mod bench;
 mod calibrate;
 mod control;
 mod echo;
@@ -26,7 +27,7 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 
-use crate::cli::{CalibrateCommand, Cli, Command, EvalCommand};
+use crate::cli::{BenchCommand, CalibrateCommand, Cli, Command, EvalCommand};
 
 pub fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
@@ -64,6 +65,12 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             readmit::run(&channel, timeout).map(|()| ExitCode::SUCCESS)
         }
         Command::Latency(args) => latency::run(&args).map(|()| ExitCode::SUCCESS),
+        Command::Bench { what } => match what {
+            BenchCommand::Ipc(args) => bench::run_ipc(&args).map(|()| ExitCode::SUCCESS),
+            BenchCommand::IpcReceiver { phase_limit } => {
+                bench::run_receiver(phase_limit).map(|()| ExitCode::SUCCESS)
+            }
+        },
         Command::Geometry { config, json } => {
             geometry::run(config.as_deref(), json).map(|()| ExitCode::SUCCESS)
         }

@@ -33,8 +33,7 @@ struct Hop {
 
 impl Hop {
     fn new(name: &'static str) -> Result<Self> {
-        // 1 ns .. 10 s at 3 significant digits.
-        let histogram = Histogram::new_with_bounds(1, 10_000_000_000, 3)?;
+        let histogram = latency_histogram()?;
         Ok(Self {
             name,
             interval: histogram.clone(),
@@ -52,21 +51,28 @@ impl Hop {
     }
 }
 
-#[derive(Serialize)]
-struct HopReport {
-    hop: &'static str,
-    samples: u64,
-    p50_us: f64,
-    p99_us: f64,
-    p999_us: f64,
-    max_us: f64,
+/// Percentiles of one hop, µs.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct HopReport {
+    /// Which hop.
+    pub hop: &'static str,
+    /// Samples measured.
+    pub samples: u64,
+    /// Median, µs.
+    pub p50_us: f64,
+    /// 99th percentile, µs.
+    pub p99_us: f64,
+    /// 99.9th percentile, µs.
+    pub p999_us: f64,
+    /// Largest, µs.
+    pub max_us: f64,
 }
 
-fn report(hop: &Hop) -> HopReport {
-    let h = &hop.histogram;
+/// The percentiles of `histogram` (ns) as hop `name`'s report.
+pub fn report_of(name: &'static str, h: &Histogram<u64>) -> HopReport {
     let us = |ns: u64| ns as f64 / 1000.0;
     HopReport {
-        hop: hop.name,
+        hop: name,
         samples: h.len(),
         p50_us: us(h.value_at_quantile(0.5)),
         p99_us: us(h.value_at_quantile(0.99)),
@@ -74,6 +80,27 @@ fn report(hop: &Hop) -> HopReport {
         max_us: us(h.max()),
     }
 }
+
+fn report(hop: &Hop) -> HopReport {
+    report_of(hop.name, &hop.histogram)
+}
+
+/// A histogram for latencies: 1 ns .. 10 s at 3 significant digits.
+pub fn latency_histogram() -> Result<Histogram<u64>> {
+    Ok(Histogram::new_with_bounds(1, 10_000_000_000, 3)?)
+}
+
+/// The hops of the pipeline, in path order, then the altimeter's.
+pub const HOPS: [&str; 6] = [
+    "serial rx -> acquisition published",
+    "acquisition -> fusion published",
+    "fusion -> navigator published",
+    "serial rx -> nav state published",
+    "navigator published -> consumer received",
+    "acquisition -> altimeter published",
+];
+/// Index of the end-to-end hop in [`HOPS`].
+pub const END_TO_END: usize = 3;
 
 fn stage(h: &Header, s: Stage) -> u64 {
     h.stage_ns(s)
@@ -125,60 +152,35 @@ pub fn run(args: &LatencyArgs) -> Result<()> {
     // Ports are made after the tool node, so they are dropped before it cleans up.
     let tool = ToolNode::join("latency")?;
     let (node, settings) = (tool.node(), tool.settings());
-    // The stream consumers see: both navigator lanes through the lane selector.
-    let mut nav = NavSubscriber::new(node)?;
-    let alt = TopicSubscriber::<Altitude>::new(node, names::ALTITUDE)?;
-    let mut hops = [
-        Hop::new("serial rx -> acquisition published")?,
-        Hop::new("acquisition -> fusion published")?,
-        Hop::new("fusion -> navigator published")?,
-        Hop::new("serial rx -> nav state published")?,
-        Hop::new("navigator published -> consumer received")?,
-        Hop::new("acquisition -> altimeter published")?,
-    ];
-    let end = Instant::now() + Duration::from_secs_f64(seconds);
-    while Instant::now() < end && !shutdown.requested() {
-        nav.wait(Duration::from_millis(50))?;
-        while let Some(s) = nav.receive()? {
-            let now = monotonic_ns();
-            let h = &s.header;
-            let (rx, acq, fus, navp) = (
-                h.origin_rx_ns,
-                stage(h, Stage::Acquisition),
-                stage(h, Stage::Fusion),
-                stage(h, Stage::Navigator),
-            );
-            hops[0].record(rx, acq);
-            hops[1].record(acq, fus);
-            hops[2].record(fus, navp);
-            hops[3].record(rx, navp);
-            hops[4].record(navp, now);
+    let mut hops = measure(
+        node,
+        Duration::from_secs_f64(seconds),
+        &shutdown,
+        |s, now| {
             if trace_out.is_some() {
+                let h = &s.header;
                 traced.push(TracedSample {
                     seq: h.origin_seq,
                     lane: s.lane,
-                    rx_ns: rx,
-                    acquisition_ns: acq,
-                    fusion_ns: fus,
-                    navigator_ns: navp,
+                    rx_ns: h.origin_rx_ns,
+                    acquisition_ns: stage(h, Stage::Acquisition),
+                    fusion_ns: stage(h, Stage::Fusion),
+                    navigator_ns: stage(h, Stage::Navigator),
                     consumer_ns: now,
                 });
             }
-        }
-        while let Some(a) = alt.receive()? {
-            hops[5].record(
-                stage(&a.header, Stage::Acquisition),
-                stage(&a.header, Stage::Altimeter),
-            );
-        }
-        if let Some(log) = hdr_log.as_mut() {
-            let now = SystemTime::now();
-            if now.duration_since(interval_start).unwrap_or(Duration::ZERO) >= interval {
-                write_intervals(log, &mut hops, interval_start, now)?;
-                interval_start = now;
+        },
+        |hops| {
+            if let Some(log) = hdr_log.as_mut() {
+                let now = SystemTime::now();
+                if now.duration_since(interval_start).unwrap_or(Duration::ZERO) >= interval {
+                    write_intervals(log, hops, interval_start, now)?;
+                    interval_start = now;
+                }
             }
-        }
-    }
+            Ok(())
+        },
+    )?;
     if let Some(log) = hdr_log.as_mut() {
         write_intervals(log, &mut hops, interval_start, SystemTime::now())?;
     }
@@ -193,7 +195,7 @@ pub fn run(args: &LatencyArgs) -> Result<()> {
         out.flush()
             .with_context(|| format!("--trace {}", path.display()))?;
     }
-    if hops[3].histogram.is_empty() {
+    if hops[END_TO_END].histogram.is_empty() {
         bail!(
             "no navigation state received in {seconds} s on prefix {:?}: is the pipeline running (rins up)?",
             settings.prefix
@@ -231,4 +233,66 @@ fn write_intervals<W: Write>(
         hop.interval.reset();
     }
     Ok(())
+}
+
+/// Measures the hops of the deployment `node` belongs to for `length` (or until `shutdown`):
+/// the navigation stream consumers see (both lanes through the lane selector) and the altitude.
+/// `on_nav` sees each navigation sample and its receive time; `on_turn` the hops after each
+/// wake-up.
+fn measure(
+    node: &rins_runtime::ipc::IpcNode,
+    length: Duration,
+    shutdown: &Shutdown,
+    mut on_nav: impl FnMut(&ipc_types::NavState, u64),
+    mut on_turn: impl FnMut(&mut [Hop]) -> Result<()>,
+) -> Result<[Hop; 6]> {
+    let mut nav = NavSubscriber::new(node)?;
+    let alt = TopicSubscriber::<Altitude>::new(node, names::ALTITUDE)?;
+    let mut hops = [
+        Hop::new(HOPS[0])?,
+        Hop::new(HOPS[1])?,
+        Hop::new(HOPS[2])?,
+        Hop::new(HOPS[3])?,
+        Hop::new(HOPS[4])?,
+        Hop::new(HOPS[5])?,
+    ];
+    let end = Instant::now() + length;
+    while Instant::now() < end && !shutdown.requested() {
+        nav.wait(Duration::from_millis(50))?;
+        while let Some(s) = nav.receive()? {
+            let now = monotonic_ns();
+            let h = &s.header;
+            let (rx, acq, fus, navp) = (
+                h.origin_rx_ns,
+                stage(h, Stage::Acquisition),
+                stage(h, Stage::Fusion),
+                stage(h, Stage::Navigator),
+            );
+            hops[0].record(rx, acq);
+            hops[1].record(acq, fus);
+            hops[2].record(fus, navp);
+            hops[3].record(rx, navp);
+            hops[4].record(navp, now);
+            on_nav(&s, now);
+        }
+        while let Some(a) = alt.receive()? {
+            hops[5].record(
+                stage(&a.header, Stage::Acquisition),
+                stage(&a.header, Stage::Altimeter),
+            );
+        }
+        on_turn(&mut hops)?;
+    }
+    Ok(hops)
+}
+
+/// The hops of the deployment `node` belongs to over `length`: what `rins bench ipc` compares
+/// with the bare transport.
+pub fn measure_hops(
+    node: &rins_runtime::ipc::IpcNode,
+    length: Duration,
+    shutdown: &Shutdown,
+) -> Result<Vec<HopReport>> {
+    let hops = measure(node, length, shutdown, |_, _| {}, |_| Ok(()))?;
+    Ok(hops.iter().map(report).collect())
 }
