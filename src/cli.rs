@@ -43,6 +43,9 @@ pub enum Command {
         /// fusion.kalman.sample_period_s together).
         #[arg(long, value_name = "HZ")]
         imu_rate: Option<f64>,
+        /// Ask for the `[realtime]` settings (as `realtime.enabled = true`).
+        #[arg(long)]
+        realtime: bool,
     },
     /// Run the device simulator on a pseudo-terminal.
     Sim(SimArgs),
@@ -398,6 +401,11 @@ pub struct UpArgs {
     /// fusion.sample_rate_hz and fusion.kalman.sample_period_s together).
     #[arg(long, value_name = "HZ")]
     pub imu_rate: Option<f64>,
+    /// Every service asks for its `[realtime]` settings (SCHED_FIFO priority, CPU affinity,
+    /// locked memory; as `realtime.enabled = true`); what the system refuses is logged and the
+    /// service runs on without it.
+    #[arg(long)]
+    pub realtime: bool,
     /// Record every topic into this MCAP file from the start (replaced if it exists), as
     /// `rins record` does.
     #[arg(long, value_name = "FILE")]

@@ -138,6 +138,10 @@ pub struct RinsConfig {
     pub mavlink: MavlinkConfig,
     /// `[gnss]`: the GNSS receiver's serial line.
     pub gnss: GnssConfig,
+    /// `[realtime]`: scheduling, affinity and memory locking of each service.
+    pub realtime: crate::realtime_config::RealtimeConfig,
+    /// `[wait]`: how the stages wait for their input.
+    pub wait: crate::wait_config::WaitConfig,
 }
 
 impl RinsConfig {
@@ -177,6 +181,8 @@ impl RinsConfig {
         self.watchdog.validate()?;
         self.deployment.validate()?;
         self.mavlink.validate()?;
+        self.realtime.validate()?;
+        self.wait.validate()?;
         Ok(())
     }
 

@@ -4,4 +4,6 @@
 pub mod built_services;
 pub mod cli;
 pub mod config;
+pub mod realtime_config;
 pub mod replay;
+pub mod wait_config;

@@ -69,7 +69,14 @@ fn a_recorded_flight_replays_to_the_same_navigation_output() {
         &["replay", file_s, "--as-fast-as-possible", "--json"],
         std::time::Duration::from_secs(300),
     );
-    assert!(live.status.success(), "rins replay: {}", stderr(&live));
+    // A replay that ran but differs prints its report (with the first differing sample and
+    // fields) on stdout: show both.
+    assert!(
+        live.status.success(),
+        "rins replay: {}\n{}",
+        String::from_utf8_lossy(&live.stdout),
+        stderr(&live)
+    );
     let live = last_json(&live);
     assert_eq!(
         num(&live, "nav_samples_compared"),

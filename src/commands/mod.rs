@@ -42,8 +42,17 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             mavlink,
             gnss,
             imu_rate,
-        } => service::run(name, config.as_deref(), port, mavlink, gnss, imu_rate)
-            .map(|()| ExitCode::SUCCESS),
+            realtime,
+        } => service::run(
+            name,
+            config.as_deref(),
+            port,
+            mavlink,
+            gnss,
+            imu_rate,
+            realtime,
+        )
+        .map(|()| ExitCode::SUCCESS),
         Command::Sim(args) => {
             rins_runtime::logging::init("sim");
             sim::run(&args).map(|()| ExitCode::SUCCESS)

@@ -12,7 +12,7 @@ use crate::config;
 
 /// Runs service `name` with the configuration at `config_path` (the built-in one when none) and,
 /// for acquisition (or the gnss service), the serial device `port`; for the MAVLink output, the
-/// endpoint `mavlink`; with `gnss`, a GNSS receiver fitted; `imu_rate` the block's sample rate.
+/// endpoint `mavlink`; with `gnss`, a GNSS receiver fitted; `imu_rate` the block's sample rate; `realtime` turns `[realtime]` on.
 pub fn run(
     name: ServiceName,
     config_path: Option<&Path>,
@@ -20,6 +20,7 @@ pub fn run(
     mavlink: Option<String>,
     gnss: bool,
     imu_rate: Option<f64>,
+    realtime: bool,
 ) -> Result<()> {
     let process = name.kind().name();
     rins_runtime::logging::init(process);
@@ -30,6 +31,11 @@ pub fn run(
     if let Some(hz) = imu_rate {
         cfg.set_imu_rate(hz)?;
     }
+    if realtime {
+        cfg.realtime.enabled = true;
+    }
+    // Before any thread or port exists: threads started later inherit the scheduling.
+    rins::realtime_config::apply_for(&cfg.realtime, process);
     match (name, port) {
         (ServiceName::Gnss, Some(port)) => cfg.gnss.port = Some(port),
         (_, Some(port)) => cfg.acquisition.port = Some(port),
@@ -44,7 +50,8 @@ pub fn run(
     let shutdown = Shutdown::install()?;
     let settings = IpcSettings::from_env();
     tracing::info!(service = %process, pid = std::process::id(), prefix = %settings.prefix, "starting");
-    let ctx = ServiceContext::new(settings, shutdown);
+    let mut ctx = ServiceContext::new(settings, shutdown);
+    ctx.wait = cfg.wait.for_service(process);
     let result = match name {
         ServiceName::Acquisition => rins_acquisition::service::AcquisitionService {
             config: cfg.acquisition,

@@ -163,6 +163,9 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
                 child_args.push("--gnss".to_string());
             }
             child_args.extend(imu_rate_args(args));
+            if args.realtime {
+                child_args.push("--realtime".to_string());
+            }
             if kind == ServiceKind::Gnss
                 && let Some(gnss_port) = &cfg.gnss.port
             {

@@ -20,12 +20,18 @@ pub struct ServiceContext {
     pub settings: IpcSettings,
     /// Set when the process is asked to stop; every loop polls it.
     pub shutdown: Shutdown,
+    /// How a stage driven by a topic waits for its input.
+    pub wait: crate::wait_strategy::WaitStrategy,
 }
 
 impl ServiceContext {
     /// A context for `settings`, stopped by `shutdown`.
     pub fn new(settings: IpcSettings, shutdown: Shutdown) -> Self {
-        Self { settings, shutdown }
+        Self {
+            settings,
+            shutdown,
+            wait: crate::wait_strategy::WaitStrategy::Event,
+        }
     }
 
     /// The node of a process of `kind`, named after it (the watchdog tells the pipeline's nodes

@@ -75,6 +75,15 @@ impl<T: Versioned + Debug + ZeroCopySend + Copy + 'static> StageInput<T> {
     pub fn wait(&self, timeout: Duration) -> Result<bool, IpcError> {
         self.topic.wait(timeout)
     }
+
+    /// Waits for input the way `strategy` says, at most `timeout`.
+    pub fn wait_with(
+        &self,
+        strategy: &crate::wait_strategy::WaitStrategy,
+        timeout: Duration,
+    ) -> Result<bool, IpcError> {
+        strategy.wait(&self.topic, timeout)
+    }
 }
 
 /// A topic a stage publishes: each sample leaves stamped with the stage's publish time.

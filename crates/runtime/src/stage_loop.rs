@@ -17,6 +17,7 @@ use crate::payload::{Stamped, Versioned};
 use crate::service_loop::ServiceLoop;
 use crate::shutdown::Shutdown;
 use crate::stage_io::{Received, StageInput, StagePublisher};
+use crate::wait_strategy::WaitStrategy;
 
 /// What a stage's step made of one input sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -101,6 +102,7 @@ pub struct StageLoop<I: Debug + ZeroCopySend + 'static, O: Debug + ZeroCopySend 
     input: StageInput<I>,
     output: StagePublisher<O>,
     wait: Duration,
+    strategy: WaitStrategy,
 }
 
 impl<I, O> StageLoop<I, O>
@@ -119,7 +121,14 @@ where
             output: StagePublisher::new(node, topics.output, topics.stage)?,
             service: ServiceLoop::new(node, topics.kind, shutdown)?,
             wait: topics.wait,
+            strategy: WaitStrategy::Event,
         })
+    }
+
+    /// Waits for input the way `strategy` says (default: [`WaitStrategy::Event`]).
+    pub fn with_wait_strategy(mut self, strategy: WaitStrategy) -> Self {
+        self.strategy = strategy;
+        self
     }
 
     /// Runs `stage` until a stop is requested; returns the final counters.
@@ -128,7 +137,7 @@ where
         stage: &mut S,
     ) -> Result<Health, IpcError> {
         while self.service.running() {
-            self.input.wait(self.wait)?;
+            self.input.wait_with(&self.strategy, self.wait)?;
             let counters = &mut self.service.counters;
             stage.before_input(counters)?;
             let mut received = 0;

@@ -67,7 +67,9 @@ impl Service for AltimeterService {
         let mut stage = AltimeterStage {
             estimator: self.estimator,
         };
-        StageLoop::new(&node, &topics, &ctx.shutdown)?.run(&mut stage)?;
+        StageLoop::new(&node, &topics, &ctx.shutdown)?
+            .with_wait_strategy(ctx.wait)
+            .run(&mut stage)?;
         Ok(())
     }
 }

@@ -261,7 +261,8 @@ impl Service for FusionService {
             output: names::FUSED_IMU,
             wait: WAIT,
         };
-        let stage_loop = StageLoop::new(&node, &topics, &ctx.shutdown)?;
+        let stage_loop =
+            StageLoop::new(&node, &topics, &ctx.shutdown)?.with_wait_strategy(ctx.wait);
         let mut stage = FusionStage {
             n_gyro: self.fuser.gyro_geometry().n(),
             n_accel: self.fuser.accel_geometry().n(),

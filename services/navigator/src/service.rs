@@ -295,7 +295,8 @@ impl Service for NavigatorService {
             output: names::NAV_LANES[usize::from(lane)],
             wait: WAIT,
         };
-        let stage_loop = StageLoop::new(&node, &topics, &ctx.shutdown)?;
+        let stage_loop =
+            StageLoop::new(&node, &topics, &ctx.shutdown)?.with_wait_strategy(ctx.wait);
         // With two lanes, a lane that aligns listens to its peer: restarted in flight, it takes the
         // peer's solution over instead of waiting for a rest it will not get (see `takeover`).
         let peer_in = match lanes {

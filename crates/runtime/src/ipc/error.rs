@@ -10,6 +10,7 @@ use iceoryx2::port::listener::{ListenerCreateError, ListenerWaitError};
 use iceoryx2::port::notifier::{NotifierCreateError, NotifierNotifyError};
 use iceoryx2::port::publisher::PublisherCreateError;
 use iceoryx2::port::subscriber::SubscriberCreateError;
+use iceoryx2::port::update_connections::ConnectionFailure;
 use iceoryx2::port::{LoanError, ReceiveError, SendError};
 use iceoryx2::prelude::SemanticStringError;
 use iceoryx2::service::builder::event::EventOpenOrCreateError;
@@ -193,6 +194,14 @@ pub enum IpcError {
         topic: &'static str,
         /// iceoryx2's error.
         source: NotifierNotifyError,
+    },
+    /// The subscriber could not connect to a publisher of the topic.
+    #[error("connecting to the publishers of {topic:?} failed")]
+    Connect {
+        /// The topic.
+        topic: &'static str,
+        /// iceoryx2's error.
+        source: ConnectionFailure,
     },
     /// A sample could not be received.
     #[error("receive on {topic:?} failed")]

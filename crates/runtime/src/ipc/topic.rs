@@ -184,6 +184,27 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
         }
     }
 
+    /// Whether a sample is queued (without taking it).
+    pub fn has_samples(&self) -> Result<bool, IpcError> {
+        self.subscriber
+            .has_samples()
+            .map_err(|source| IpcError::Connect {
+                topic: self.name,
+                source,
+            })
+    }
+
+    /// Takes every pending notification off the listener without sleeping (a poller's chore).
+    pub fn clear_signals(&self) -> Result<(), IpcError> {
+        match self.listener.try_wait(|_| {}) {
+            Ok(_) | Err(ListenerWaitError::InterruptSignal) => Ok(()),
+            Err(source) => Err(IpcError::Wait {
+                topic: self.name,
+                source,
+            }),
+        }
+    }
+
     /// The topic's name.
     pub fn name(&self) -> &'static str {
         self.name

@@ -1,0 +1,64 @@
+//! How a stage waits for its next input sample. `Event` sleeps on the topic's iceoryx2 listener
+//! until the publisher notifies (no CPU while idle, one wake-up per sample); `Spin` polls the
+//! subscriber's queue without sleeping (no wake-up, a whole CPU); `Hybrid` polls for a while after
+//! each wake-up — catching a sample that follows soon without another wake-up — then sleeps.
+
+use std::time::{Duration, Instant};
+
+use crate::ipc::{IpcError, TopicSubscriber};
+
+/// See the module documentation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum WaitStrategy {
+    /// Sleep on the listener until notified.
+    #[default]
+    Event,
+    /// Poll the queue until a sample is there.
+    Spin,
+    /// Poll for `spin`, then sleep on the listener.
+    Hybrid {
+        /// How long to poll before sleeping.
+        spin: Duration,
+    },
+}
+
+impl WaitStrategy {
+    /// Waits for a sample of `topic` the way this strategy says, at most `timeout`; returns
+    /// whether one may be there. A signal to the process cuts a sleep short.
+    pub fn wait<T>(&self, topic: &TopicSubscriber<T>, timeout: Duration) -> Result<bool, IpcError>
+    where
+        T: std::fmt::Debug + iceoryx2::prelude::ZeroCopySend + Copy + 'static,
+    {
+        match *self {
+            WaitStrategy::Event => topic.wait(timeout),
+            WaitStrategy::Spin => poll(topic, timeout),
+            WaitStrategy::Hybrid { spin } => {
+                if poll(topic, spin.min(timeout))? {
+                    Ok(true)
+                } else {
+                    topic.wait(timeout.saturating_sub(spin))
+                }
+            }
+        }
+    }
+}
+
+/// Polls `topic`'s queue for up to `limit`; the notifications the publisher sent meanwhile are
+/// taken off the listener, so that they neither pile up nor wake a later sleep for nothing.
+fn poll<T>(topic: &TopicSubscriber<T>, limit: Duration) -> Result<bool, IpcError>
+where
+    T: std::fmt::Debug + iceoryx2::prelude::ZeroCopySend + Copy + 'static,
+{
+    let until = Instant::now() + limit;
+    loop {
+        if topic.has_samples()? {
+            topic.clear_signals()?;
+            return Ok(true);
+        }
+        if Instant::now() >= until {
+            topic.clear_signals()?;
+            return Ok(false);
+        }
+        std::hint::spin_loop();
+    }
+}
