@@ -1,8 +1,10 @@
 //! Recording and deterministic replay end to end: a 20 s uav flight with a gyro killed at 8 s is
 //! recorded from the start (`rins up --record`); the raw topics of the file, fed through a fresh
 //! deployment as fast as it takes them, give the same navigation output bit for bit (both lanes,
-//! every sample, all but the stages' publish times), and so does the in-process replay. The file
-//! holds every topic, the injected fault as fusion saw it, and decodes in Python's MCAP libraries.
+//! every sample, all but the stages' publish times), and so does the in-process replay; a recording
+//! whose navigator applied an aiding reading late (a burst after a stall) is said so, and its two
+//! replays agree with each other. The file holds every topic, the injected fault as fusion saw it,
+//! and decodes in Python's MCAP libraries.
 
 mod common;
 
@@ -63,40 +65,48 @@ fn a_recorded_flight_replays_to_the_same_navigation_output() {
         .expect("decodes");
     assert_eq!(last_fused.gyro_state[1], ChannelState::Excluded as u8);
 
-    // Live, as fast as the pipeline takes it: identical, sample for sample.
+    // Live, as fast as the pipeline takes it: identical, sample for sample. Unless the recorded
+    // navigator applied an aiding reading late (a burst of frames after a stall of the loaded
+    // machine can bring an altitude after the IMU frames it had to precede): a replay applies it
+    // in its place and cannot reproduce that, and the two replays must then agree with each
+    // other instead.
     let replaying = Isolated::new("rep");
-    let live = replaying.run_with_timeout(
+    let live_run = replaying.run_with_timeout(
         &["replay", file_s, "--as-fast-as-possible", "--json"],
         std::time::Duration::from_secs(300),
     );
-    // A replay that ran but differs prints its report (with the first differing sample and
-    // fields) on stdout: show both.
-    assert!(
-        live.status.success(),
-        "rins replay: {}\n{}",
-        String::from_utf8_lossy(&live.stdout),
-        stderr(&live)
-    );
-    let live = last_json(&live);
+    let live = last_json(&live_run);
+    let recorded_late = num(&live, "recorded_late_aiding");
+    let clean = recorded_late == 0.0;
     assert_eq!(
         num(&live, "nav_samples_compared"),
         2.0 * imu as f64,
         "{live}"
     );
-    assert_eq!(num(&live, "nav_samples_different"), 0.0, "{live}");
     assert_eq!(num(&live, "nav_samples_missing"), 0.0, "{live}");
+    if clean {
+        assert!(live_run.status.success(), "{live}");
+        assert_eq!(num(&live, "nav_samples_different"), 0.0, "{live}");
+    }
     assert!(replaying.shm_entries().is_empty());
 
     // In process, through the same library code: identical too.
-    let offline = Isolated::new("off").run(&["replay", file_s, "--offline", "--json"]);
-    assert!(
-        offline.status.success(),
-        "rins replay --offline: {}",
-        stderr(&offline)
-    );
-    let offline = last_json(&offline);
+    let offline_run = Isolated::new("off").run(&["replay", file_s, "--offline", "--json"]);
+    let offline = last_json(&offline_run);
     assert_eq!(num(&offline, "nav_samples_compared"), nav as f64);
-    assert_eq!(num(&offline, "nav_samples_different"), 0.0, "{offline}");
+    assert_eq!(num(&offline, "recorded_late_aiding"), recorded_late);
+    if clean {
+        assert!(offline_run.status.success(), "{offline}");
+        assert_eq!(num(&offline, "nav_samples_different"), 0.0, "{offline}");
+    } else {
+        eprintln!(
+            "the recorded navigator applied {recorded_late} aiding readings late: the replays \
+             are compared with each other"
+        );
+        for field in ["nav_samples_different", "first_different"] {
+            assert_eq!(live[field], offline[field], "{field}: {live} vs {offline}");
+        }
+    }
 
     // Foxglove's Python decoders read every message.
     if let Some(python) = interpreter("a_recorded_flight_replays_to_the_same_navigation_output") {

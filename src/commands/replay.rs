@@ -44,6 +44,10 @@ struct ReplayReport {
     speed_achieved: f64,
     #[serde(flatten)]
     comparison: NavComparison,
+    /// Aiding readings the recorded navigator lanes applied after their place in the IMU stream
+    /// (a burst of frames after a serial stall); the replay applies them in their place, so the
+    /// samples after the first cannot match.
+    recorded_late_aiding: u64,
     /// Messages of the file that were skipped or not decodable.
     file_messages_skipped: u64,
     file_damage: Option<String>,
@@ -97,6 +101,7 @@ pub fn run(args: &ReplayArgs) -> Result<ExitCode> {
         seconds,
         speed_achieved: if seconds > 0.0 { span_s / seconds } else { 0.0 },
         comparison: compare(&input.nav, &replayed),
+        recorded_late_aiding: input.recorded_late_aiding.iter().sum(),
         file_messages_skipped: input.skipped + input.undecodable,
         file_damage: input.damage.clone(),
     };
@@ -116,6 +121,14 @@ pub fn run(args: &ReplayArgs) -> Result<ExitCode> {
             c.nav_samples_different,
             c.nav_samples_missing
         );
+        if report.recorded_late_aiding > 0 && c.nav_samples_different > 0 {
+            println!(
+                "the recording's navigator applied {} aiding readings after their place in the IMU \
+                 stream (a burst of frames after a serial stall); the replay applies them in their \
+                 place, so the samples after the first of them differ",
+                report.recorded_late_aiding
+            );
+        }
     }
     // Not identical is a finding a script must see.
     Ok(

@@ -1,9 +1,10 @@
 //! The raw sensor samples of a recording, in the order the sensor block produced them.
 
+use std::collections::HashMap;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use ipc_types::{NavState, RawAux, RawBaro, RawImu, RawMag, names};
+use ipc_types::{Health, NavState, RawAux, RawBaro, RawImu, RawMag, ServiceKind, names};
 use rins_recording::{RecordedMessage, Recording, read_file};
 
 /// One raw sample of a recording.
@@ -21,9 +22,23 @@ pub enum RawSample {
 
 impl RawSample {
     /// The order the samples reached the computer: the serial receive time of their frames (each
-    /// frame type counts its own sequence numbers, so those do not order samples across types).
-    fn order(&self) -> u64 {
-        self.rx_ns()
+    /// frame type counts its own sequence numbers, so those do not order samples across types),
+    /// then the device time. One read of the serial port after a stall hands out many frames with
+    /// one receive time; the wire carries them in device-time order, while the recorder wrote
+    /// them topic by topic. Ordered by receive time alone, a barometer sample would be fed after
+    /// IMU frames it preceded on the wire, and meet the navigator later than it did when recorded.
+    fn order(&self) -> (u64, u64) {
+        (self.rx_ns(), self.device_time_us())
+    }
+
+    /// The frame's device time, µs.
+    pub fn device_time_us(&self) -> u64 {
+        match self {
+            Self::Imu(s) => s.header.origin_device_time_us,
+            Self::Baro(s) => s.header.origin_device_time_us,
+            Self::Mag(s) => s.header.origin_device_time_us,
+            Self::Aux(s) => s.header.origin_device_time_us,
+        }
     }
 
     /// The frame's serial receive time, ns (CLOCK_MONOTONIC of the recording).
@@ -45,6 +60,11 @@ pub struct ReplayInput {
     pub raw: Vec<RawSample>,
     /// The recorded navigation output of lane 0 and lane 1.
     pub nav: [Vec<NavState>; 2],
+    /// Aiding readings each recorded navigator lane applied after their place in the IMU stream
+    /// (from its last recorded heartbeat). A serial stall hands the pipeline a burst of frames at
+    /// once, and an altitude can then reach a lane after the IMU frames it had to precede; a
+    /// replay applies it in its place, so the samples after it cannot match the recording.
+    pub recorded_late_aiding: [u64; 2],
     /// Messages of the file that could not be decoded (skipped, counted).
     pub undecodable: u64,
     /// Messages the reader skipped (wrong length, version), and where the file was cut short.
@@ -68,17 +88,25 @@ impl ReplayInput {
             damage: recording.damage.clone(),
             ..Self::default()
         };
+        let mut late_by_process = HashMap::new();
         for m in &recording.messages {
-            if input.take(m).is_err() {
+            if input.take(m, &mut late_by_process).is_err() {
                 input.undecodable += 1;
             }
         }
-        // Stable: samples received at the same instant keep their recorded order.
+        for ((lane, _pid), late) in late_by_process {
+            input.recorded_late_aiding[lane] += late;
+        }
+        // Stable: samples of one frame (same receive and device time) keep their recorded order.
         input.raw.sort_by_key(RawSample::order);
         input
     }
 
-    fn take(&mut self, m: &RecordedMessage) -> Result<(), rins_recording::DecodeError> {
+    fn take(
+        &mut self,
+        m: &RecordedMessage,
+        late_by_process: &mut HashMap<(usize, u32), u64>,
+    ) -> Result<(), rins_recording::DecodeError> {
         match &*m.topic {
             names::RAW_IMU => self.raw.push(RawSample::Imu(m.decode()?)),
             names::RAW_BARO => self.raw.push(RawSample::Baro(m.decode()?)),
@@ -86,6 +114,17 @@ impl ReplayInput {
             names::RAW_AUX => self.raw.push(RawSample::Aux(m.decode()?)),
             t if t == names::NAV_LANES[0] => self.nav[0].push(m.decode()?),
             t if t == names::NAV_LANES[1] => self.nav[1].push(m.decode()?),
+            names::HEARTBEAT => {
+                let beat: Health = m.decode()?;
+                let lane = ServiceKind::NAVIGATOR_LANES
+                    .iter()
+                    .position(|k| *k as u8 == beat.service);
+                if let Some(lane) = lane {
+                    // Counters count since the process started: the newest of each process.
+                    let late = late_by_process.entry((lane, beat.pid)).or_insert(0);
+                    *late = (*late).max(beat.late);
+                }
+            }
             _ => {}
         }
         Ok(())
@@ -97,5 +136,60 @@ impl ReplayInput {
             .iter()
             .filter(|s| matches!(s, RawSample::Imu(_)))
             .count()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn header(rx_ns: u64, t_us: u64) -> ipc_types::Header {
+        ipc_types::Header {
+            origin_rx_ns: rx_ns,
+            origin_device_time_us: t_us,
+            ..ipc_types::Header::default()
+        }
+    }
+
+    #[test]
+    fn frames_of_one_serial_read_keep_their_wire_order_across_topics() {
+        let imu = |rx, t| {
+            RawSample::Imu(RawImu {
+                header: header(rx, t),
+                ..RawImu::default()
+            })
+        };
+        let baro = |rx, t| {
+            RawSample::Baro(RawBaro {
+                header: header(rx, t),
+                ..RawBaro::default()
+            })
+        };
+        // The recorder wrote the IMU topic first; a stall made the read at 50 ns hand out the
+        // frames of 2000..2030 µs at once.
+        let mut raw = [
+            imu(10, 1000),
+            imu(50, 2000),
+            imu(50, 2010),
+            imu(50, 2030),
+            baro(10, 1000),
+            baro(50, 2020),
+        ];
+        raw.sort_by_key(RawSample::order);
+        let order: Vec<(bool, u64)> = raw
+            .iter()
+            .map(|s| (matches!(s, RawSample::Baro(_)), s.device_time_us()))
+            .collect();
+        assert_eq!(
+            order,
+            [
+                (false, 1000),
+                (true, 1000),
+                (false, 2000),
+                (false, 2010),
+                (true, 2020),
+                (false, 2030)
+            ]
+        );
     }
 }

@@ -1,0 +1,61 @@
+//! Decoding the receiver's bytes must not touch the heap: NMEA sentences through the `nmea` crate
+//! and NAV-PVT frames through the `ublox` crate, read in the small pieces a serial port hands out,
+//! every epoch published.
+
+use ipc_types::{GnssFix, GnssFixType};
+use rins_gnss_protocol::decode::GnssDecoder;
+use rins_gnss_protocol::encode::{write_nav_pvt, write_nmea_epoch};
+use rins_test_support::counting_alloc::{CountingAllocator, allocations_during};
+
+#[global_allocator]
+static ALLOCATOR: CountingAllocator = CountingAllocator;
+
+fn epoch(i: u64) -> GnssFix {
+    GnssFix {
+        receiver_time_us: 45_296_000_000 + i * 200_000,
+        fix_type: GnssFixType::Fix3d as u8,
+        satellites: 11,
+        latitude_rad: (-33.8688 + i as f64 * 1e-6).to_radians(),
+        longitude_rad: (151.2093 - i as f64 * 1e-6).to_radians(),
+        altitude_m: 58.25 + i as f64,
+        velocity_ned_mps: [3.0, -4.0, 0.5],
+        horizontal_accuracy_m: 1.5,
+        vertical_accuracy_m: 3.0,
+        speed_accuracy_mps: 0.1,
+        hdop: 0.8,
+        ..GnssFix::default()
+    }
+}
+
+#[test]
+fn decoding_nmea_and_ubx_does_not_allocate() {
+    // The counter sees this thread's allocations.
+    assert!(allocations_during(|| drop(std::hint::black_box(vec![1u8; 8]))) > 0);
+
+    for ubx in [false, true] {
+        let mut stream = Vec::new();
+        for i in 0..50 {
+            match ubx {
+                true => write_nav_pvt(&epoch(i), &mut stream),
+                false => write_nmea_epoch(&epoch(i), &mut stream),
+            }
+        }
+        let mut decoder = GnssDecoder::new();
+        // One epoch first: whatever the decoder sets up once is not per epoch.
+        let first = stream.len() / 50;
+        decoder.push(&stream[..first], 1, |_| {});
+        let mut fixes = 0;
+        let allocations = allocations_during(|| {
+            for (k, piece) in stream[first..].chunks(61).enumerate() {
+                decoder.push(piece, k as u64, |_| fixes += 1);
+            }
+        });
+        // NMEA knows an epoch complete when the next begins: the last one stays pending.
+        assert!(
+            fixes >= 48,
+            "ubx {ubx}: {fixes} fixes, {:?}",
+            decoder.stats()
+        );
+        assert_eq!(allocations, 0, "ubx {ubx}: allocations while decoding");
+    }
+}
