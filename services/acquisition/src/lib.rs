@@ -9,5 +9,6 @@ pub mod listen;
 pub mod port;
 pub mod presence;
 pub mod resume_file;
+pub mod resume_saver;
 pub mod service;
 pub mod to_ipc;

@@ -20,6 +20,7 @@ use crate::line_watch::LineWatch;
 use crate::port;
 use crate::presence::{Opened, Presence};
 use crate::resume_file;
+use crate::resume_saver::ResumeSaver;
 use crate::to_ipc;
 use rins_protocol::{DecodedFrame, Decoder, DecoderStats, FrameType, Payload, link_error};
 
@@ -142,6 +143,7 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
     }
     // The first frames judge the rest of the point: a part that does not fit them is counted.
     let mut resume_rejected = decoder.stats().resume_rejected;
+    let resume_saver = ResumeSaver::start(resume_path.clone())?;
     let mut next_save_ns = 0u64;
     let mut counters = Health::default();
     let mut presence = Presence::new(Backoff::new(
@@ -216,7 +218,7 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
                     let rx_ns = monotonic_ns();
                     if rx_ns >= next_save_ns {
                         next_save_ns = rx_ns + resume_file::SAVE_PERIOD_NS;
-                        save_resume_point(&resume_path, &decoder);
+                        resume_saver.offer(decoder.resume_point());
                     }
                     let mut failed = None;
                     decoder.push(&buf[..n], rx_ns, |frame| {
@@ -264,7 +266,7 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
             wait_for_retry(delay, shutdown, &mut heartbeat, &counters)?;
         }
     }
-    save_resume_point(&resume_path, &decoder);
+    resume_saver.finish(decoder.resume_point());
     tracing::info!(frames = counters.received, "acquisition stopped");
     Ok(())
 }
@@ -296,12 +298,4 @@ fn warn_resume_ignored(decoder: &Decoder, rejected: u64) {
         time_us = now.time_us,
         "resume point far from the device's actual time: ignored"
     );
-}
-
-/// Saves where the numbering stands (once a second, off the per-frame path); a failure is logged at
-/// debug level: the next save tries again, and a restart without a point only renumbers.
-fn save_resume_point(path: &std::path::Path, decoder: &Decoder) {
-    if let Err(e) = resume_file::save(path, &decoder.resume_point()) {
-        tracing::debug!(path = %path.display(), error = %e, "cannot save the resume point");
-    }
 }
