@@ -4,7 +4,9 @@
 
 mod common;
 
-use common::{Isolated, last_json, num, stderr};
+use std::time::Duration;
+
+use common::{Isolated, last_json, num, spawn_up_navigating, stderr, stop_up};
 
 fn gnss_faults(summary: &serde_json::Value) -> Vec<serde_json::Value> {
     summary["faults"]
@@ -70,6 +72,46 @@ fn a_jump_is_rejected_within_a_second_and_a_drift_within_30_s() {
         step <= 1.0,
         "the solution stepped {step} m during the jump: {jump}"
     );
+    assert_eq!(num(&s, "false_alarms"), 0.0, "{s}");
+}
+
+/// A jump injected at run time, as an operator does (`rins inject gnss jump 50` into a running
+/// deployment, then `clear`): the summary reports it with the bounds of a scheduled one, and the
+/// receiver's return is no false alarm.
+#[test]
+fn a_jump_injected_at_run_time_is_rejected_within_a_second() {
+    let ipc = Isolated::new("gnss_inject_run_time");
+    let up = spawn_up_navigating(
+        &ipc,
+        &["--scenario", "uav", "--gnss", "--duration", "600", "--json"],
+    );
+    let inject = |args: &[&str]| {
+        let out = ipc.run(&[&["inject", "gnss"], args].concat());
+        assert!(
+            out.status.success(),
+            "rins inject gnss {args:?}: {}",
+            stderr(&out)
+        );
+    };
+    // Aided for a while first.
+    std::thread::sleep(Duration::from_secs(15));
+    inject(&["jump", "50"]);
+    std::thread::sleep(Duration::from_secs(8));
+    inject(&["clear"]);
+    // Re-admitted 3 s after the jump ends.
+    std::thread::sleep(Duration::from_secs(6));
+    let s = stop_up(&ipc, up);
+    let faults = gnss_faults(&s);
+    assert_eq!(faults.len(), 1, "{s}");
+    let jump = &faults[0];
+    assert_eq!(jump["kind"], "gnss-jump", "{jump}");
+    let delay = num(jump, "detected_at_s") - num(jump, "injected_at_s");
+    assert!(
+        (0.0..=1.0).contains(&delay),
+        "jump detected after {delay} s: {jump}"
+    );
+    let step = num(jump, "horiz_step_m_max");
+    assert!(step <= 1.0, "the solution stepped {step} m: {jump}");
     assert_eq!(num(&s, "false_alarms"), 0.0, "{s}");
 }
 
