@@ -37,6 +37,11 @@ pub struct GnssAidingConfig {
     /// real quadrotor flights chooses (`rins eval quadrotor --mode gnss`): a smaller allowance
     /// or threshold raises alarms on clean fixes there.
     pub drift_threshold: f64,
+    /// Threshold of the displacement test ([`crate::gnss_displacement`]), σ (2 dof): the
+    /// receiver's displacement over 10 s against the inertial velocity. Under white fix noise
+    /// of the reported accuracy, 6 σ is passed once in some 10⁸ fixes; a 0.5 m/s drift passes it
+    /// within about ten seconds.
+    pub displacement_threshold: f64,
     /// A rejected receiver comes back once its fixes have passed the gate for this long, s.
     pub readmit_after_s: f64,
 }
@@ -55,6 +60,7 @@ impl Default for GnssAidingConfig {
             reject_after_fixes: 3,
             drift_slack: 2.0,
             drift_threshold: 25.0,
+            displacement_threshold: 6.0,
             readmit_after_s: 3.0,
         }
     }
@@ -81,6 +87,7 @@ impl GnssAidingConfig {
         positive("reject_after_fixes", f64::from(self.reject_after_fixes))?;
         positive("drift_slack", self.drift_slack)?;
         positive("drift_threshold", self.drift_threshold)?;
+        positive("displacement_threshold", self.displacement_threshold)?;
         positive("readmit_after_s", self.readmit_after_s)
     }
 }

@@ -148,6 +148,14 @@ impl GnssMonitor {
         }
     }
 
+    /// Rejects a receiver still believed for a drift another test saw (see
+    /// [`crate::gnss_displacement`]); nothing when it is rejected already.
+    pub fn reject_for_drift(&mut self, t_us: u64) {
+        if self.standing == Standing::Accepted {
+            self.reject(t_us, RejectReason::Drift);
+        }
+    }
+
     fn reject(&mut self, t_us: u64, reason: RejectReason) {
         self.standing = Standing::Rejected {
             reason,

@@ -137,7 +137,23 @@ impl AidedNavigator {
             (Some(_), Some(at_rejection)) if offset_m >= 0.5 * at_rejection => f64::INFINITY,
             _ => d2,
         };
-        let verdict = self.gnss.monitor.judge(m.t_us, d2, normalised);
+        let mut verdict = self.gnss.monitor.judge(m.t_us, d2, normalised);
+        if verdict == Verdict::Use {
+            let sigma_h = floor(m.sigma_h_m, c.sigma_horizontal_floor_m);
+            // The receiver's own velocity where it reports one (see `gnss_displacement` for why
+            // not the solution's), the solution's otherwise.
+            let velocity = m.velocity_ned.map_or(past.velocity_ned, Vector3::from);
+            let displaced = self
+                .gnss
+                .displacement
+                .push(m.t_us, m.position, &velocity, sigma_h);
+            if displaced.is_some_and(|d| d > c.displacement_threshold) {
+                self.gnss.monitor.reject_for_drift(m.t_us);
+                verdict = Verdict::Rejected;
+            }
+        } else {
+            self.gnss.displacement.reset();
+        }
         if verdict == Verdict::Rejected && self.gnss.jump_offset_m.is_none() {
             self.gnss.jump_offset_m = Some(offset_m);
         }
@@ -185,6 +201,7 @@ impl AidedNavigator {
     /// receiver's latency; the latency's motion is within the variance given here).
     fn reset_from_fix(&mut self, m: &GnssMeasurement) -> GnssOutcome {
         let c = self.config.gnss;
+        self.gnss.displacement.reset();
         let Some(ekf) = self.ekf_mut() else {
             return GnssOutcome::NotUsed;
         };
@@ -240,6 +257,8 @@ pub(crate) struct GnssAidingState {
     pub(crate) last_receiver_time_us: Option<u64>,
     /// The horizontal distance of the fixes from the solution when the receiver was rejected, m.
     pub(crate) jump_offset_m: Option<f64>,
+    /// The receiver's displacement against the inertial velocity (the gain-free drift test).
+    pub(crate) displacement: crate::gnss_displacement::DisplacementTest,
 }
 
 impl GnssAidingState {
@@ -249,6 +268,7 @@ impl GnssAidingState {
             monitor: crate::gnss_monitor::GnssMonitor::new(config),
             last_receiver_time_us: None,
             jump_offset_m: None,
+            displacement: crate::gnss_displacement::DisplacementTest::default(),
         }
     }
 
@@ -259,5 +279,6 @@ impl GnssAidingState {
         self.monitor = crate::gnss_monitor::GnssMonitor::new(config);
         self.last_receiver_time_us = None;
         self.jump_offset_m = None;
+        self.displacement.reset();
     }
 }

@@ -16,6 +16,7 @@ pub mod config;
 pub mod ekf;
 pub mod force_window;
 pub mod gnss_config;
+pub mod gnss_displacement;
 pub mod gnss_hold;
 pub mod gnss_monitor;
 pub mod gnss_updates;
