@@ -109,3 +109,39 @@ fn negative_numbers_get_the_range_message() {
     );
     fails_with(&["soak", "--minutes", "-1"], &["--minutes -1"]);
 }
+
+/// A root and prefix too long together for iceoryx2's socket names: `rins up` and a tool refuse at
+/// once, naming both, and nothing is created.
+#[test]
+fn a_root_and_prefix_too_long_for_socket_names_are_refused_naming_both() {
+    let ipc = common::Isolated::new("long_names");
+    let root = ipc
+        .root
+        .join("a-directory-name-long-enough-to-leave-no-room");
+    for args in [
+        &["up", "--duration", "1"][..],
+        &["status", "--timeout", "1"],
+    ] {
+        let out = ipc
+            .command()
+            .args(args)
+            .env("RINS_IPC_ROOT", &root)
+            .output()
+            .expect("cannot run rins");
+        assert!(!out.status.success(), "{args:?} should fail");
+        let stderr = common::stderr(&out);
+        for part in [
+            "RINS_IPC_ROOT",
+            "RINS_IPC_PREFIX",
+            "too long together",
+            "at most 62",
+        ] {
+            assert!(
+                stderr.contains(part),
+                "{args:?}: {part:?} missing:\n{stderr}"
+            );
+        }
+        assert!(!ipc.root.exists(), "{args:?} created the root");
+        assert_eq!(ipc.shm_entries(), Vec::<String>::new());
+    }
+}

@@ -10,6 +10,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use ipc_types::ServiceKind;
 use rins_runtime::ipc::{IpcSettings, create_node};
+use rins_runtime::root_lock::RootLock;
 use rins_runtime::shm_cleanup;
 use rins_runtime::shutdown::Shutdown;
 use rins_watchdog::deployment_checks::{ensure_no_live_deployment, refuse_foreign_entries};
@@ -92,9 +93,13 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
         return Ok(std::process::ExitCode::SUCCESS);
     }
     let settings = IpcSettings::from_env();
+    settings.check_name_lengths()?;
     refuse_foreign_entries(&settings)?;
     // Only a root this run created is removed at the end (and only when empty).
     let root_created = settings.ensure_root()?;
+    // Held until this deployment's first node exists: a tool arriving meanwhile either made its
+    // node before the check below (and is seen) or makes it after the clean-up (and keeps it).
+    let arrival_lock = RootLock::exclusive(&settings)?;
     // The configuration file lets programs that are not rins (a Python consumer) join this
     // deployment; it goes again at stop.
     let run_dir = ensure_no_live_deployment(&settings)
@@ -129,6 +134,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
 
     let exe = std::env::current_exe().context("cannot locate the rins executable")?;
     let node = create_node("watchdog", &settings)?;
+    drop(arrival_lock);
     let mut monitor = Monitor::new(&node)?;
     let mut supervisor = Supervisor::new();
     let started = Instant::now();

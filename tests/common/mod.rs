@@ -24,8 +24,12 @@ impl Isolated {
     pub fn new(test: &str) -> Self {
         static NEXT: AtomicU32 = AtomicU32::new(0);
         let n = NEXT.fetch_add(1, Ordering::Relaxed);
-        let prefix = format!("rt{}_{}_{test}_", std::process::id(), n);
-        let root = std::env::temp_dir().join(format!("{prefix}root"));
+        // Short: iceoryx2 names its event sockets ROOT/PREFIX<id>.event, and a socket's path is
+        // limited (the test's name is there to recognise its files, its start is enough).
+        let id = format!("rt{}_{n}", std::process::id());
+        let name: String = test.chars().take(16).collect();
+        let prefix = format!("{id}_{name}_");
+        let root = std::env::temp_dir().join(id);
         Self { prefix, root }
     }
 
@@ -93,6 +97,17 @@ impl Isolated {
         }
     }
 
+    /// Where [`spawn_up`] sends the pipeline's stderr: a file, not a pipe, so that a long run's
+    /// warnings never fill a buffer no one reads, and a failure can show what the pipeline said.
+    pub fn up_stderr_path(&self) -> PathBuf {
+        std::env::temp_dir().join(format!("{}up-stderr.log", self.prefix))
+    }
+
+    /// What the pipeline from [`spawn_up`] wrote to stderr so far.
+    pub fn up_stderr(&self) -> String {
+        std::fs::read_to_string(self.up_stderr_path()).unwrap_or_default()
+    }
+
     /// Shared-memory entries of this namespace still present.
     pub fn shm_entries(&self) -> Vec<String> {
         std::fs::read_dir("/dev/shm")
@@ -139,6 +154,7 @@ impl Drop for Isolated {
             let _ = std::fs::remove_file(PathBuf::from("/dev/shm").join(name));
         }
         let _ = std::fs::remove_dir_all(&self.root);
+        let _ = std::fs::remove_file(self.up_stderr_path());
     }
 }
 
@@ -235,11 +251,12 @@ pub fn quadrotor_data_dir() -> Option<PathBuf> {
 
 /// `rins up ARGS` started in the background on `ipc`'s namespace, stdout piped for its summary.
 pub fn spawn_up(ipc: &Isolated, args: &[&str]) -> std::process::Child {
+    let log = std::fs::File::create(ipc.up_stderr_path()).expect("cannot create the stderr log");
     ipc.command()
         .arg("up")
         .args(args)
         .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::null())
+        .stderr(log)
         .spawn()
         .expect("cannot start rins up")
 }
@@ -247,9 +264,17 @@ pub fn spawn_up(ipc: &Isolated, args: &[&str]) -> std::process::Child {
 /// [`spawn_up`], then waits (up to two minutes: a loaded machine starts six processes slowly) for
 /// the first navigation sample, so the pipeline is known to run end to end.
 pub fn spawn_up_navigating(ipc: &Isolated, args: &[&str]) -> std::process::Child {
-    let up = spawn_up(ipc, args);
+    let mut up = spawn_up(ipc, args);
     let first = ipc.run(&["echo", "nav", "--count", "1", "--timeout", "120"]);
-    assert!(first.status.success(), "no navigation sample: {first:?}");
+    if !first.status.success() {
+        let exited = up.try_wait().ok().flatten();
+        let _ = up.kill();
+        let _ = up.wait();
+        panic!(
+            "no navigation sample: {first:?}\nrins up (exit: {exited:?}) wrote:\n{}",
+            ipc.up_stderr()
+        );
+    }
     up
 }
 
@@ -264,7 +289,12 @@ pub fn stop_up_output(ipc: &Isolated, up: std::process::Child) -> Output {
     // Our own child process, not reaped yet.
     send_signal(u64::from(up.id()), Signal::Terminate).expect("SIGTERM to our own child");
     let out = up.wait_with_output().expect("rins up did not finish");
-    assert!(out.status.success(), "rins up: {:?}", out.status);
+    assert!(
+        out.status.success(),
+        "rins up: {:?}\n{}",
+        out.status,
+        ipc.up_stderr()
+    );
     assert_eq!(ipc.shm_entries(), Vec::<String>::new());
     out
 }

@@ -15,6 +15,7 @@ use crate::{private_dir, shm_cleanup, user};
 /// that joins a deployment starts here.
 pub fn settings_to_join() -> Result<IpcSettings> {
     let settings = IpcSettings::joining_from_env()?;
+    settings.check_name_lengths()?;
     check_joinable(&settings)?;
     Ok(settings)
 }

@@ -16,6 +16,7 @@ pub mod nav_subscriber;
 pub mod payload;
 pub mod private_dir;
 pub mod realtime;
+pub mod root_lock;
 pub mod service;
 pub mod service_loop;
 pub mod shm_cleanup;

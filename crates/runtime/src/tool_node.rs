@@ -16,15 +16,18 @@ use std::path::Path;
 use anyhow::Result;
 
 use crate::ipc::{IpcNode, IpcSettings, create_node, for_each_live_node, own_ports};
+use crate::root_lock::RootLock;
 use crate::{join_check, private_dir, shm_cleanup, user};
 
 /// A tool's node on the deployment of the environment's prefix and root (see
 /// [`join_check::settings_to_join`]); cleans up after itself when dropped. Create every port from
 /// [`ToolNode::node`] after the `ToolNode`, so that the ports are dropped before it.
 pub struct ToolNode {
-    // Fields drop in declaration order: the node first, then the clean-up that needs it gone.
+    // Fields drop in declaration order: the node first, then the clean-up that needs it gone,
+    // then the lock taken for both (see `Drop`).
     node: IpcNode,
     cleanup: Cleanup,
+    lock: Option<RootLock>,
 }
 
 impl ToolNode {
@@ -34,16 +37,26 @@ impl ToolNode {
         let settings = join_check::settings_to_join()?;
         let root = private_dir::without_trailing_slash(Path::new(&settings.root)).to_path_buf();
         let root_existed = std::fs::symlink_metadata(&root).is_ok();
-        let node = create_node(&format!("{tool}-{}", std::process::id()), &settings);
+        // A deployment starting now does not clean the prefix while the node is being made (see
+        // `root_lock`). Another user's root cannot be locked, nor is it ever cleaned by us.
+        let lock = own_deployment(&settings)
+            .then(|| RootLock::shared(&settings))
+            .transpose();
+        let node = lock.and_then(|lock| {
+            create_node(&format!("{tool}-{}", std::process::id()), &settings).map(|n| (n, lock))
+        });
         // Made before the error is returned: a failed creation may have left the root and the
         // domain's segment, and dropping the clean-up removes them.
         let cleanup = Cleanup {
             root_created: !root_existed && root.exists(),
             settings,
         };
+        let (node, lock) = node?;
+        drop(lock);
         Ok(Self {
-            node: node?,
+            node,
             cleanup,
+            lock: None,
         })
     }
 
@@ -56,6 +69,21 @@ impl ToolNode {
     pub fn settings(&self) -> &IpcSettings {
         &self.cleanup.settings
     }
+}
+
+impl Drop for ToolNode {
+    /// A deployment starting now does not count the live nodes while this one goes and its
+    /// leftovers are removed: it would see the prefix still in use, or the removal would take
+    /// what it just made.
+    fn drop(&mut self) {
+        if own_deployment(&self.cleanup.settings) {
+            self.lock = RootLock::exclusive(&self.cleanup.settings).ok();
+        }
+    }
+}
+
+fn own_deployment(settings: &IpcSettings) -> bool {
+    settings.owner == user::effective_uid()
 }
 
 /// With a pipeline running: removes the connection segments from its publishers to this process's
@@ -85,7 +113,7 @@ impl Drop for Cleanup {
     fn drop(&mut self) {
         // Only the owner's deployment is ever cleaned: a tool that joined another user's (with
         // RINS_IPC_OWNER) removes nothing of it.
-        if self.settings.owner != user::effective_uid() {
+        if !own_deployment(&self.settings) {
             return;
         }
         let mut alive = 0usize;

@@ -43,6 +43,29 @@ pub enum IpcError {
         /// Why iceoryx2 refused it.
         source: SemanticStringError,
     },
+    /// The root and the prefix together leave no room for the name of an event socket.
+    #[error(
+        "{ROOT_ENV} = {root:?} ({root_len} bytes) and {PREFIX_ENV} = {prefix:?} ({prefix_len} bytes) are \
+         too long together: at most {limit} bytes. Every event socket is named ROOT/PREFIX<id>.event, \
+         the id up to {id_digits} digits, and a Unix socket's path holds at most {socket_path_max} bytes; \
+         choose a shorter root or prefix"
+    )]
+    NamesTooLong {
+        /// The root as given.
+        root: String,
+        /// Its length with the trailing slash, bytes.
+        root_len: usize,
+        /// The prefix as given.
+        prefix: String,
+        /// Its length, bytes.
+        prefix_len: usize,
+        /// The largest accepted sum of the two.
+        limit: usize,
+        /// Digits of the longest socket id.
+        id_digits: usize,
+        /// The longest Unix socket path, bytes.
+        socket_path_max: usize,
+    },
     /// The root is not (and could not be made) a private directory of the deployment's owner.
     #[error("IPC root ({ROOT_ENV})")]
     Root {

@@ -7,6 +7,13 @@ use super::env::{OWNER_ENV, PREFIX_ENV, ROOT_ENV};
 use super::error::IpcError;
 use crate::{private_dir, user};
 
+/// The longest path of a Unix socket: `sun_path` holds 108 bytes with the terminating NUL.
+const SOCKET_PATH_MAX: usize = 107;
+/// Digits of the largest u128, the id iceoryx2 names an event socket by.
+const EVENT_SOCKET_ID_DIGITS: usize = 39;
+/// What follows the id in an event socket's name.
+const EVENT_SOCKET_SUFFIX: &str = ".event";
+
 /// Environment variable iceoryx2-style per-user runtime directories come from.
 const XDG_RUNTIME_DIR: &str = "XDG_RUNTIME_DIR";
 
@@ -95,8 +102,29 @@ impl IpcSettings {
         Ok(dir)
     }
 
+    /// Refuses a root and prefix too long for iceoryx2's event sockets, which are named
+    /// `ROOT/PREFIX<id>.event`: a Unix socket's path is limited, and the id (a u128 in decimal)
+    /// grows with every port a process makes. Past the limit a listener fails at run time, in
+    /// whichever process comes to make one with a long id first; this says so before anything starts.
+    pub fn check_name_lengths(&self) -> Result<(), IpcError> {
+        let limit = SOCKET_PATH_MAX - EVENT_SOCKET_ID_DIGITS - EVENT_SOCKET_SUFFIX.len();
+        if self.root.len() + self.prefix.len() > limit {
+            return Err(IpcError::NamesTooLong {
+                root: self.root.clone(),
+                root_len: self.root.len(),
+                prefix: self.prefix.clone(),
+                prefix_len: self.prefix.len(),
+                limit,
+                id_digits: EVENT_SOCKET_ID_DIGITS,
+                socket_path_max: SOCKET_PATH_MAX,
+            });
+        }
+        Ok(())
+    }
+
     /// iceoryx2's configuration for this deployment: its prefix and root.
     pub fn iceoryx_config(&self) -> Result<Config, IpcError> {
+        self.check_name_lengths()?;
         let mut config = Config::default();
         config.global.prefix =
             FileName::new(self.prefix.as_bytes()).map_err(|source| IpcError::Prefix {
@@ -115,6 +143,40 @@ impl IpcSettings {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// 62 bytes of root and prefix together pass; one more is refused, naming both and the limit.
+    #[test]
+    fn a_root_and_prefix_too_long_for_a_socket_path_are_refused() {
+        let root = format!("/{}/", "r".repeat(40)); // 42 bytes with its slashes
+        assert!(
+            IpcSettings::new("p".repeat(20), root.clone())
+                .check_name_lengths()
+                .is_ok()
+        );
+        let err = IpcSettings::new("p".repeat(21), root)
+            .check_name_lengths()
+            .unwrap_err()
+            .to_string();
+        for part in [
+            "RINS_IPC_ROOT",
+            "42 bytes",
+            "RINS_IPC_PREFIX",
+            "21 bytes",
+            "at most 62",
+        ] {
+            assert!(err.contains(part), "{part:?} missing from: {err}");
+        }
+        // The default names of any user fit.
+        let uid = u32::MAX;
+        assert!(
+            IpcSettings::new(
+                default_prefix(uid),
+                default_root(uid, Some("/run/user/4294967295"))
+            )
+            .check_name_lengths()
+            .is_ok()
+        );
+    }
 
     #[test]
     fn defaults_are_per_user() {
