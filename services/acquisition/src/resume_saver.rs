@@ -9,7 +9,7 @@
 use std::path::PathBuf;
 use std::thread::JoinHandle;
 
-use crossbeam_channel::{Sender, TrySendError, bounded};
+use crossbeam_channel::{Sender, bounded};
 use rins_protocol::ResumePoint;
 
 use crate::resume_file;
@@ -45,9 +45,9 @@ impl ResumeSaver {
     /// writer still busy with the previous point makes this one skipped.
     pub fn offer(&self, point: ResumePoint) {
         if let Some(tx) = &self.points {
-            match tx.try_send(point) {
-                Ok(()) | Err(TrySendError::Full(_) | TrySendError::Disconnected(_)) => {}
-            }
+            // Full: the writer is busy and this point is skipped. Disconnected: the writer is
+            // gone, and `finish` still saves the last point.
+            let _ = tx.try_send(point);
         }
     }
 

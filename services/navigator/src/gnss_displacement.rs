@@ -20,6 +20,8 @@
 //!
 //! Fixed size, no allocation.
 
+use std::collections::VecDeque;
+
 use nalgebra::Vector3;
 use rins_earth::wgs84::{meridian_radius, prime_vertical_radius};
 
@@ -33,6 +35,8 @@ pub const BLOCK_S: f64 = 2.0;
 const MAX_GAP_S: f64 = 1.0;
 /// Offsets remembered: [`WINDOW_S`] + [`BLOCK_S`] at up to 10 Hz, with room.
 const CAPACITY: usize = 160;
+/// Fixes each block needs before the test judges: one, so that a 1 Hz receiver is judged too.
+const MIN_FIXES_PER_BLOCK: usize = 1;
 
 #[derive(Debug, Clone, Copy)]
 struct Previous {
@@ -47,10 +51,8 @@ struct Previous {
 pub struct DisplacementTest {
     previous: Option<Previous>,
     offset_m: [f64; 2],
-    /// Ring of (device time µs, offset north/east m), oldest at `start`.
-    ring: [(u64, [f64; 2]); CAPACITY],
-    start: usize,
-    len: usize,
+    /// (device time µs, offset north/east m), oldest first; allocated once, at its capacity.
+    offsets: VecDeque<(u64, [f64; 2])>,
 }
 
 impl Default for DisplacementTest {
@@ -58,9 +60,7 @@ impl Default for DisplacementTest {
         Self {
             previous: None,
             offset_m: [0.0; 2],
-            ring: [(0, [0.0; 2]); CAPACITY],
-            start: 0,
-            len: 0,
+            offsets: VecDeque::with_capacity(CAPACITY),
         }
     }
 }
@@ -70,8 +70,7 @@ impl DisplacementTest {
     pub fn reset(&mut self) {
         self.previous = None;
         self.offset_m = [0.0; 2];
-        self.start = 0;
-        self.len = 0;
+        self.offsets.clear();
     }
 
     /// Takes the fix at device time `t_us` at geodetic `position` (rad, rad, m) with the
@@ -107,27 +106,17 @@ impl DisplacementTest {
             lon,
             velocity_ne,
         });
-        self.remember(t_us, self.offset_m);
-        self.statistic(t_us, sigma_h_m)
-    }
-
-    fn remember(&mut self, t_us: u64, offset: [f64; 2]) {
-        if self.len == CAPACITY {
-            self.start = (self.start + 1) % CAPACITY;
-            self.len -= 1;
+        if self.offsets.len() == CAPACITY {
+            self.offsets.pop_front();
         }
-        self.ring[(self.start + self.len) % CAPACITY] = (t_us, offset);
-        self.len += 1;
-    }
-
-    fn entries(&self) -> impl Iterator<Item = &(u64, [f64; 2])> {
-        (0..self.len).map(move |i| &self.ring[(self.start + i) % CAPACITY])
+        self.offsets.push_back((t_us, self.offset_m));
+        self.statistic(t_us, sigma_h_m)
     }
 
     /// Mean offset and count of the entries with `from_s <= t_now − t < to_s`.
     fn block(&self, t_now_us: u64, from_s: f64, to_s: f64) -> ([f64; 2], usize) {
         let (mut sum, mut n) = ([0.0; 2], 0usize);
-        for (t, offset) in self.entries() {
+        for (t, offset) in &self.offsets {
             let age_s = t_now_us.saturating_sub(*t) as f64 * 1e-6;
             if age_s >= from_s && age_s < to_s {
                 sum[0] += offset[0];
@@ -144,9 +133,11 @@ impl DisplacementTest {
     fn statistic(&self, t_now_us: u64, sigma_h_m: f64) -> Option<f64> {
         let (recent, n1) = self.block(t_now_us, 0.0, BLOCK_S);
         let (earlier, n2) = self.block(t_now_us, WINDOW_S, WINDOW_S + BLOCK_S);
-        // Both blocks at least half full at the slowest rate a receiver is used at (1 Hz).
-        let least = (BLOCK_S / 2.0).floor().max(1.0) as usize;
-        if n1 < least || n2 < least || sigma_h_m.is_nan() || sigma_h_m <= 0.0 {
+        if n1 < MIN_FIXES_PER_BLOCK
+            || n2 < MIN_FIXES_PER_BLOCK
+            || sigma_h_m.is_nan()
+            || sigma_h_m <= 0.0
+        {
             return None;
         }
         let sigma = sigma_h_m * (1.0 / n1 as f64 + 1.0 / n2 as f64).sqrt();
