@@ -408,6 +408,8 @@ INTEGRITY_REASONS = {
     0x100: "non-finite",
     0x200: "aiding-stale",
     0x400: "gnss-inconsistent",
+    0x800: "sensor-fault-unisolated",
+    0x1000: "position-unknown",
 }
 
 #: Bits of NavState.aiding (accepted sources), with their names.

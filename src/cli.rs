@@ -96,7 +96,7 @@ pub enum Command {
     /// sample; `--offline` runs the same code in this process without IPC.
     Replay(ReplayArgs),
     /// Return a channel that fusion excluded to service and wait for fusion's answer: readmitted
-    /// once it stayed in the solution through its probation, or refused (fault still present, no
+    /// once it passed its probation against the other channels, or refused (fault still present, no
     /// such channel); exits non-zero unless it is in the solution.
     Readmit {
         /// Channel: gyro or accel followed by its 0-based index, e.g. gyro2, accel0.
@@ -130,6 +130,10 @@ pub enum Command {
     },
     /// Monte Carlo comparison of the redundant block with an orthogonal triad, with a gyro kill.
     Mc(McArgs),
+    /// Fault sweep: one gyro or accelerometer fault per run (bias steps, a ramp, a noise increase)
+    /// injected in flight into the configured chain, in-process; detection and isolation times,
+    /// attitude error while the integrity said ok, false alarms of a clean run.
+    Sweep(SweepArgs),
     /// Fit sensor calibrations offline from recorded samples.
     Calibrate {
         /// Which calibration.
@@ -316,6 +320,34 @@ pub struct McArgs {
     /// Configuration file (its sim, navigator and altimeter settings are used).
     #[arg(long)]
     pub config: Option<PathBuf>,
+}
+
+/// Options of `rins sweep`.
+#[derive(Debug, Args)]
+pub struct SweepArgs {
+    /// Configuration file whose sim, fusion, altimeter and navigator settings are swept (default:
+    /// the built-in configuration); the `uav` scenario is flown whatever it names.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Simulator seed of every run (default: sim.seed).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Injection time, s of device time; repeat for several (default: 8 and 120, the ground roll
+    /// and the first turn).
+    #[arg(long = "at", value_name = "S", allow_negative_numbers = true)]
+    pub at: Vec<f64>,
+    /// Flight after each injection, s (default 45).
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub window: Option<f64>,
+    /// Only this channel (gyro0 … accel3); repeat for several (default: every channel).
+    #[arg(long, value_name = "CHANNEL")]
+    pub channel: Vec<String>,
+    /// Worker threads (default 2).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// One JSON object on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// A service `rins service` can run.

@@ -241,3 +241,60 @@ fn a_block_of_the_wrong_shape_is_invalid_input_and_fusion_is_not_restarted() {
     // The stall was upstream: fusion answered every frame, the watchdog restarted nothing.
     assert_eq!(e.summary["restarts"], 0, "{}", e.summary);
 }
+
+/// `rins up ARGS --json` on the simulator, one pipeline slot held: the checked summary.
+fn up_summary(test: &str, args: &[&str]) -> Value {
+    let _slot = PipelineSlot::take();
+    common::up_json(test, args)
+}
+
+/// A 0.02 rad/s bias on one of four gyros: a one-dimensional parity space detects it but cannot
+/// say which channel it is. Fusion's windowed parity mean declares it within a tenth of a second
+/// (the per-sample test took 3.6 s, while the attitude integrated 3° of error and the integrity
+/// said ok), and no sample the integrity calls ok is off by more than the fault-free flight's
+/// own error (1.24° at 45 s).
+#[test]
+fn a_gyro_bias_is_declared_at_once_and_no_sample_called_ok_carries_its_error() {
+    let s = up_summary(
+        "ig_bias",
+        &[
+            "--scenario",
+            "uav",
+            "--duration",
+            "25",
+            "--inject",
+            "gyro2:bias=0.02@8s",
+        ],
+    );
+    let fault = &s["faults"][0];
+    let injected = fault["injected_at_s"].as_f64().expect("injected");
+    let detected = fault["detected_at_s"].as_f64().expect("detected");
+    assert!(detected - injected < DETECT_WITHIN_S, "{fault}");
+    assert!(fault["isolated_at_s"].as_f64().is_some(), "{fault}");
+    let while_ok = common::num(&s, "att_err_deg_max_while_ok");
+    assert!(while_ok < 1.5, "{while_ok}° while ok: {s}");
+    assert_eq!(common::num(&s, "false_alarms"), 0.0, "{s}");
+}
+
+/// A configuration that names no initial position (here: only an alignment setting) starts the
+/// navigator at a placeholder (0°, 0°), 5 300 km from the simulator's origin: the horizontal
+/// solution is never called ok, and the summary has no "while ok" horizontal error to show.
+#[test]
+fn without_an_initial_position_no_sample_is_ok() {
+    let config = common::TempFile::new("ig-partial", "toml", "[navigator]\nalign_s = 1.0\n");
+    let s = up_summary(
+        "ig_nopos",
+        &[
+            "--scenario",
+            "static",
+            "--duration",
+            "6",
+            "--config",
+            config.path(),
+        ],
+    );
+    let samples = &s["nav_integrity_samples"];
+    assert_eq!(samples["ok"], 0, "{s}");
+    assert!(samples["degraded"].as_u64().unwrap_or(0) > 1000, "{s}");
+    assert!(s.get("horiz_err_m_max_while_ok").is_none(), "{s}");
+}

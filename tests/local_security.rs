@@ -481,3 +481,299 @@ fn sigterm_during_start_up_is_a_clean_stop() {
     std::thread::sleep(Duration::from_millis(500));
     stop_up(&ipc, up);
 }
+
+/// Every entry of a running deployment: its shared memory in /dev/shm and everything under its
+/// root (the root itself first).
+fn deployment_files(ipc: &Isolated) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = ipc
+        .shm_entries()
+        .into_iter()
+        .map(|n| Path::new("/dev/shm").join(n))
+        .collect();
+    let mut dirs = vec![ipc.root.clone()];
+    while let Some(dir) = dirs.pop() {
+        files.push(dir.clone());
+        for entry in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
+            let path = entry.path();
+            if entry.file_type().is_ok_and(|t| t.is_dir()) {
+                dirs.push(path);
+            } else {
+                files.push(path);
+            }
+        }
+    }
+    files
+}
+
+/// What another user's attempt on a file came to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Attempt {
+    /// Refused with EACCES or EPERM.
+    Refused,
+    /// It worked: the file was theirs to change.
+    Done,
+    /// Refused otherwise (the errno).
+    Other(i32),
+}
+
+/// As uid and gid 65534, in a child process, tries to open each path for writing, to truncate it
+/// and to delete it; returns what each of the three came to, per path.
+fn try_as_nobody(paths: &[PathBuf]) -> Vec<[Attempt; 3]> {
+    let names: Vec<CString> = paths.iter().map(|p| c_path(p)).collect();
+    let mut fds = [0i32; 2];
+    // SAFETY: a valid two-int array.
+    assert_eq!(unsafe { libc::pipe(fds.as_mut_ptr()) }, 0);
+    // Everything the child needs is made before the fork: between fork and _exit it only calls
+    // async-signal-safe functions.
+    let mut codes = vec![0u8; names.len() * 3];
+    // SAFETY: fork in a test process; the child only makes system calls and ends with _exit.
+    let pid = unsafe { libc::fork() };
+    assert!(pid >= 0, "fork");
+    if pid == 0 {
+        let code = |r: libc::c_int| -> u8 {
+            if r >= 0 {
+                return 1;
+            }
+            // SAFETY: errno of this thread.
+            match unsafe { *libc::__errno_location() } {
+                libc::EACCES | libc::EPERM => 0,
+                e => 2 + (e.clamp(0, 250) as u8),
+            }
+        };
+        // SAFETY: plain system calls on valid NUL-terminated paths and our own pipe; the child
+        // ends with _exit whatever happens.
+        unsafe {
+            if libc::setgroups(0, std::ptr::null()) != 0
+                || libc::setgid(NOBODY) != 0
+                || libc::setuid(NOBODY) != 0
+            {
+                libc::_exit(99);
+            }
+            for (i, name) in names.iter().enumerate() {
+                let fd = libc::open(
+                    name.as_ptr(),
+                    libc::O_WRONLY | libc::O_NOFOLLOW | libc::O_NONBLOCK,
+                );
+                codes[i * 3] = code(fd);
+                if fd >= 0 {
+                    libc::close(fd);
+                }
+                codes[i * 3 + 1] = code(libc::truncate(name.as_ptr(), 0));
+                codes[i * 3 + 2] = code(libc::unlink(name.as_ptr()));
+            }
+            libc::write(fds[1], codes.as_ptr().cast(), codes.len());
+            libc::_exit(0);
+        }
+    }
+    // SAFETY: our end of the pipe, and our own child.
+    unsafe { libc::close(fds[1]) };
+    let mut status = 0;
+    // SAFETY: waiting for our own child.
+    assert_eq!(unsafe { libc::waitpid(pid, &mut status, 0) }, pid);
+    assert_eq!(status, 0, "the child could not become uid {NOBODY}");
+    // SAFETY: reading into a buffer of that length from our end of the pipe.
+    let n = unsafe { libc::read(fds[0], codes.as_mut_ptr().cast(), codes.len()) };
+    // SAFETY: our own descriptor.
+    unsafe { libc::close(fds[0]) };
+    assert_eq!(n as usize, codes.len(), "the child's report");
+    let attempt = |c: u8| match c {
+        0 => Attempt::Refused,
+        1 => Attempt::Done,
+        e => Attempt::Other(i32::from(e) - 2),
+    };
+    codes
+        .chunks(3)
+        .map(|c| [attempt(c[0]), attempt(c[1]), attempt(c[2])])
+        .collect()
+}
+
+/// No file of a running deployment is another user's to write, truncate or delete: every shared
+/// memory segment (iceoryx2's management segment included, which iceoryx2 alone makes 0666) and
+/// every file under the root. Checked by modes and by trying, as uid 65534.
+#[test]
+fn no_file_of_a_running_deployment_can_be_written_truncated_or_deleted_by_another_user() {
+    let ipc = Isolated::new("othuid");
+    let _slot = PipelineSlot::take();
+    let up = Stopped(Some(common::spawn_up_navigating(
+        &ipc,
+        &["--scenario", "static", "--duration", "60", "--json"],
+    )));
+    let files = deployment_files(&ipc);
+    let shm: Vec<&PathBuf> = files.iter().filter(|p| p.starts_with("/dev/shm")).collect();
+    assert!(
+        shm.iter()
+            .any(|p| p.to_string_lossy().ends_with(".global_mgmt")),
+        "the management segment is among {shm:?}"
+    );
+    assert!(shm.len() > 20, "{shm:?}");
+    // Modes: the shared memory owner-only, nothing under the root writable by others, the root
+    // reachable by its owner only.
+    for path in &files {
+        let meta = std::fs::symlink_metadata(path).unwrap();
+        let mode = meta.mode() & 0o7777;
+        if meta.file_type().is_symlink() {
+            continue;
+        }
+        if path.starts_with("/dev/shm") {
+            assert_eq!(mode & 0o077, 0, "{} is mode {mode:o}", path.display());
+        } else {
+            assert_eq!(mode & 0o022, 0, "{} is mode {mode:o}", path.display());
+        }
+    }
+    assert_eq!(std::fs::metadata(&ipc.root).unwrap().mode() & 0o777, 0o700);
+    if !is_root() {
+        eprintln!("note: not root; the modes were checked, the other user's attempts are not");
+        return;
+    }
+    let attempts = try_as_nobody(&files);
+    let allowed: Vec<String> = files
+        .iter()
+        .zip(&attempts)
+        // A directory is never open for writing, whoever asks (EISDIR): what matters of it is
+        // that it cannot be removed and that nothing in it can be reached.
+        .filter(|(p, a)| {
+            a.iter().any(|r| {
+                *r != Attempt::Refused && !(p.is_dir() && *r == Attempt::Other(libc::EISDIR))
+            })
+        })
+        .map(|(p, a)| format!("{} {a:?}", p.display()))
+        .collect();
+    assert_eq!(
+        allowed,
+        Vec::<String>::new(),
+        "open/truncate/unlink as uid {NOBODY}"
+    );
+    // Nothing was touched: the deployment runs on.
+    let out = ipc.run_with_timeout(&["echo", "nav", "--count", "10", "--timeout", "10"], PROMPT);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = up.stop(Duration::from_secs(30));
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+/// The deployment's iceoryx2 management segment, found among its shared memory.
+fn management_segment(ipc: &Isolated) -> PathBuf {
+    let name = ipc
+        .shm_entries()
+        .into_iter()
+        .find(|n| n.ends_with(".global_mgmt"))
+        .expect("the deployment has a management segment");
+    Path::new("/dev/shm").join(name)
+}
+
+/// Where iceoryx2's management segment of `ipc`'s deployment is, before anything made it.
+fn management_segment_to_be(ipc: &Isolated) -> PathBuf {
+    let config = iceoryx2::prelude::Config::default();
+    Path::new("/dev/shm").join(rins_runtime::ipc::mgmt_segment::segment_name(
+        &ipc.prefix,
+        &config,
+    ))
+}
+
+/// The owner damages the management segment during a run and a service dies: no node can be made
+/// any more, so the service cannot come back. The deployment does not go on reporting a
+/// navigation that stopped: its restarts fail, it is given up and `rins up` stops with an error
+/// naming the file.
+#[test]
+fn a_management_segment_damaged_during_a_run_stops_the_deployment_loudly() {
+    let ipc = Isolated::new("mgmtdmg");
+    let _slot = PipelineSlot::take();
+    let up = common::spawn_up_navigating(
+        &ipc,
+        &["--scenario", "static", "--duration", "45", "--json"],
+    );
+    let report = ipc.status();
+    let fusion = report["services"]
+        .as_array()
+        .and_then(|s| s.iter().find(|s| s["service"] == "fusion"))
+        .and_then(|s| s["pid"].as_u64())
+        .expect("fusion's pid");
+    let segment = management_segment(&ipc);
+    std::fs::write(&segment, [0xFFu8; 16]).unwrap();
+    send_signal(fusion, Signal::Kill).expect("SIGKILL to fusion");
+    let started = Instant::now();
+    let out = wait_within(up, Duration::from_secs(30));
+    let err = ipc.up_stderr();
+    assert!(!out.status.success(), "rins up should fail:\n{err}");
+    assert!(
+        started.elapsed() < Duration::from_secs(20),
+        "took {:?}",
+        started.elapsed()
+    );
+    let name = segment.display().to_string();
+    for part in [
+        "fusion failed to start 5 times in a row",
+        "stopping the pipeline",
+        &name,
+        "holds version word 0xffffffffffffffff",
+    ] {
+        assert!(err.contains(part), "{part:?} missing:\n{err}");
+    }
+    assert_eq!(processes_of(&ipc.prefix), Vec::<u32>::new());
+}
+
+/// A tool facing a damaged management segment (truncated to nothing, or overwritten) fails at
+/// once, naming it, instead of waiting for ever or failing on an iceoryx2 error that names
+/// nothing; and a tool without a timeout stops on SIGTERM.
+#[test]
+fn tools_facing_a_damaged_management_segment_fail_promptly_naming_it_and_stop_on_sigterm() {
+    for (what, contents, expected) in [
+        ("truncated", Vec::new(), "is 0 bytes long"),
+        (
+            "garbage",
+            vec![0xFFu8; 16],
+            "holds version word 0xffffffffffffffff",
+        ),
+    ] {
+        let ipc = Isolated::new(&format!("mg{what}"));
+        let segment = management_segment_to_be(&ipc);
+        let plant = || {
+            std::fs::write(&segment, &contents).unwrap();
+            std::fs::set_permissions(&segment, std::fs::Permissions::from_mode(0o600)).unwrap();
+        };
+        let name = segment.display().to_string();
+        plant();
+        let started = Instant::now();
+        let out = ipc.run_with_timeout(&["echo", "nav", "--timeout", "3"], Duration::from_secs(6));
+        assert!(!out.status.success(), "{what}");
+        assert!(
+            started.elapsed() < Duration::from_secs(5),
+            "{what}: {:?}",
+            started.elapsed()
+        );
+        let err = stderr(&out);
+        assert!(
+            err.contains(&name) && err.contains(expected),
+            "{what}: {err}"
+        );
+        plant();
+        let out = ipc.run_with_timeout(&["status", "--timeout", "2"], Duration::from_secs(5));
+        assert!(!out.status.success(), "{what}");
+        assert!(stderr(&out).contains(&name), "{what}: {}", stderr(&out));
+        for args in [
+            &["inject", "gyro0", "dead"][..],
+            &["readmit", "gyro0", "--timeout", "2"],
+        ] {
+            plant();
+            let out = ipc.run_with_timeout(args, Duration::from_secs(5));
+            assert!(!out.status.success(), "{what}: {args:?}");
+            assert!(
+                stderr(&out).contains(&name),
+                "{what}: {args:?}: {}",
+                stderr(&out)
+            );
+        }
+        // No timeout: it ends on SIGTERM (or has ended by then), within two seconds.
+        plant();
+        let echo = ipc
+            .command()
+            .args(["echo", "nav"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("rins echo");
+        std::thread::sleep(Duration::from_millis(300));
+        let _ = send_signal(u64::from(echo.id()), Signal::Terminate);
+        let out = wait_within(echo, Duration::from_secs(2));
+        assert!(!out.status.success(), "{what}: {}", stderr(&out));
+    }
+}

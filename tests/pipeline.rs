@@ -3,40 +3,12 @@
 
 mod common;
 
-use common::{Isolated, last_json, num};
+use common::{num, up_json as up_with};
 
 /// Runs `rins up` for `duration` seconds and returns the summary, after checking a clean exit and
 /// an empty /dev/shm for the test's prefix.
 fn up(test: &str, scenario: &str, duration: &str) -> serde_json::Value {
     up_with(test, &["--scenario", scenario, "--duration", duration])
-}
-
-/// `rins up ARGS --json`, checked as [`up`] does.
-fn up_with(test: &str, args: &[&str]) -> serde_json::Value {
-    let ipc = Isolated::new(test);
-    let mut all = vec!["up"];
-    all.extend_from_slice(args);
-    all.push("--json");
-    let out = ipc.run(&all);
-    assert!(
-        out.status.success(),
-        "rins up failed: {:?}\n{}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let summary = last_json(&out);
-    assert_eq!(
-        ipc.shm_entries(),
-        Vec::<String>::new(),
-        "shared memory left behind"
-    );
-    assert_eq!(num(&summary, "shm_leaked"), 0.0);
-    assert!(
-        !ipc.root.exists(),
-        "iceoryx2 root left behind: {}",
-        ipc.root.display()
-    );
-    summary
 }
 
 #[test]

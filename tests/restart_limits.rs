@@ -186,3 +186,37 @@ fn bad_restart_settings_are_refused_naming_the_key() {
         &["give_up", "shutdown", "leave-down"],
     );
 }
+
+/// A service left down over its limit: the timed run reaches its end, its summary names the
+/// service as failed, and `rins up` exits non-zero, saying which — the pipeline it was asked to run
+/// was not whole.
+#[test]
+fn a_timed_run_with_a_service_given_up_ends_with_an_error() {
+    let _slot = PipelineSlot::take();
+    let ipc = Isolated::new("failedend");
+    let config = TempFile::new(
+        "limits",
+        "toml",
+        "[watchdog.services.altimeter]\nmax_restarts = 0\ngive_up = \"leave-down\"\n",
+    );
+    let up = spawn_up_navigating(
+        &ipc,
+        &[
+            "--config",
+            config.path(),
+            "--scenario",
+            "static",
+            "--duration",
+            "8",
+            "--json",
+        ],
+    );
+    sigkill(running_pid(&ipc, "altimeter", None));
+    let out = up.wait_with_output().expect("rins up");
+    let err = ipc.up_stderr();
+    assert!(!out.status.success(), "rins up should fail:\n{err}");
+    assert!(err.contains("altimeter given up during the run"), "{err}");
+    let summary = common::last_json(&out);
+    assert_eq!(summary["failed_services"], serde_json::json!(["altimeter"]));
+    assert_eq!(ipc.shm_entries(), Vec::<String>::new());
+}

@@ -46,10 +46,12 @@ fn status_shows_every_process_and_counts_a_restart_after_sigkill() {
         assert!(s["heartbeat_age_ms"].as_u64().unwrap() < 3000, "{s}");
     }
     // 1 kHz input: the navigator and fusion publish every sample. The report's window is 250 ms,
-    // so a busy machine may shift a few samples between windows.
+    // so a busy machine may shift samples between windows: a stage held off the CPU for 130 ms of
+    // the window (seen at a load of 4 on 2 cores) reads half the rate. What is checked is that
+    // output flows at the input's order of magnitude, not 0 and not a burst of several windows.
     for name in ["fusion", "navigator"] {
         let rate = service(&report, name)["output_rate_hz"].as_f64().unwrap();
-        assert!((500.0..=1500.0).contains(&rate), "{name} {rate}");
+        assert!((250.0..=1750.0).contains(&rate), "{name} {rate}");
     }
     assert!(service(&report, "sim")["output_rate_hz"].is_null());
 
@@ -203,5 +205,47 @@ fn fusion_says_when_acquisition_goes_quiet_and_when_it_is_back() {
         .max();
     assert!(fusion_episodes.is_some_and(|n| n >= 1), "{text}");
 
+    stop_up(&ipc, up);
+}
+
+/// While the serial line is unplugged no navigation sample comes: the report and the status line
+/// say so instead of the last sample's "navigating", and say navigating again once it flows.
+#[test]
+fn a_navigation_output_that_stops_is_not_reported_as_navigating() {
+    let ipc = Isolated::new("navstops");
+    let _slot = PipelineSlot::take();
+    let up = spawn_up_navigating(
+        &ipc,
+        &["--scenario", "static", "--duration", "60", "--json"],
+    );
+    // Aligned and flowing first.
+    ipc.status_until(Duration::from_secs(30), |r| {
+        r["navigation"]["mode"] == "navigating" && r["navigation"]["output_flowing"] == true
+    });
+    let out = ipc.run(&["inject", "disconnect", "--duration", "4"]);
+    assert!(out.status.success(), "{}", common::stderr(&out));
+    let stopped = ipc.status_until(Duration::from_secs(10), |r| {
+        r["navigation"]["output_flowing"] == false
+    });
+    let nav = &stopped["navigation"];
+    assert_eq!(nav["mode"], "invalid", "{stopped}");
+    assert!(
+        nav["summary"]
+            .as_str()
+            .is_some_and(|s| s.starts_with("no navigation output for ")),
+        "{stopped}"
+    );
+    let start = std::time::Instant::now();
+    while !ipc.up_stderr().contains("| no navigation output") {
+        assert!(
+            start.elapsed() < Duration::from_secs(5),
+            "no status line said so:\n{}",
+            ipc.up_stderr()
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    ipc.status_until(Duration::from_secs(30), |r| {
+        r["navigation"]["output_flowing"] == true
+    });
     stop_up(&ipc, up);
 }

@@ -73,9 +73,16 @@ pub mod integrity_reason {
     /// The GNSS receiver disagrees with the inertial solution (a jump, or a drift the inertial
     /// solution does not follow): it is rejected until it is consistent again.
     pub const GNSS_INCONSISTENT: u32 = 1 << 10;
+    /// Fusion detects a fault among the redundant IMU channels that it cannot yet pin on one
+    /// channel: the solution still includes the channel that disagrees. Held after the fault is
+    /// isolated while the attitude error it may have left is beyond the limit.
+    pub const SENSOR_FAULT_UNISOLATED: u32 = 1 << 11;
+    /// No initial position was configured and no absolute fix has set one yet: the horizontal
+    /// position is unknown (latitude and longitude are placeholders).
+    pub const POSITION_UNKNOWN: u32 = 1 << 12;
 
     /// Every reason with its name, in bit order.
-    pub const NAMES: [(u32, &str); 11] = [
+    pub const NAMES: [(u32, &str); 13] = [
         (IMU_UNUSABLE, "imu-unusable"),
         (TIME_NOT_ADVANCING, "time-not-advancing"),
         (ALL_AIDING_REJECTED, "all-aiding-rejected"),
@@ -87,6 +94,8 @@ pub mod integrity_reason {
         (NON_FINITE, "non-finite"),
         (AIDING_STALE, "aiding-stale"),
         (GNSS_INCONSISTENT, "gnss-inconsistent"),
+        (SENSOR_FAULT_UNISOLATED, "sensor-fault-unisolated"),
+        (POSITION_UNKNOWN, "position-unknown"),
     ];
 
     /// The names of the bits set in `reasons`, comma-separated (empty for none).

@@ -5,9 +5,12 @@ pymavlink and checks: the message set and each stream's rate (±10 %), the attit
 `rins echo nav` for the same samples, the odometry covariance against the solution's, TIMESYNC
 answers, a STATUSTEXT after `rins inject gyro1 dead`, the reset counter and a lane-switch text after
 the lane the stream delivers is killed, and re-admission commands acknowledged with fusion's answer.
+The link is signed with KEY_HEX: pymavlink takes only messages carrying a valid signature, signs
+what it sends, and an unsigned command must go unanswered.
 
-Usage: python mavlink_stream.py RINS_BINARY PORT CONFIG   (RINS_IPC_PREFIX / RINS_IPC_ROOT isolate the
-run; CONFIG is a configuration file that accepts MAVLink commands)
+Usage: python mavlink_stream.py RINS_BINARY PORT CONFIG KEY_HEX   (RINS_IPC_PREFIX / RINS_IPC_ROOT
+isolate the run; CONFIG is a configuration file that accepts MAVLink commands signed with the key
+KEY_HEX, 64 hexadecimal digits, from system 255)
 Prints one JSON line of what it measured; exits non-zero on the first failed check.
 """
 
@@ -66,8 +69,11 @@ def msg_time_s(m):
 
 
 class Listener:
-    def __init__(self, port):
+    def __init__(self, port, key):
         self.conn = mavutil.mavlink_connection(f"udpin:127.0.0.1:{port}", source_system=255)
+        # Unsigned or badly signed messages are dropped by pymavlink: everything checked below
+        # arrived signed with the key.
+        self.conn.setup_signing(key, sign_outgoing=True)
         # Every STATUSTEXT seen, and the lane the stream delivers: a loaded machine can starve a
         # lane past the selector's dead time at any moment, and the stream then goes on from the
         # other lane (announced once, whichever check was waiting at the time).
@@ -129,8 +135,9 @@ def run(rins, *args, timeout=30):
 
 def main():
     rins, port, config = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+    key = bytes.fromhex(sys.argv[4])
     measured = {}
-    listener = Listener(port)
+    listener = Listener(port, key)
     up = subprocess.Popen(
         [rins, "up", "--scenario", "uav", "--duration", "120", "--json", "--config", config,
          "--mavlink", f"udpout:127.0.0.1:{port}"],
@@ -221,7 +228,16 @@ def check(rins, listener, measured):
         fail("TIMESYNC not answered", measured)
     measured["timesync_tc1_ns"] = ts.tc1
 
-    # 5. Commands: one rins does not carry out, and a re-admission of a channel in service.
+    # 5. Commands: an unsigned one is refused (no answer at all), one rins does not carry out, and a
+    # re-admission of a channel in service.
+    listener.conn.mav.signing.sign_outgoing = False
+    listener.conn.mav.command_long_send(1, 197, mavutil.mavlink.MAV_CMD_USER_1, 0,
+                                        1.0, 0.0, 0, 0, 0, 0, 0)
+    listener.conn.mav.signing.sign_outgoing = True
+    ack = listener.wait_for(3, lambda m: m.get_type() == "COMMAND_ACK")
+    measured["unsigned_command_answered"] = ack is not None
+    if ack is not None:
+        fail(f"an unsigned command was answered: {ack}", measured)
     listener.conn.mav.command_long_send(1, 197, mavutil.mavlink.MAV_CMD_COMPONENT_ARM_DISARM,
                                         0, 1, 0, 0, 0, 0, 0, 0)
     ack = listener.wait_for(5, lambda m: m.get_type() == "COMMAND_ACK")

@@ -11,6 +11,7 @@ use ipc_types::{
 };
 use rins_runtime::ipc::{IpcNode, SampleSource, TopicSubscriber};
 use rins_runtime::nav_subscriber::NavSubscriber;
+use rins_runtime::setup_guard::SetupGuard;
 use rins_runtime::shutdown::Shutdown;
 use rins_runtime::tool_node::ToolNode;
 use serde_json::Value;
@@ -129,10 +130,18 @@ where
 {
     let started_ns = rins_runtime::clock::monotonic_ns();
     let shutdown = Shutdown::install()?;
+    // Joining and subscribing keep the timeout and stop on a signal, whatever the deployment's
+    // files hold: iceoryx2 waits for ever on some damaged ones, and never looks at the flag.
+    let guard = SetupGuard::arm(
+        format!("echo: subscribing to {name:?}"),
+        opts.timeout,
+        Some(shutdown.clone()),
+    );
     // Ports are made after the tool node, so they are dropped before it cleans up.
     let tool = ToolNode::join("echo")?;
     let node = tool.node();
     let mut sub = open(node)?;
+    guard.disarm();
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     let mut printed = 0u64;

@@ -21,6 +21,7 @@ mod service;
 mod sim;
 mod status;
 mod status_link;
+mod sweep;
 mod up;
 
 use std::process::ExitCode;
@@ -90,6 +91,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             EvalCommand::Quadrotor(args) => eval::run_quadrotor(&args).map(|()| ExitCode::SUCCESS),
         },
         Command::Mc(args) => mc::run(&args).map(|()| ExitCode::SUCCESS),
+        Command::Sweep(args) => sweep::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Calibrate { what } => match what {
             CalibrateCommand::Mag(args) => calibrate::run_mag(&args).map(|()| ExitCode::SUCCESS),
         },

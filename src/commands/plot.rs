@@ -40,6 +40,13 @@ pub fn run(file: &Path, out: &Path, json: bool) -> Result<()> {
     if let Some(damage) = &report.damage {
         eprintln!("plot: {}: reading stopped early: {damage}", file.display());
     }
+    if report.damaged_chunks > 0 {
+        eprintln!(
+            "plot: {}: {} damaged chunks skipped",
+            file.display(),
+            report.damaged_chunks
+        );
+    }
     if report.damaged_messages > 0 {
         eprintln!(
             "plot: {}: {} damaged messages skipped",

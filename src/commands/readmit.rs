@@ -23,7 +23,7 @@ pub fn describe(channel: &ChannelId, reply: &FusionReply) -> (String, bool) {
         .map_or_else(|| format!("reason {}", reply.reason), |r| r.name().into());
     match ReadmitOutcome::from_u8(reply.outcome) {
         Some(ReadmitOutcome::Readmitted) => (
-            format!("{channel}: readmitted (stayed in the solution through its probation)"),
+            format!("{channel}: readmitted (passed its probation against the other channels)"),
             true,
         ),
         Some(ReadmitOutcome::NotExcluded) => (

@@ -50,6 +50,8 @@ struct ReplayReport {
     recorded_late_aiding: u64,
     /// Messages of the file that were skipped or not decodable.
     file_messages_skipped: u64,
+    /// Chunks of the file skipped as damaged (their messages are lost, and not counted above).
+    file_chunks_damaged: u64,
     file_damage: Option<String>,
 }
 
@@ -103,6 +105,7 @@ pub fn run(args: &ReplayArgs) -> Result<ExitCode> {
         comparison: compare(&input.nav, &replayed),
         recorded_late_aiding: input.recorded_late_aiding.iter().sum(),
         file_messages_skipped: input.skipped + input.undecodable,
+        file_chunks_damaged: input.damaged_chunks,
         file_damage: input.damage.clone(),
     };
     let c = &report.comparison;
@@ -121,6 +124,15 @@ pub fn run(args: &ReplayArgs) -> Result<ExitCode> {
             c.nav_samples_different,
             c.nav_samples_missing
         );
+        if report.file_chunks_damaged > 0 || report.file_messages_skipped > 0 {
+            println!(
+                "{}: {} damaged chunks and {} damaged messages skipped",
+                report.file, report.file_chunks_damaged, report.file_messages_skipped
+            );
+        }
+        if let Some(damage) = &report.file_damage {
+            println!("{}: reading stopped early: {damage}", report.file);
+        }
         if report.recorded_late_aiding > 0 && c.nav_samples_different > 0 {
             println!(
                 "the recording's navigator applied {} aiding readings after their place in the IMU \

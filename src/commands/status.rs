@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Result, bail};
 use ipc_types::{HealthReport, ServiceKind, ServiceState, names};
 use rins_runtime::ipc::TopicSubscriber;
+use rins_runtime::setup_guard::SetupGuard;
 use rins_runtime::tool_node::ToolNode;
 use rins_watchdog::redundancy_view::{
     NavView, RedundancyView, SensorRow, nav_view, redundancy_view,
@@ -88,6 +89,8 @@ pub fn table(report: &StatusReport) -> String {
         ));
     }
     match &report.navigation {
+        // Its mode and integrity were the last sample's: nothing to show of a stopped output.
+        Some(n) if !n.output_flowing => out.push_str(&format!("\nnavigation   {}\n", n.summary)),
         Some(n) => {
             out.push_str(&format!(
                 "\nnavigation   {}, integrity {}",
@@ -144,10 +147,18 @@ pub fn run(json: bool, timeout_s: f64) -> Result<()> {
     if !(timeout_s.is_finite() && timeout_s > 0.0) {
         bail!("--timeout {timeout_s}: must be a positive number of seconds");
     }
+    // Joining and subscribing keep the timeout whatever the deployment's files hold (iceoryx2
+    // waits for ever on some damaged ones).
+    let guard = SetupGuard::arm(
+        "status: subscribing to the health report".into(),
+        Some(Duration::from_secs_f64(timeout_s)),
+        None,
+    );
     // Ports are made after the tool node, so they are dropped before it cleans up.
     let tool = ToolNode::join("status")?;
     let (node, settings) = (tool.node(), tool.settings());
     let sub = TopicSubscriber::<HealthReport>::new(node, names::HEALTH)?;
+    guard.disarm();
     let deadline = Instant::now() + Duration::from_secs_f64(timeout_s);
     let report = loop {
         sub.wait(Duration::from_millis(50))?;
@@ -272,5 +283,35 @@ mod tests {
         assert_eq!(json["redundancy"]["gyro"]["in_use"], 3);
         assert_eq!(json["redundancy"]["channels"][1]["reason"], "parity");
         assert_eq!(json["navigation"]["lane"], 1);
+        assert_eq!(json["navigation"]["output_flowing"], true);
+    }
+
+    /// A report whose navigation sample is old says the output stopped, in the table and the
+    /// JSON, and nowhere "navigating".
+    #[test]
+    fn a_stopped_navigation_output_is_not_reported_as_navigating() {
+        use ipc_types::{NavMode, NavState};
+        use rins_watchdog::redundancy_view::nav_of;
+        let report = HealthReport {
+            nav: nav_of(
+                &NavState {
+                    mode: NavMode::Navigating as u8,
+                    ..NavState::default()
+                },
+                12_345,
+            ),
+            ..HealthReport::default()
+        };
+        let r = rows(&report);
+        let t = table(&r);
+        assert!(
+            t.contains("navigation   no navigation output for 12.3 s\n"),
+            "{t}"
+        );
+        assert!(!t.contains("navigating"), "{t}");
+        let json: serde_json::Value =
+            serde_json::from_str(&serde_json::to_string(&r).expect("serialises")).expect("json");
+        assert_eq!(json["navigation"]["mode"], "invalid");
+        assert_eq!(json["navigation"]["output_flowing"], false);
     }
 }

@@ -28,6 +28,7 @@ use rins_watchdog::supervisor::{ChildSpec, Supervisor};
 
 use crate::cli::UpArgs;
 use crate::commands::fault_args;
+use crate::commands::record::{self, RecordingOutcome};
 use crate::config::{self, RinsConfig};
 
 /// Applies the command line's overrides to the configuration and checks them.
@@ -87,8 +88,15 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     let shutdown = Shutdown::install()?;
     let mut cfg = config::load(args.config.as_deref())?;
     apply_overrides(&mut cfg, args)?;
+    // A recording that cannot be made is refused before anything starts, naming the path.
+    if let Some(file) = &args.record {
+        record::check_target(file)?;
+    }
     // Refused here, before any child runs, rather than by a child in a restart loop.
     cfg.build_services()?;
+    if cfg.mavlink.enabled {
+        rins_mavlink::signing::key_for(&cfg.mavlink)?;
+    }
     if shutdown.requested() {
         return Ok(std::process::ExitCode::SUCCESS);
     }
@@ -192,13 +200,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
             })?;
         }
         if let Some(file) = &args.record {
-            recorder = Some(start_recorder(
-                &exe,
-                file,
-                &run_dir,
-                &mut supervisor,
-                &shutdown,
-            )?);
+            recorder = Some(start_recorder(&exe, file, &run_dir, &shutdown)?);
         }
         if simulate {
             supervisor.start(ChildSpec {
@@ -233,9 +235,9 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
 
     supervisor.stop_all(Duration::from_millis(cfg.watchdog.stop_grace_ms));
     // The recorder last: it writes what the services published while stopping.
-    if let Some(child) = recorder {
-        stop_recorder(child);
-    }
+    let recording = recorder
+        .zip(args.record.as_deref())
+        .map(|(child, file)| stop_recorder(child, file));
     settings.remove_iceoryx_config_file();
     // Drain what the children published while stopping, then release our own ports.
     let _ = monitor.drain();
@@ -255,10 +257,15 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
         ..summary
     };
     if args.json {
-        println!("{}", serde_json::to_string(&summary)?);
+        println!("{}", record::summary_json(&summary, recording.as_ref())?);
     } else if args.duration.is_some() {
         // A timed run ends with what it measured; one stopped by hand ends quietly.
         print!("{}", summary_text(&summary));
+        if let Some(r) = &recording {
+            print!("{}", r.text());
+        }
+    } else if let Some(r) = &recording {
+        eprint!("{}", r.text());
     }
     // A timed run that never saw a frame did not do what was asked: a bring-up script must see it.
     if args.duration.is_some()
@@ -267,16 +274,32 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     {
         bail!("{why}");
     }
+    // A timed run with a stage given up did not run the pipeline it was asked to: a script must
+    // see it, whatever the rest of the summary says.
+    if args.duration.is_some() && !shutdown.requested() && !summary.failed_services.is_empty() {
+        bail!(
+            "{} given up during the run (restarts kept failing): the pipeline was not whole at \
+             its end",
+            summary.failed_services.join(", ")
+        );
+    }
+    // A recording asked for and not made whole is a failed run, however it was stopped.
+    if let Some(why) = recording.as_ref().and_then(RecordingOutcome::failure) {
+        bail!("{why}");
+    }
     Ok(std::process::ExitCode::SUCCESS)
 }
 
+/// How long the recorder may take to subscribe to every topic (a loaded machine is slow to start
+/// a process).
+const RECORDER_START: Duration = Duration::from_secs(10);
+
 /// Starts `rins record FILE` on this deployment and waits until it has subscribed to every topic,
-/// so that the recording starts with the first sample.
+/// so that the recording starts with the first sample; fails as soon as the recorder exits.
 fn start_recorder(
     exe: &Path,
     file: &Path,
     run_dir: &Path,
-    supervisor: &mut Supervisor,
     shutdown: &Shutdown,
 ) -> Result<std::process::Child> {
     let ready = run_dir.join("recorder-ready");
@@ -289,7 +312,7 @@ fn start_recorder(
         .stdout(std::process::Stdio::piped())
         .spawn()
         .with_context(|| format!("cannot start the recorder for {}", file.display()))?;
-    let waited = wait_for_path(&ready, supervisor, shutdown);
+    let waited = record::wait_until_ready(&mut child, &ready, file, shutdown, RECORDER_START);
     let _ = std::fs::remove_file(&ready);
     if let Err(e) = waited {
         let _ = child.kill();
@@ -299,19 +322,15 @@ fn start_recorder(
     Ok(child)
 }
 
-/// Stops the recorder (SIGINT: it finishes the file) and reports what it wrote on stderr.
-fn stop_recorder(child: std::process::Child) {
+/// Stops the recorder (SIGINT: it finishes the file) and returns what it reported.
+fn stop_recorder(child: std::process::Child, file: &Path) -> RecordingOutcome {
     if let Ok(pid) = i32::try_from(child.id()) {
         // SAFETY: kill(2) on our own child's pid with a valid signal number.
         unsafe { libc::kill(pid, libc::SIGINT) };
     }
     match child.wait_with_output() {
-        Ok(out) if out.status.success() => {
-            let text = String::from_utf8_lossy(&out.stdout);
-            eprintln!("recording: {}", text.lines().last().unwrap_or_default());
-        }
-        Ok(out) => eprintln!("recording failed: {}", out.status),
-        Err(e) => eprintln!("recording: cannot collect the recorder: {e}"),
+        Ok(out) => RecordingOutcome::from_recorder(file, out.status, &out.stdout),
+        Err(e) => RecordingOutcome::lost(file, format!("cannot collect the recorder: {e}")),
     }
 }
 

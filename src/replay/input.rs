@@ -69,12 +69,15 @@ pub struct ReplayInput {
     pub undecodable: u64,
     /// Messages the reader skipped (wrong length, version), and where the file was cut short.
     pub skipped: u64,
+    /// Chunks of the file the reader skipped as damaged (their messages are lost).
+    pub damaged_chunks: u64,
     /// The reader's note on a damaged file, if any.
     pub damage: Option<String>,
 }
 
 impl ReplayInput {
-    /// Reads `path`.
+    /// Reads `path` (a regular file: anything else is refused at once, see
+    /// [`rins_recording::read_file_bytes`]).
     pub fn read(path: &Path) -> Result<Self> {
         let recording =
             read_file(path).with_context(|| format!("cannot read {}", path.display()))?;
@@ -85,6 +88,7 @@ impl ReplayInput {
     pub fn from_recording(recording: Recording) -> Self {
         let mut input = Self {
             skipped: recording.skipped_count,
+            damaged_chunks: recording.damaged_chunk_count,
             damage: recording.damage.clone(),
             ..Self::default()
         };
@@ -149,6 +153,90 @@ mod tests {
             origin_device_time_us: t_us,
             ..ipc_types::Header::default()
         }
+    }
+
+    /// A recording of `n` raw IMU frames in small chunks, its bytes.
+    fn raw_recording(path: &Path, n: u64) -> Vec<u8> {
+        let options = rins_recording::RecordOptions {
+            chunk_size: 4096,
+            ..Default::default()
+        };
+        let mut rec = rins_recording::Recorder::create(path, &options).unwrap();
+        let ch = rec.channel_for::<RawImu>(names::RAW_IMU).unwrap();
+        for i in 0..n {
+            let imu = RawImu {
+                header: header(1_000_000 + i * 1_000_000, 1000 + i * 1000),
+                ..RawImu::default()
+            };
+            rec.write_payload(ch, i, i, &imu).unwrap();
+        }
+        rec.finish().unwrap();
+        std::fs::read(path).unwrap()
+    }
+
+    #[test]
+    fn a_damaged_chunk_is_counted_and_the_rest_replayed() {
+        let dir = std::env::temp_dir().join(format!("rins-replay-input-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("run.mcap");
+        let mut bytes = raw_recording(&path, 300);
+        // The chunk records (opcode 6) of the file, outside any chunk.
+        let mut chunks = Vec::new();
+        let mut pos = 8;
+        while pos + 9 <= bytes.len() && bytes[pos] != 0x0F {
+            let len = u64::from_le_bytes(bytes[pos + 1..pos + 9].try_into().unwrap()) as usize;
+            if bytes[pos] == 0x06 {
+                chunks.push((pos, len));
+            }
+            pos += 9 + len;
+        }
+        assert!(chunks.len() >= 3, "{} chunks", chunks.len());
+        let (start, len) = chunks[1];
+        for i in 0..16 {
+            bytes[start + 9 + len / 2 + i] ^= 1 << (i % 8);
+        }
+        std::fs::write(&path, &bytes).unwrap();
+        let input = ReplayInput::read(&path).unwrap();
+        assert_eq!(input.damaged_chunks, 1);
+        assert_eq!(input.skipped, 0);
+        assert_eq!(input.damage, None);
+        // The frames after the damaged chunk are there.
+        assert_eq!(
+            input.raw.last().map(RawSample::device_time_us),
+            Some(300_000)
+        );
+        assert!(
+            input.raw.len() < 300 && input.raw.len() > 150,
+            "{}",
+            input.raw.len()
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_fifo_is_refused_without_waiting_for_a_writer() {
+        let dir = std::env::temp_dir().join(format!("rins-replay-fifo-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let fifo = dir.join("run.mcap");
+        let c = std::ffi::CString::new(fifo.to_string_lossy().as_bytes()).unwrap();
+        // SAFETY: a valid NUL-terminated path.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        let (tx, rx) = std::sync::mpsc::channel();
+        let path = fifo.clone();
+        std::thread::spawn(move || {
+            let _ = tx.send(ReplayInput::read(&path).map(|i| i.raw.len()));
+        });
+        let result = rx
+            .recv_timeout(std::time::Duration::from_secs(5))
+            .expect("reading a FIFO did not end within 5 s");
+        let text = format!("{:#}", result.unwrap_err());
+        assert!(
+            text.ends_with(&format!("{} is a FIFO, not a regular file", fifo.display())),
+            "{text}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

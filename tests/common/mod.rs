@@ -121,6 +121,35 @@ impl Isolated {
     }
 }
 
+/// `rins up ARGS --json` on a private namespace: the summary, after checking a clean exit, an
+/// empty /dev/shm for the test's prefix and no iceoryx2 root left behind.
+pub fn up_json(test: &str, args: &[&str]) -> serde_json::Value {
+    let ipc = Isolated::new(test);
+    let mut all = vec!["up"];
+    all.extend_from_slice(args);
+    all.push("--json");
+    let out = ipc.run(&all);
+    assert!(
+        out.status.success(),
+        "rins up failed: {:?}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary = last_json(&out);
+    assert_eq!(
+        ipc.shm_entries(),
+        Vec::<String>::new(),
+        "shared memory left behind"
+    );
+    assert_eq!(num(&summary, "shm_leaked"), 0.0);
+    assert!(
+        !ipc.root.exists(),
+        "iceoryx2 root left behind: {}",
+        ipc.root.display()
+    );
+    summary
+}
+
 /// At most [`PipelineSlot::MAX`] pipelines of one test binary run at the same time.
 pub struct PipelineSlot;
 

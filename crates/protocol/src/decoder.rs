@@ -40,11 +40,13 @@ pub struct DecoderStats {
     pub lost_frames_by_type: [u64; FrameType::COUNT],
     /// Valid frames whose sequence number was received before: not handed out.
     pub duplicates: u64,
-    /// Valid frames behind the newest of their type, not received before (reordered): not handed
-    /// out, and no longer counted lost.
+    /// Valid frames behind the newest of their type, not received before (reordered), or too far
+    /// behind to tell: not handed out, and no longer counted lost.
     pub late: u64,
     /// Sequence jumps: a number implausibly far ahead of the receive clock, or too far behind to
-    /// be a late frame. The numbering was re-based; nothing counted lost.
+    /// be a late frame and continued by the next frame of its type (a counter that restarted; a
+    /// single frame that far behind is counted `late`). The numbering was re-based; nothing
+    /// counted lost.
     pub seq_jumps: u64,
     /// Device-time discontinuities re-based on the receive clock.
     pub time_rebases: u64,
@@ -142,6 +144,9 @@ impl Decoder {
     pub fn reset(&mut self) {
         self.stats.resync_bytes += self.len as u64;
         self.len = 0;
+        for s in &mut self.seq {
+            s.reconnected();
+        }
     }
 
     /// Where the extended sequence numbers (per frame type) and device time stand.

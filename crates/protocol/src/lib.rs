@@ -12,6 +12,7 @@ pub mod frame;
 pub mod frame_period;
 pub mod layout;
 pub mod line_report;
+pub mod lost_runs;
 pub mod resume_point;
 pub mod seq_extend;
 pub mod seq_window;

@@ -12,9 +12,15 @@
 //! - a number behind the newest, within the window of [`WINDOW`] numbers, not received yet is
 //!   **late**: not delivered (consumers need increasing numbers: a strapdown integrator cannot
 //!   integrate backwards), and taken back out of the lost count when its gap counted it.
-//! - a number [`WINDOW`] or more behind the newest cannot be told a duplicate from a late frame; no
-//!   serial link delivers a frame that late (a second at 1 kHz), while a restarted counter lands
-//!   there: it is taken as a **sequence jump** too — re-based, delivered.
+//! - a number [`WINDOW`] or more behind the newest cannot be told a duplicate from a late frame. It
+//!   is either a stray frame far out of place (a corrupted number, a device resending an old
+//!   frame) or the first of a counter that restarted there; the next frame tells which. Until
+//!   then it is **late** (not delivered, never counted lost). When the next frame continues its
+//!   number, the counter restarted: a **sequence jump**, re-based there and delivered. When the
+//!   next frame continues the newest, it was a stray frame and nothing changes: re-basing on it
+//!   would read the following frames as a forward step of as many numbers, all "lost". After a
+//!   reconnect ([`SeqExtender::reconnected`]) the device was away and has likely restarted: the
+//!   first frame that far behind is a jump at once.
 //!
 //! - a number behind the newest after the type was silent for longer than the window lasts (an
 //!   outage of more than 2^15 frames reads backwards) is a sequence jump too.
@@ -26,6 +32,7 @@
 use super::arrival::ArrivalAnchor;
 use super::continuity::Continuity;
 use super::frame_period::FramePeriod;
+use super::lost_runs::LostRuns;
 use super::seq_window::{ReceivedWindow, WINDOW};
 
 /// What one frame is, by its sequence number.
@@ -81,23 +88,34 @@ pub struct SeqExtender {
     period: FramePeriod,
     /// In frames of the learnt period (set once the period is known).
     anchor: ArrivalAnchor,
+    /// The wire number of the last frame [`WINDOW`] or more behind the newest, until the next
+    /// frame shows whether a counter restarted there.
+    far_behind: Option<u16>,
+    /// The last runs of numbers counted lost, to recover one arriving beyond the window.
+    lost_runs: LostRuns,
+    /// The line was reopened and no frame of this type arrived since.
+    reconnected: bool,
 }
 
 impl SeqExtender {
     /// Classifies the frame numbered `wire` on the wire, received at `rx_ns` (CLOCK_MONOTONIC).
     pub fn extend(&mut self, wire: u16, rx_ns: u64) -> SeqVerdict {
+        let reconnected = std::mem::take(&mut self.reconnected);
         let Some(newest) = self.newest else {
             return self.first(wire, rx_ns);
         };
         // Truncation intended: the signed 16-bit difference.
         let step = wire.wrapping_sub(newest.wire) as i16;
         if step > 0 {
+            // The counter goes on: a frame far behind it was a stray one.
+            self.far_behind = None;
             let k = step.unsigned_abs().into();
             let seq = newest.seq.saturating_add(k);
             if self.runs_ahead(seq, rx_ns) {
                 return self.rebase(wire, rx_ns);
             }
             self.window.advance(k);
+            self.lost_runs.add(newest.seq.saturating_add(1), seq);
             self.accept(seq, wire, rx_ns);
             return SeqVerdict::New {
                 seq,
@@ -106,18 +124,41 @@ impl SeqExtender {
             };
         }
         let behind = u64::from(step.unsigned_abs());
-        if behind >= WINDOW || self.silent_beyond_the_window(newest.rx_ns, rx_ns) {
+        if self.silent_beyond_the_window(newest.rx_ns, rx_ns) {
             return self.rebase(wire, rx_ns);
+        }
+        // Checked before the window: a counter restarted right at its edge continues into it.
+        if self
+            .far_behind
+            .is_some_and(|prev| wire == prev.wrapping_add(1))
+        {
+            return self.rebase(wire, rx_ns);
+        }
+        // The frame's own number, when it is one whose loss was counted.
+        let counted = newest
+            .seq
+            .checked_sub(behind)
+            .filter(|&n| n >= self.counted_from);
+        if behind >= WINDOW {
+            if reconnected {
+                return self.rebase(wire, rx_ns);
+            }
+            self.far_behind = Some(wire);
+            let recovered = counted.is_some_and(|n| self.lost_runs.recover(n));
+            return SeqVerdict::Late { recovered };
         }
         if self.window.received(behind) {
             return SeqVerdict::Duplicate;
         }
         self.window.mark(behind);
-        let recovered = newest
-            .seq
-            .checked_sub(behind)
-            .is_some_and(|n| n >= self.counted_from);
-        SeqVerdict::Late { recovered }
+        // Taken out of the runs too, so that a later copy beyond the window is not recovered
+        // again.
+        let recovered = counted.inspect(|&n| {
+            self.lost_runs.recover(n);
+        });
+        SeqVerdict::Late {
+            recovered: recovered.is_some(),
+        }
     }
 
     /// Continues after `last`, the extended number of a frame published earlier by a previous run
@@ -131,6 +172,12 @@ impl SeqExtender {
             resume: Some((last, last_wire)),
             ..Self::default()
         };
+    }
+
+    /// The line was reopened (the device was away): its next frame, if far behind the newest, is
+    /// taken for a restarted counter at once rather than after the frame that continues it.
+    pub fn reconnected(&mut self) {
+        self.reconnected = true;
     }
 
     /// The extended number of the newest frame (before the first, the resume point's).
@@ -179,6 +226,8 @@ impl SeqExtender {
             .map_or(u64::from(wire), |n| n.seq.saturating_add(1));
         self.window = ReceivedWindow::newest_only();
         self.counted_from = seq;
+        self.far_behind = None;
+        self.lost_runs = LostRuns::default();
         self.period.discard_block();
         self.newest = Some(Newest { seq, wire, rx_ns });
         if let Some(p) = self.period.period_ns() {
@@ -345,18 +394,38 @@ mod tests {
     }
 
     #[test]
-    fn far_behind_is_a_jump_backwards() {
+    fn far_behind_and_continued_is_a_jump_backwards() {
         let mut s = SeqExtender::default();
         s.extend(5_000, 0);
+        // Too old to tell: late, until the next frame says more.
         assert_eq!(
             s.extend(5_000 - WINDOW as u16, 0),
+            SeqVerdict::Late { recovered: false }
+        );
+        // Continued: the counter restarted there.
+        assert_eq!(
+            s.extend(5_001 - WINDOW as u16, 0),
             SeqVerdict::New {
                 seq: 5_001,
                 lost: 0,
                 continuity: Continuity::Rebased
             }
         );
-        assert_eq!(s.extend(5_001 - WINDOW as u16, 0), new(5_002, 0));
+        assert_eq!(s.extend(5_002 - WINDOW as u16, 0), new(5_002, 0));
+    }
+
+    #[test]
+    fn far_behind_once_is_a_stray_frame_and_changes_nothing() {
+        let mut s = SeqExtender::default();
+        s.extend(5_000, 0);
+        assert_eq!(s.extend(3_208, 0), SeqVerdict::Late { recovered: false });
+        // The counter goes on from the newest: nothing lost, no jump.
+        assert_eq!(s.extend(5_001, 0), new(5_001, 0));
+        // A stray frame is not a restart just because another stray one precedes it by one,
+        // once the counter went on in between.
+        assert_eq!(s.extend(3_209, 0), SeqVerdict::Late { recovered: false });
+        assert_eq!(s.extend(5_002, 0), new(5_002, 0));
+        assert_eq!(s.extend(3_210, 0), SeqVerdict::Late { recovered: false });
     }
 
     #[test]

@@ -83,11 +83,14 @@ fn seeds() -> Vec<(&'static str, Vec<u8>, usize)> {
         v.extend(stream);
         v
     };
+    // The full IMU frame's number is 4 661 behind the example's and nothing continues it: too far
+    // behind to tell late from a restarted counter, and no next frame says, so it is withheld.
+    // In `seq_far_back`, 100 is withheld until 101 confirms the restart.
     vec![
         ("imu_whole", with_chunks(&[], &encode_one(&imu)), 1),
-        ("all_types_whole", with_chunks(&[], &all), 5),
-        ("all_types_bytewise", with_chunks(&[1], &all), 5),
-        ("all_types_ragged", with_chunks(&[7, 0, 50, 3], &all), 5),
+        ("all_types_whole", with_chunks(&[], &all), 4),
+        ("all_types_bytewise", with_chunks(&[1], &all), 4),
+        ("all_types_ragged", with_chunks(&[7, 0, 50, 3], &all), 4),
         ("bit_flip_then_baro", with_chunks(&[5, 11], &corrupt), 1),
         (
             "fake_sync_in_garbage",
@@ -95,7 +98,7 @@ fn seeds() -> Vec<(&'static str, Vec<u8>, usize)> {
             2,
         ),
         ("time_back_rebased", with_chunks(&[], &time_back), 3),
-        ("seq_far_back_jump", with_chunks(&[16], &seq_far_back), 4),
+        ("seq_far_back_jump", with_chunks(&[16], &seq_far_back), 3),
         ("repeated_and_late", with_chunks(&[], &repeated_and_late), 3),
     ]
 }

@@ -171,7 +171,8 @@ fn a_resumed_decoder_continues_a_previous_run() {
 #[test]
 fn a_decoder_resumed_after_a_jump_and_a_re_based_clock_continues_forward() {
     let mut first = Decoder::new();
-    // A device counter restarted (1104 → 0: a jump) and a clock that stepped back 10 s (a re-base).
+    // A device counter restarted (1104 → 0: a jump, once 1 confirms it) and a clock that stepped
+    // back 10 s (a re-base).
     decode_all(
         &mut first,
         &[
@@ -179,7 +180,10 @@ fn a_decoder_resumed_after_a_jump_and_a_re_based_clock_continues_forward() {
             frame(imu(), 1104, 20_001_000),
         ],
     );
-    decode_all(&mut first, &[frame(imu(), 0, 10_002_000)]);
+    decode_all(
+        &mut first,
+        &[frame(imu(), 0, 10_001_000), frame(imu(), 1, 10_002_000)],
+    );
     let stats = first.stats();
     assert_eq!((stats.seq_jumps, stats.time_rebases), (1, 1));
     let point = first.resume_point();
@@ -187,16 +191,16 @@ fn a_decoder_resumed_after_a_jump_and_a_re_based_clock_continues_forward() {
         point.seq[FrameType::Imu.index()].unwrap(),
         point.time_us.unwrap(),
     );
-    assert_eq!(point.seq_wire[FrameType::Imu.index()], Some(0));
+    assert_eq!(point.seq_wire[FrameType::Imu.index()], Some(1));
     assert_eq!(point.time_wire, Some(10_002_000));
     assert_ne!(
-        seq as u16, 0,
+        seq as u16, 1,
         "the low bits are not the wire number any more"
     );
     let mut second = Decoder::new();
     second.resume_from(&point).unwrap();
     // Five frames and 5 ms later.
-    let out = decode_all(&mut second, &[frame(imu(), 5, 10_007_000)]);
+    let out = decode_all(&mut second, &[frame(imu(), 6, 10_007_000)]);
     assert_eq!((out[0].seq, out[0].device_time_us), (seq + 5, time + 5_000));
     assert_eq!(second.stats().resume_rejected, 0);
 }

@@ -86,20 +86,15 @@ pub enum RecordError {
 }
 
 /// An error that stops reading a recording. Damage that only costs some messages (a wrong length,
-/// a cut-off end) is reported in the [`crate::Recording`] instead.
+/// a damaged chunk, a cut-off end) is reported in the [`crate::Recording`] instead.
 #[derive(Debug, thiserror::Error)]
 pub enum ReadError {
-    /// The file could not be read.
-    #[error("{path}: {source}")]
-    Io {
-        /// The recording's path.
-        path: PathBuf,
-        /// The underlying error.
-        #[source]
-        source: std::io::Error,
-    },
+    /// The file could not be opened or read, or is no regular file, or is too large; the error
+    /// names the path.
+    #[error(transparent)]
+    File(#[from] rins_regular_file::FileError),
     /// The bytes are not an MCAP file (no magic at the start).
-    #[error("{origin}: not an MCAP recording: {source}")]
+    #[error("{origin}: not an MCAP recording")]
     NotMcap {
         /// The recording's path, or what the bytes are.
         origin: String,

@@ -12,7 +12,9 @@
 //! - [`Recorder`]: the MCAP writer; [`spawn_writer`] puts it behind a queue that never blocks the
 //!   threads taking samples in, and counts what it drops;
 //! - [`read_file`] / [`Messages`]: reading back, refusing channels of another payload version,
-//!   skipping (and counting) damaged messages, and keeping what a cut-off file still holds.
+//!   skipping (and counting) damaged messages and chunks, and keeping what a cut-off file still
+//!   holds; a recording path must be a regular file of at most [`MAX_RECORDING_BYTES`], and no
+//!   length the file declares is allocated before it is checked.
 //!
 //! Each channel's metadata names the payload type (`type_name`, e.g. `rins::NavState`), its
 //! layout version (`payload_version`, [`ipc_types::PAYLOAD_VERSION`]) and size, so that a reader
@@ -21,6 +23,7 @@
 pub mod cdr;
 mod error;
 mod reader;
+mod scan;
 pub mod schema;
 mod threaded;
 mod topics;
@@ -29,9 +32,10 @@ mod writer;
 pub use cdr::Recordable;
 pub use error::{DecodeError, ReadError, RecordError};
 pub use reader::{
-    MAX_SKIP_DETAILS, Messages, RecordedMessage, Recording, SkipReason, Skipped, decode,
-    read_bytes, read_file,
+    DamagedChunk, MAX_SKIP_DETAILS, Messages, RecordedMessage, Recording, SkipReason, Skipped,
+    decode, read_bytes, read_file, read_file_bytes,
 };
+pub use scan::{MAX_CHUNK_BYTES, MAX_RECORDING_BYTES};
 pub use schema::{MAX_PAYLOAD, StructLayout};
 pub use threaded::{
     Dropped, RecordReceiver, RecordSender, join_writer, record_channel, spawn_writer,

@@ -4,21 +4,31 @@
 //! A channel recorded with another payload version or an unknown payload type stops the reading
 //! with an error naming the topic: its bytes would be misread. Damage that only costs some
 //! messages does not: a message of the wrong length (or without the CDR header, or with another
-//! version in its `version` field) is skipped and counted with the reason, and a file that ends
-//! early (the recorder was killed before it finished the file) yields every message of its
-//! complete chunks, then reports where reading stopped in [`Messages::damage`]. The messages of
-//! the chunk being written when the recorder died are lost: a chunk is only readable whole.
+//! version in its `version` field, or of a channel never defined) is skipped and counted with the
+//! reason; a damaged chunk (its CRC does not match, it does not decompress, it declares more than
+//! [`crate::MAX_CHUNK_BYTES`]) is skipped whole and counted, and reading goes on with the next
+//! one; a file that ends early (the recorder was killed before it finished the file) yields every
+//! message of its complete chunks, then reports where reading stopped in [`Messages::damage`].
+//! The messages of the chunk being written when the recorder died are lost: a chunk is only
+//! readable whole.
 //!
-//! Reading is sequential (`mcap::MessageStream`): it does not need the summary section at the end
-//! of the file, which a killed recorder never wrote.
+//! Reading is sequential: it does not need the summary section at the end of the file, which a
+//! killed recorder never wrote (when it is there, its channel definitions stand in for those of a
+//! damaged chunk). The file is taken apart by [`crate::scan`], which allocates nothing from a
+//! length the file declares before checking it.
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::collections::hash_map::Entry;
 use std::path::Path;
 use std::sync::Arc;
 
+use mcap::read::ChannelAccumulator;
+use mcap::records::{MessageHeader, Record, op};
+
 use crate::cdr::{self, Recordable};
 use crate::error::{DecodeError, ReadError};
+use crate::scan::{self, Framing, MAX_RECORDING_BYTES};
 use crate::schema::{self, StructLayout};
 use crate::writer::{MESSAGE_ENCODING, META_PAYLOAD_VERSION, META_TYPE_NAME};
 
@@ -84,12 +94,17 @@ pub enum SkipReason {
         /// The version found.
         found: u16,
     },
+    /// Its channel was never defined (its definition was in a damaged chunk, say).
+    UnknownChannel {
+        /// The channel id the message names.
+        channel: u16,
+    },
 }
 
 /// A message that was skipped, and why.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Skipped {
-    /// Its topic.
+    /// Its topic (`channel N` for a channel never defined).
     pub topic: String,
     /// Its log time, ns.
     pub log_time_ns: u64,
@@ -106,18 +121,37 @@ pub struct Recording {
     pub skipped_count: u64,
     /// The first [`MAX_SKIP_DETAILS`] skipped messages.
     pub skipped: Vec<Skipped>,
+    /// Chunks skipped as damaged (see [`Messages::damaged_chunk_count`]).
+    pub damaged_chunk_count: u64,
+    /// The first [`MAX_SKIP_DETAILS`] damaged chunks.
+    pub damaged_chunks: Vec<DamagedChunk>,
     /// Where reading stopped early and why (a cut-off file), `None` for a complete file.
     pub damage: Option<String>,
 }
 
+/// A chunk (or a record outside any chunk) skipped as damaged.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DamagedChunk {
+    /// Where it starts in the file, bytes.
+    pub offset: u64,
+    /// What is wrong with it.
+    pub reason: String,
+}
+
+/// The bytes of the recording file at `path`: a regular file (never a FIFO, a device or a
+/// directory, which are refused at once) of at most [`MAX_RECORDING_BYTES`].
+pub fn read_file_bytes(path: impl AsRef<Path>) -> Result<Vec<u8>, ReadError> {
+    Ok(rins_regular_file::read_bounded(
+        path.as_ref(),
+        MAX_RECORDING_BYTES,
+    )?)
+}
+
 /// Reads the recording at `path` whole (see the module documentation for what is refused and
-/// what is skipped).
+/// what is skipped, and [`read_file_bytes`] for what the path must be).
 pub fn read_file(path: impl AsRef<Path>) -> Result<Recording, ReadError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = read_file_bytes(path)?;
     read_bytes(&bytes, &path.display().to_string())
 }
 
@@ -132,6 +166,8 @@ pub fn read_bytes(bytes: &[u8], origin: &str) -> Result<Recording, ReadError> {
         messages: out,
         skipped_count: messages.skipped_count,
         skipped: messages.skipped,
+        damaged_chunk_count: messages.damaged_chunk_count,
+        damaged_chunks: messages.damaged_chunks,
         damage: messages.damage,
     })
 }
@@ -145,18 +181,46 @@ struct ChannelInfo {
 /// The messages of a recording, one at a time, in file order: for a recording too large to
 /// hold decoded in memory. Ends at the first error (`Some(Err)`, then `None`).
 pub struct Messages<'a> {
-    stream: mcap::MessageStream<'a>,
+    bytes: &'a [u8],
+    /// Where the next record outside a chunk starts.
+    pos: usize,
+    /// The chunk being read, if any.
+    chunk: Option<ChunkCursor<'a>>,
+    /// Schemas and channels as defined so far.
+    defined: ChannelAccumulator<'static>,
+    /// Channels checked against this build, by id.
     channels: HashMap<u16, ChannelInfo>,
     skipped_count: u64,
     skipped: Vec<Skipped>,
+    damaged_chunk_count: u64,
+    damaged_chunks: Vec<DamagedChunk>,
     damage: Option<String>,
     done: bool,
+}
+
+/// The records of one chunk, and how far they have been read.
+struct ChunkCursor<'a> {
+    records: Cow<'a, [u8]>,
+    pos: usize,
+    /// Where the chunk starts in the file.
+    offset: usize,
+}
+
+/// What one record brought.
+enum Outcome {
+    /// Nothing to hand out (a schema, a channel, an index, a skipped message).
+    Nothing,
+    /// A message, or the error that ends the reading.
+    Item(Result<RecordedMessage, ReadError>),
+    /// The record is damaged; so is the chunk holding it.
+    Damaged(String),
 }
 
 impl std::fmt::Debug for Messages<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Messages")
             .field("skipped_count", &self.skipped_count)
+            .field("damaged_chunk_count", &self.damaged_chunk_count)
             .field("damage", &self.damage)
             .finish_non_exhaustive()
     }
@@ -165,26 +229,67 @@ impl std::fmt::Debug for Messages<'_> {
 impl<'a> Messages<'a> {
     /// Starts reading the recording in `bytes`; `origin` names it in errors.
     pub fn new(bytes: &'a [u8], origin: &str) -> Result<Self, ReadError> {
-        // The stream would only notice at its first record; a file that is not MCAP at all is an
-        // error, not a damaged recording.
+        // A file that is not MCAP at all is an error, not a damaged recording.
         if !bytes.starts_with(mcap::MAGIC) {
             return Err(ReadError::NotMcap {
                 origin: origin.to_string(),
                 source: mcap::McapError::BadMagic,
             });
         }
-        let stream = mcap::MessageStream::new(bytes).map_err(|source| ReadError::NotMcap {
-            origin: origin.to_string(),
-            source,
-        })?;
-        Ok(Self {
-            stream,
+        let mut messages = Self {
+            bytes,
+            pos: mcap::MAGIC.len(),
+            chunk: None,
+            defined: ChannelAccumulator::default(),
             channels: HashMap::new(),
             skipped_count: 0,
             skipped: Vec::new(),
+            damaged_chunk_count: 0,
+            damaged_chunks: Vec::new(),
             damage: None,
             done: false,
-        })
+        };
+        messages.define_from_summary();
+        Ok(messages)
+    }
+
+    /// Takes in the schemas and channels the summary section repeats, when the file has one: the
+    /// writer defines a channel once, in the chunk of its first message, and when that chunk is
+    /// damaged the messages of every later chunk would otherwise have no channel. A damaged
+    /// summary only costs this help.
+    fn define_from_summary(&mut self) {
+        // The footer record (opcode, length 20, summary start, summary offset start, CRC), then
+        // the closing magic.
+        const FOOTER_RECORD: usize = 1 + 8 + 20;
+        let bytes = self.bytes;
+        let Some(footer_at) = bytes.len().checked_sub(mcap::MAGIC.len() + FOOTER_RECORD) else {
+            return;
+        };
+        if !bytes.ends_with(mcap::MAGIC) {
+            return;
+        }
+        let Framing::Record { opcode, body } = scan::frame(bytes, footer_at) else {
+            return;
+        };
+        let Some(start) = bytes[body.clone()].first_chunk::<8>() else {
+            return;
+        };
+        let start = u64::from_le_bytes(*start);
+        // Zero: no summary; otherwise it lies between the data section and the footer.
+        let Ok(mut pos) = usize::try_from(start) else {
+            return;
+        };
+        if opcode != op::FOOTER || body.len() != 20 || pos == 0 || pos >= footer_at {
+            return;
+        }
+        let summary = &bytes[..footer_at];
+        while let Framing::Record { opcode, body } = scan::frame(summary, pos) {
+            pos = body.end;
+            if matches!(opcode, op::SCHEMA | op::CHANNEL) {
+                // Definitions only: nothing to hand out, and a damaged one is no loss.
+                let _ = self.record(opcode, &summary[body]);
+            }
+        }
     }
 
     /// Messages skipped so far.
@@ -195,6 +300,19 @@ impl<'a> Messages<'a> {
     /// The first [`MAX_SKIP_DETAILS`] messages skipped so far.
     pub fn skipped(&self) -> &[Skipped] {
         &self.skipped
+    }
+
+    /// Chunks skipped so far as damaged: a CRC that does not match, data that does not
+    /// decompress, a declared size beyond [`crate::MAX_CHUNK_BYTES`], a record that overruns the
+    /// chunk or the file. Their messages are lost (and not counted in [`Self::skipped_count`]: a
+    /// damaged chunk does not say how many it held).
+    pub fn damaged_chunk_count(&self) -> u64 {
+        self.damaged_chunk_count
+    }
+
+    /// The first [`MAX_SKIP_DETAILS`] chunks skipped so far as damaged.
+    pub fn damaged_chunks(&self) -> &[DamagedChunk] {
+        &self.damaged_chunks
     }
 
     /// Where reading stopped early and why, once it has.
@@ -210,6 +328,174 @@ impl<'a> Messages<'a> {
                 log_time_ns,
                 reason,
             });
+        }
+    }
+
+    fn damaged(&mut self, offset: usize, reason: String) {
+        self.damaged_chunk_count += 1;
+        if self.damaged_chunks.len() < MAX_SKIP_DETAILS {
+            self.damaged_chunks.push(DamagedChunk {
+                offset: offset as u64,
+                reason,
+            });
+        }
+    }
+
+    /// Takes in one record (of a chunk, or outside any).
+    fn record(&mut self, opcode: u8, body: &[u8]) -> Outcome {
+        if !scan::lengths_fit(opcode, body) {
+            return Outcome::Damaged(format!("a record (opcode {opcode:#04x}) overruns itself"));
+        }
+        let parsed = match opcode {
+            op::SCHEMA | op::CHANNEL | op::MESSAGE => mcap::parse_record(opcode, body),
+            // Indexes, attachments, metadata, statistics: nothing a reader of payloads needs.
+            _ => return Outcome::Nothing,
+        };
+        let defined = match parsed {
+            Ok(Record::Schema { header, data }) => {
+                self.defined.add_schema_from_slice(header, &data)
+            }
+            Ok(Record::Channel(channel)) => self.defined.add_channel(channel),
+            Ok(Record::Message { header, data }) => return self.message(header, &data),
+            Ok(_) => Ok(()),
+            Err(e) => Err(e),
+        };
+        match defined {
+            Ok(()) => Outcome::Nothing,
+            Err(e) => Outcome::Damaged(e.to_string()),
+        }
+    }
+
+    /// Checks one message.
+    fn message(&mut self, header: MessageHeader, data: &[u8]) -> Outcome {
+        let channel_id = header.channel_id;
+        let info = match self.channels.entry(channel_id) {
+            Entry::Occupied(entry) => entry.into_mut(),
+            Entry::Vacant(entry) => {
+                let Some(channel) = self.defined.get(channel_id) else {
+                    let topic = format!("channel {channel_id}");
+                    let reason = SkipReason::UnknownChannel {
+                        channel: channel_id,
+                    };
+                    self.skip(&topic, header.log_time, reason);
+                    return Outcome::Nothing;
+                };
+                match check_channel(&channel) {
+                    Ok(info) => entry.insert(info),
+                    Err(e) => return Outcome::Item(Err(e)),
+                }
+            }
+        };
+        let (topic, layout) = (Arc::clone(&info.topic), info.layout);
+        let expected = cdr::CDR_LE_HEADER.len() + layout.size;
+        if data.len() != expected {
+            let reason = SkipReason::WrongLength {
+                expected,
+                found: data.len(),
+            };
+            self.skip(&topic, header.log_time, reason);
+            return Outcome::Nothing;
+        }
+        let Some(payload) = cdr::payload_of(data) else {
+            self.skip(&topic, header.log_time, SkipReason::NotCdr);
+            return Outcome::Nothing;
+        };
+        // Every payload starts with its `version` (u16); a reader of a single message checks
+        // it as the processes do.
+        let version = payload.first_chunk::<2>().map(|v| u16::from_le_bytes(*v));
+        if let Some(version) = version.filter(|v| *v != ipc_types::PAYLOAD_VERSION) {
+            let reason = SkipReason::WrongVersion { found: version };
+            self.skip(&topic, header.log_time, reason);
+            return Outcome::Nothing;
+        }
+        Outcome::Item(Ok(RecordedMessage {
+            topic,
+            layout,
+            log_time_ns: header.log_time,
+            publish_time_ns: header.publish_time,
+            sequence: header.sequence,
+            payload: payload.to_vec(),
+        }))
+    }
+
+    /// The next record of the chunk being read, taken in; `None` when no chunk is being read.
+    fn next_in_chunk(&mut self) -> Option<Outcome> {
+        let mut chunk = self.chunk.take()?;
+        match scan::frame(&chunk.records, chunk.pos) {
+            Framing::End => Some(Outcome::Nothing),
+            Framing::Overrun(why) => {
+                self.damaged(chunk.offset, why);
+                Some(Outcome::Nothing)
+            }
+            Framing::Record { opcode, body } => {
+                chunk.pos = body.end;
+                let outcome = self.record(opcode, &chunk.records[body]);
+                match &outcome {
+                    Outcome::Damaged(why) => self.damaged(chunk.offset, why.clone()),
+                    Outcome::Item(Err(_)) => {}
+                    Outcome::Nothing | Outcome::Item(Ok(_)) => self.chunk = Some(chunk),
+                }
+                Some(outcome)
+            }
+        }
+    }
+
+    /// The next record outside any chunk, taken in (a chunk's records are then read from
+    /// [`Self::chunk`]).
+    fn next_in_file(&mut self) -> Outcome {
+        let bytes = self.bytes;
+        let at = self.pos;
+        match scan::frame(bytes, at) {
+            Framing::End => {
+                self.damage = Some(format!(
+                    "the file ends at byte {at} without its data end record: the recording was \
+                     not finished"
+                ));
+                self.done = true;
+                Outcome::Nothing
+            }
+            Framing::Overrun(why) => {
+                // Either the last record is cut off, or a damaged length lost the framing: then
+                // reading resumes at the next chunk.
+                match scan::find_chunk(bytes, at + 1) {
+                    Some(next) => {
+                        self.damaged(at, why);
+                        self.pos = next;
+                    }
+                    None => {
+                        self.damage = Some(format!("the file is cut off at byte {at}: {why}"));
+                        self.done = true;
+                    }
+                }
+                Outcome::Nothing
+            }
+            Framing::Record { opcode, body } => {
+                self.pos = body.end;
+                match opcode {
+                    op::CHUNK => match scan::chunk_records(&bytes[body]) {
+                        Ok(records) => {
+                            self.chunk = Some(ChunkCursor {
+                                records,
+                                pos: 0,
+                                offset: at,
+                            });
+                        }
+                        Err(why) => self.damaged(at, why),
+                    },
+                    // The data section ends here (a data end record has a 4-byte CRC): the
+                    // summary after it repeats what was read.
+                    op::DATA_END if body.len() == 4 => self.done = true,
+                    _ => {
+                        let outcome = self.record(opcode, &bytes[body]);
+                        if let Outcome::Damaged(why) = outcome {
+                            self.damaged(at, why);
+                            return Outcome::Nothing;
+                        }
+                        return outcome;
+                    }
+                }
+                Outcome::Nothing
+            }
         }
     }
 }
@@ -249,63 +535,21 @@ impl Iterator for Messages<'_> {
     type Item = Result<RecordedMessage, ReadError>;
 
     fn next(&mut self) -> Option<Self::Item> {
-        while !self.done {
-            let message = match self.stream.next() {
-                None => {
+        loop {
+            let outcome = match self.next_in_chunk() {
+                Some(outcome) => outcome,
+                None if self.done => return None,
+                None => self.next_in_file(),
+            };
+            match outcome {
+                Outcome::Item(Ok(message)) => return Some(Ok(message)),
+                Outcome::Item(Err(e)) => {
                     self.done = true;
-                    return None;
+                    self.chunk = None;
+                    return Some(Err(e));
                 }
-                Some(Err(e)) => {
-                    // Past the start magic, any error is damage: keep what was read.
-                    self.damage = Some(e.to_string());
-                    self.done = true;
-                    return None;
-                }
-                Some(Ok(message)) => message,
-            };
-            let channel_id = message.channel.id;
-            let info = match self.channels.entry(channel_id) {
-                Entry::Occupied(entry) => entry.into_mut(),
-                Entry::Vacant(entry) => match check_channel(&message.channel) {
-                    Ok(info) => entry.insert(info),
-                    Err(e) => {
-                        self.done = true;
-                        return Some(Err(e));
-                    }
-                },
-            };
-            let (topic, layout) = (Arc::clone(&info.topic), info.layout);
-            let data = message.data;
-            let expected = cdr::CDR_LE_HEADER.len() + layout.size;
-            if data.len() != expected {
-                let reason = SkipReason::WrongLength {
-                    expected,
-                    found: data.len(),
-                };
-                self.skip(&topic, message.log_time, reason);
-                continue;
+                Outcome::Nothing | Outcome::Damaged(_) => {}
             }
-            let Some(payload) = cdr::payload_of(&data) else {
-                self.skip(&topic, message.log_time, SkipReason::NotCdr);
-                continue;
-            };
-            // Every payload starts with its `version` (u16); a reader of a single message checks
-            // it as the processes do.
-            let version = payload.first_chunk::<2>().map(|v| u16::from_le_bytes(*v));
-            if let Some(version) = version.filter(|v| *v != ipc_types::PAYLOAD_VERSION) {
-                let reason = SkipReason::WrongVersion { found: version };
-                self.skip(&topic, message.log_time, reason);
-                continue;
-            }
-            return Some(Ok(RecordedMessage {
-                topic,
-                layout,
-                log_time_ns: message.log_time,
-                publish_time_ns: message.publish_time,
-                sequence: message.sequence,
-                payload: payload.to_vec(),
-            }));
         }
-        None
     }
 }

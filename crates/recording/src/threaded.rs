@@ -5,9 +5,13 @@
 //! sample to a bounded queue and go on; when the queue is full the sample is dropped and counted,
 //! and the summary says how many. A sample travels by value in a fixed inline buffer (the queue's
 //! slots are allocated once, when it is made), so sending allocates nothing.
+//!
+//! A writer thread that stops on an error (a full disk) says so to the senders at once
+//! ([`RecordSender::writer_failed`]), so that the recording is not carried on in vain and its end
+//! can report what was not recorded.
 
 use std::sync::Arc;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::thread::JoinHandle;
 
 use crossbeam_channel::{Receiver, Sender, TrySendError};
@@ -51,6 +55,16 @@ pub enum Dropped {
 pub struct RecordSender {
     tx: Sender<Sample>,
     slots: Arc<[Slot]>,
+    state: Arc<WriterState>,
+}
+
+/// What the writer thread tells the senders while it runs.
+#[derive(Default)]
+struct WriterState {
+    /// Samples written so far.
+    written: AtomicU64,
+    /// Set when the writer stopped on an error: nothing sent from then on is written.
+    failed: AtomicBool,
 }
 
 /// What the senders know of one channel: its payload size, and its drops.
@@ -124,6 +138,17 @@ impl RecordSender {
             .map(|s| s.dropped.load(Ordering::Relaxed))
             .sum()
     }
+
+    /// Samples the writer thread has written so far, all topics.
+    pub fn written_total(&self) -> u64 {
+        self.state.written.load(Ordering::Relaxed)
+    }
+
+    /// Whether the writer thread stopped on an error (its join handle has it): what is sent from
+    /// then on is dropped, and the file is incomplete.
+    pub fn writer_failed(&self) -> bool {
+        self.state.failed.load(Ordering::Acquire)
+    }
 }
 
 /// The writing side of [`record_channel`]: [`RecordReceiver::run`] writes what arrives until
@@ -131,6 +156,7 @@ impl RecordSender {
 pub struct RecordReceiver {
     rx: Receiver<Sample>,
     slots: Arc<[Slot]>,
+    state: Arc<WriterState>,
     recorder: Recorder,
 }
 
@@ -144,8 +170,18 @@ impl std::fmt::Debug for RecordReceiver {
 
 impl RecordReceiver {
     /// Writes every sample that arrives until all senders are dropped, then finishes the file.
-    /// Stops at the first write error (the senders then count their samples as dropped).
-    pub fn run(mut self) -> Result<RecordSummary, RecordError> {
+    /// Stops at the first write error (the senders then count their samples as dropped) and
+    /// flags it to them ([`RecordSender::writer_failed`]).
+    pub fn run(self) -> Result<RecordSummary, RecordError> {
+        let state = Arc::clone(&self.state);
+        let result = self.write_all();
+        if result.is_err() {
+            state.failed.store(true, Ordering::Release);
+        }
+        result
+    }
+
+    fn write_all(mut self) -> Result<RecordSummary, RecordError> {
         for sample in self.rx.iter() {
             self.recorder.write(
                 sample.channel,
@@ -153,6 +189,9 @@ impl RecordReceiver {
                 sample.publish_time_ns,
                 &sample.bytes[..usize::from(sample.len)],
             )?;
+            self.state
+                .written
+                .store(self.recorder.samples_written(), Ordering::Relaxed);
         }
         let mut summary = self.recorder.finish()?;
         // Every sender is gone, so the counts are final.
@@ -175,13 +214,16 @@ pub fn record_channel(recorder: Recorder, capacity: usize) -> (RecordSender, Rec
             dropped: AtomicU64::new(0),
         })
         .collect();
+    let state = Arc::new(WriterState::default());
     let sender = RecordSender {
         tx,
         slots: Arc::clone(&slots),
+        state: Arc::clone(&state),
     };
     let receiver = RecordReceiver {
         rx,
         slots,
+        state,
         recorder,
     };
     (sender, receiver)

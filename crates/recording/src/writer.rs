@@ -32,7 +32,8 @@ pub struct RecordOptions {
     /// The MCAP profile; `ros2`, the profile of ROS 2 message schemas with CDR messages.
     pub profile: String,
     /// Target uncompressed size of a chunk, bytes. A writer killed mid-chunk loses that chunk, so
-    /// smaller chunks lose less at some cost in compression.
+    /// smaller chunks lose less at some cost in compression. At most half of
+    /// [`crate::MAX_CHUNK_BYTES`] is used, so that every chunk written can be read back.
     pub chunk_size: u64,
 }
 
@@ -119,11 +120,24 @@ impl Recorder {
     pub fn create(path: impl AsRef<Path>, options: &RecordOptions) -> Result<Self, RecordError> {
         let path = path.as_ref().to_path_buf();
         let file = create_file(&path, options.overwrite)?;
+        Self::on_file(file, path, options)
+    }
+
+    /// A recording written into `file`, already open for writing, and named `path` in errors and
+    /// the summary (`options.overwrite` does not apply: the file is whatever was opened).
+    pub fn on_file(
+        file: File,
+        path: impl Into<PathBuf>,
+        options: &RecordOptions,
+    ) -> Result<Self, RecordError> {
+        let path = path.into();
         let writer = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
             // Compress in the writing thread: the pipeline's processes need the other cores.
             .compression_threads(0)
-            .chunk_size(Some(options.chunk_size))
+            // A chunk ends once it holds the target size, so it can exceed it by one message and
+            // the definitions written with it: half the reader's ceiling leaves ample room.
+            .chunk_size(Some(options.chunk_size.min(crate::MAX_CHUNK_BYTES / 2)))
             .profile(options.profile.clone())
             .library(concat!("rins-recording ", env!("CARGO_PKG_VERSION")))
             .create(BufWriter::new(file))

@@ -1,13 +1,12 @@
 //! Reading a small text file given on the command line (`--config`, `--faults`) without trusting
 //! what is at the path: a FIFO would block the open or the read for ever, a device such as
-//! /dev/zero would be read until memory runs out, a directory is no file at all. The path is opened
-//! non-blocking, the open descriptor is inspected, and at most one byte more than the limit is read.
+//! /dev/zero would be read until memory runs out, a directory is no file at all. The checks are
+//! [`rins_regular_file`]'s, which recordings get too.
 
-use std::io::Read;
-use std::os::unix::fs::OpenOptionsExt;
 use std::path::Path;
 
-use anyhow::{Result, anyhow, bail};
+use anyhow::{Result, anyhow};
+use rins_regular_file::FileError;
 
 /// Largest file [`read_text`] accepts by default: far above any configuration rins has, far below
 /// anything that strains memory.
@@ -17,36 +16,16 @@ pub const DEFAULT_LIMIT: u64 = 1 << 20;
 /// (e.g. "configuration file"), which also name the path and what was found there.
 pub fn read_text(path: &Path, what: &str, limit: u64) -> Result<String> {
     let shown = path.display();
-    // O_NONBLOCK: opening a FIFO for reading does not wait for a writer; O_NOCTTY: a terminal never
-    // becomes our controlling terminal. Neither changes anything for a regular file.
-    let file = std::fs::OpenOptions::new()
-        .read(true)
-        .custom_flags(libc::O_NONBLOCK | libc::O_NOCTTY)
-        .open(path)
-        .map_err(|e| anyhow!("cannot read {what} {shown}: {e}"))?;
-    let meta = file
-        .metadata()
-        .map_err(|e| anyhow!("cannot inspect {what} {shown}: {e}"))?;
-    if !meta.file_type().is_file() {
-        bail!(
-            "{what} {shown} is a {}, not a regular file",
-            crate::private_dir::kind_of(&meta)
-        );
-    }
-    if meta.len() > limit {
-        bail!(
-            "{what} {shown} has {} bytes, more than the {limit} allowed",
-            meta.len()
-        );
-    }
-    // The size can change after the check (a file still being written): the read is bounded too.
-    let mut bytes = Vec::new();
-    file.take(limit + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| anyhow!("cannot read {what} {shown}: {e}"))?;
-    if bytes.len() as u64 > limit {
-        bail!("{what} {shown} has more than the {limit} bytes allowed");
-    }
+    let bytes = rins_regular_file::read_bounded(path, limit).map_err(|e| match e {
+        FileError::Open { source, .. } | FileError::Read { source, .. } => {
+            anyhow!("cannot read {what} {shown}: {source}")
+        }
+        FileError::Inspect { source, .. } => anyhow!("cannot inspect {what} {shown}: {source}"),
+        // These name the path themselves.
+        other @ (FileError::NotRegular { .. }
+        | FileError::TooLarge { .. }
+        | FileError::Grew { .. }) => anyhow!("{what} {other}"),
+    })?;
     String::from_utf8(bytes).map_err(|e| anyhow!("{what} {shown} is not UTF-8 text: {e}"))
 }
 

@@ -19,6 +19,7 @@ pub mod realtime;
 pub mod root_lock;
 pub mod service;
 pub mod service_loop;
+pub mod setup_guard;
 pub mod shm_cleanup;
 pub mod shutdown;
 pub mod stage_io;

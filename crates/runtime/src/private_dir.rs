@@ -7,7 +7,7 @@
 
 use std::fmt;
 use std::fs::Metadata;
-use std::os::unix::fs::{DirBuilderExt, FileTypeExt, MetadataExt};
+use std::os::unix::fs::{DirBuilderExt, MetadataExt};
 use std::path::{Path, PathBuf};
 
 use crate::user;
@@ -15,27 +15,7 @@ use crate::user;
 /// Permission bits a private directory must not have: any access by group or others.
 const GROUP_OTHER_BITS: u32 = 0o077;
 
-/// What a file system entry is, in words for messages.
-pub fn kind_of(meta: &Metadata) -> &'static str {
-    let t = meta.file_type();
-    if t.is_symlink() {
-        "symbolic link"
-    } else if t.is_dir() {
-        "directory"
-    } else if t.is_file() {
-        "regular file"
-    } else if t.is_fifo() {
-        "FIFO"
-    } else if t.is_socket() {
-        "socket"
-    } else if t.is_char_device() {
-        "character device"
-    } else if t.is_block_device() {
-        "block device"
-    } else {
-        "special file"
-    }
-}
+pub use rins_regular_file::kind_of;
 
 /// A path that is not a private directory of the expected user, with what was found there.
 #[derive(Debug, Clone, PartialEq, Eq)]

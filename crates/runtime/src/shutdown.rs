@@ -2,8 +2,12 @@
 //! and SIGUSR2, whose default action would end the process on the spot, leaving its children
 //! running and its shared memory behind; rins has no other use for them, so they stop it cleanly.
 
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, OnceLock};
+
+/// The flag of the handlers [`Shutdown::install`] installed, for code that cannot be handed it
+/// (a guard on a tool's set-up).
+static INSTALLED: OnceLock<Shutdown> = OnceLock::new();
 
 /// The signals that request a clean stop.
 pub const STOP_SIGNALS: [i32; 5] = [
@@ -25,7 +29,15 @@ impl Shutdown {
         for signal in STOP_SIGNALS {
             signal_hook::flag::register(signal, Arc::clone(&flag))?;
         }
-        Ok(Self(flag))
+        let shutdown = Self(flag);
+        let _ = INSTALLED.set(shutdown.clone());
+        Ok(shutdown)
+    }
+
+    /// The flag of the first [`Shutdown::install`] of this process; `None` when no handler was
+    /// installed (a stop signal then ends the process by its default action).
+    pub fn installed() -> Option<Self> {
+        INSTALLED.get().cloned()
     }
 
     /// A flag no signal sets, for in-process use and tests.

@@ -17,7 +17,13 @@ use anyhow::Result;
 
 use crate::ipc::{IpcNode, IpcSettings, create_node, for_each_live_node, own_ports};
 use crate::root_lock::RootLock;
+use crate::setup_guard::SetupGuard;
 use crate::{join_check, private_dir, shm_cleanup, user};
+
+/// Longest a tool's node creation may take. It is quick (milliseconds; up to a second while another
+/// process sets the deployment's management segment up); a damaged file of the deployment could
+/// make iceoryx2 wait for ever.
+pub const JOIN_LIMIT: std::time::Duration = std::time::Duration::from_secs(10);
 
 /// A tool's node on the deployment of the environment's prefix and root (see
 /// [`join_check::settings_to_join`]); cleans up after itself when dropped. Create every port from
@@ -42,9 +48,19 @@ impl ToolNode {
         let lock = own_deployment(&settings)
             .then(|| RootLock::shared(&settings))
             .transpose();
+        // Bounded whatever the deployment's files hold, and stopped by a stop signal.
+        let guard = SetupGuard::arm(
+            format!(
+                "{tool}: joining the deployment on prefix {:?}",
+                settings.prefix
+            ),
+            Some(JOIN_LIMIT),
+            None,
+        );
         let node = lock.and_then(|lock| {
             create_node(&format!("{tool}-{}", std::process::id()), &settings).map(|n| (n, lock))
         });
+        guard.disarm();
         // Made before the error is returned: a failed creation may have left the root and the
         // domain's segment, and dropping the clean-up removes them.
         let cleanup = Cleanup {

@@ -9,7 +9,7 @@
 //! - [`rest_bias`]: per-channel gyro biases from a start-up window at rest.
 //! - [`config`]: the `[fusion]` table and its checks.
 //! - [`fuser`]: the gyro and accelerometer sides together, with their fault monitors.
-//! - [`readmit_probation`]: the answer to a re-admission, once the channel stayed clean.
+//! - [`readmit_probation`]: the answer to a re-admission, once its probation has a verdict.
 
 pub mod calibration;
 pub mod capability;

@@ -1,7 +1,12 @@
-//! The answer to a re-admission request. A re-admitted channel whose fault is still there is
-//! excluded again within a few samples; answering "accepted" at once would tell the operator the
-//! opposite of what happened. So a re-admitted channel is on probation for a configured number of
-//! fused samples: excluded again within it, the answer is `fault-still-present` with the reason;
+//! The answer to a re-admission request. Answering "accepted" at once would tell the operator the
+//! opposite of what happened when the fault is still there, so the answer waits for the verdict.
+//!
+//! A re-admitted channel is normally tested by its monitor while it stays out of the solution (see
+//! [`crate::fdi::probation`]): while the monitor says it is on probation the request waits; when
+//! the test ends, the channel is either back in the solution (`readmitted`) or still excluded,
+//! now with the reason of the test it failed (`fault-still-present` with that reason). A channel
+//! the monitor returned at once (the others had no solution to test it against) is watched for a
+//! configured number of fused samples instead: excluded again within them, `fault-still-present`;
 //! in service throughout, `readmitted`. Requests that cannot be carried out are answered at once.
 //!
 //! Pure bookkeeping on fixed arrays: the per-sample check costs one comparison while nothing is on
@@ -34,6 +39,8 @@ struct OnProbation {
     request: FusionControl,
     sensor: SensorType,
     remaining: u32,
+    /// The monitor tested the channel out of the solution on an earlier sample.
+    tested: bool,
 }
 
 /// Re-admissions on probation and answers not yet published.
@@ -82,6 +89,7 @@ impl ReadmitProbation {
                     request: *request,
                     sensor,
                     remaining: self.samples,
+                    tested: false,
                 });
                 self.on_probation += 1;
             }
@@ -94,8 +102,9 @@ impl ReadmitProbation {
         }
     }
 
-    /// Follows every channel on probation through one fused sample.
-    pub fn on_fused(&mut self, fused: &FusedImu) {
+    /// Follows every channel on probation through one fused sample. `testing(sensor, channel)`:
+    /// the monitor still tests the channel out of the solution (no verdict yet).
+    pub fn on_fused(&mut self, fused: &FusedImu, testing: impl Fn(SensorType, usize) -> bool) {
         if self.on_probation == 0 {
             return;
         }
@@ -108,6 +117,11 @@ impl ReadmitProbation {
                 SensorType::Accel => (&fused.accel_state, &fused.accel_reason),
             };
             let channel = usize::from(p.request.channel);
+            if testing(p.sensor, channel) {
+                p.tested = true;
+                self.pending[i] = Some(p);
+                continue;
+            }
             let excluded = states.get(channel).copied() == Some(ChannelState::Excluded as u8);
             p.remaining = p.remaining.saturating_sub(1);
             let outcome = if excluded {
@@ -116,7 +130,8 @@ impl ReadmitProbation {
                     .and_then(|r| FaultReason::from_u8(*r))
                     .unwrap_or(FaultReason::None);
                 Some((ReadmitOutcome::FaultStillPresent, reason))
-            } else if p.remaining == 0 {
+            } else if p.tested || p.remaining == 0 {
+                // Passed the monitor's tests and back in the solution, or in service throughout.
                 Some((ReadmitOutcome::Readmitted, FaultReason::None))
             } else {
                 None
@@ -188,6 +203,11 @@ mod tests {
         f
     }
 
+    /// A monitor that returned the channel at once.
+    fn not_testing(_: SensorType, _: usize) -> bool {
+        false
+    }
+
     fn replies(p: &mut ReadmitProbation) -> Vec<FusionReply> {
         let mut out = Vec::new();
         p.take_replies(|r| out.push(r));
@@ -201,13 +221,13 @@ mod tests {
             ReadmitResult::Readmitted
         });
         let ok = fused_with(ChannelState::Ok, FaultReason::None);
-        p.on_fused(&ok);
-        p.on_fused(&ok);
+        p.on_fused(&ok, not_testing);
+        p.on_fused(&ok, not_testing);
         assert!(
             replies(&mut p).is_empty(),
             "answered before the probation ended"
         );
-        p.on_fused(&ok);
+        p.on_fused(&ok, not_testing);
         let r = replies(&mut p);
         assert_eq!(r.len(), 1);
         assert_eq!(r[0].outcome, ReadmitOutcome::Readmitted as u8);
@@ -222,15 +242,73 @@ mod tests {
         p.on_request(&request(SensorType::Gyro, 2, 5), |_, _| {
             ReadmitResult::Readmitted
         });
-        p.on_fused(&fused_with(ChannelState::Ok, FaultReason::None));
+        p.on_fused(
+            &fused_with(ChannelState::Ok, FaultReason::None),
+            not_testing,
+        );
         // A suspect channel is still in the solution: no verdict yet.
-        p.on_fused(&fused_with(ChannelState::Suspect, FaultReason::Parity));
+        p.on_fused(
+            &fused_with(ChannelState::Suspect, FaultReason::Parity),
+            not_testing,
+        );
         assert!(replies(&mut p).is_empty());
-        p.on_fused(&fused_with(ChannelState::Excluded, FaultReason::Missing));
+        p.on_fused(
+            &fused_with(ChannelState::Excluded, FaultReason::Missing),
+            not_testing,
+        );
         let r = replies(&mut p);
         assert_eq!(r.len(), 1);
         assert_eq!(r[0].outcome, ReadmitOutcome::FaultStillPresent as u8);
         assert_eq!(r[0].reason, FaultReason::Missing as u8);
+    }
+
+    #[test]
+    fn a_channel_tested_out_of_the_solution_is_answered_when_the_test_ends() {
+        let testing = std::cell::Cell::new(true);
+        let monitor = |sensor: SensorType, channel: usize| {
+            sensor == SensorType::Gyro && channel == 2 && testing.get()
+        };
+        let mut p = ReadmitProbation::new(1000, 1);
+        p.on_request(&request(SensorType::Gyro, 2, 5), |_, _| {
+            ReadmitResult::Readmitted
+        });
+        p.on_request(&request(SensorType::Gyro, 2, 6), |_, _| {
+            ReadmitResult::Readmitted
+        });
+        // Out of the solution while tested: Excluded with its old reason, no verdict yet.
+        let under_test = fused_with(ChannelState::Excluded, FaultReason::StationaryReference);
+        for _ in 0..2000 {
+            p.on_fused(&under_test, monitor);
+        }
+        assert!(replies(&mut p).is_empty(), "answered while still tested");
+        // Failed its bias test: still excluded, now for parity.
+        testing.set(false);
+        p.on_fused(
+            &fused_with(ChannelState::Excluded, FaultReason::Parity),
+            monitor,
+        );
+        let r = replies(&mut p);
+        assert_eq!(r.len(), 2);
+        assert!(
+            r.iter()
+                .all(|r| r.outcome == ReadmitOutcome::FaultStillPresent as u8
+                    && r.reason == FaultReason::Parity as u8)
+        );
+        // Passed: back in the solution, answered on that sample, long before 1000 samples.
+        testing.set(true);
+        p.on_request(&request(SensorType::Gyro, 2, 7), |_, _| {
+            ReadmitResult::Readmitted
+        });
+        p.on_fused(&under_test, monitor);
+        testing.set(false);
+        p.on_fused(&fused_with(ChannelState::Ok, FaultReason::None), monitor);
+        let r = replies(&mut p);
+        assert_eq!(r.len(), 1);
+        assert_eq!(
+            (r[0].request_id, r[0].outcome),
+            (7, ReadmitOutcome::Readmitted as u8)
+        );
+        assert_eq!(p.on_probation(), 0);
     }
 
     #[test]
@@ -241,8 +319,8 @@ mod tests {
         });
         // Gyro 2 excluded says nothing about accelerometer 2.
         let gyro_out = fused_with(ChannelState::Excluded, FaultReason::Parity);
-        p.on_fused(&gyro_out);
-        p.on_fused(&gyro_out);
+        p.on_fused(&gyro_out, not_testing);
+        p.on_fused(&gyro_out, not_testing);
         let r = replies(&mut p);
         assert_eq!(r[0].outcome, ReadmitOutcome::Readmitted as u8);
     }

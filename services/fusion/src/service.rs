@@ -209,7 +209,10 @@ impl PipelineStage for FusionStage {
             log_events(&fused, raw.header.origin_device_time_us);
         }
         let msg = fused_message(raw, &fused, self.n_gyro, self.n_accel);
-        self.probation.on_fused(&msg);
+        let fuser = &self.fuser;
+        self.probation.on_fused(&msg, |sensor, channel| {
+            fuser.monitor(sensor).on_probation(channel)
+        });
         Step::Publish(msg)
     }
 
@@ -246,8 +249,9 @@ pub struct FusionService {
     pub fuser: ImuFuser,
     /// How long fusion waits for raw IMU before it reports acquisition stale ([`input_deadline`]).
     pub input_deadline: Duration,
-    /// Fused samples a channel re-admitted by command stays on probation before the command is
-    /// answered ([`ReadmitProbation`]).
+    /// Fused samples a channel re-admitted by command that the monitor returned at once (no
+    /// solution to test it against) stays watched before the command is answered
+    /// ([`ReadmitProbation`]); otherwise the monitor's own probation decides.
     pub readmit_probation_samples: u32,
 }
 

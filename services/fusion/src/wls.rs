@@ -138,6 +138,15 @@ impl WlsSolver {
         (x, self.variance)
     }
 
+    /// Column of the gain G for `channel`: how a change of that channel's value moves the
+    /// solution. `None` when the channel is not in the solution.
+    pub fn gain_of(&self, channel: usize) -> Option<[f64; 3]> {
+        self.active[..self.n_active]
+            .iter()
+            .position(|&i| usize::from(i) == channel)
+            .map(|k| self.gain[k])
+    }
+
     /// The channels this solver uses (bit i = channel i).
     pub fn mask(&self) -> u32 {
         self.mask

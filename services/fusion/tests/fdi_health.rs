@@ -251,8 +251,9 @@ fn noisy_channel_among_three_is_suspect() {
     );
 }
 
-/// Readmit returns an excluded channel (event Excluded → Ok); it is judged afresh and excluded
-/// again if still faulty. Unknown channels are refused.
+/// Readmit puts an excluded channel on probation, out of the solution; still faulty, it stays
+/// excluded; repaired, it returns at the probation's end (event Excluded → Ok). Unknown channels
+/// are refused.
 #[test]
 fn readmit_is_explicit_and_the_channel_is_judged_again() {
     let cfg = FdiConfig::default();
@@ -267,15 +268,23 @@ fn readmit_is_explicit_and_the_channel_is_judged_again() {
         rig.monitor.readmit(9).unwrap_err().to_string(),
         "gyro channel 9 does not exist (4 channels fitted)"
     );
-    // Still dead: readmitted, then excluded again on the next sample (no event: the state is
-    // Excluded/Missing before and after the sample).
+    // Still dead: on probation out of the solution, refused on the next sample (no event: the
+    // state is Excluded/Missing before and after the sample).
     assert_eq!(rig.monitor.readmit(1), Ok(true));
-    assert_eq!(rig.monitor.active_mask(), 0b1111);
-    rig.step(x, false);
     assert_eq!(rig.monitor.active_mask(), 0b1101);
-    // Repaired: readmitted and stays in.
+    assert!(rig.monitor.on_probation(1));
+    rig.step(x, false);
+    assert!(!rig.monitor.on_probation(1));
+    assert_eq!(rig.monitor.active_mask(), 0b1101);
+    assert!(rig.events.is_empty());
+    // Repaired: readmitted, out for the probation, then in.
     rig.inject(1, Fault::None);
     assert_eq!(rig.monitor.readmit(1), Ok(true));
+    for _ in 1..cfg.readmit_probation_samples {
+        let (est, st) = rig.step(x, false);
+        assert_eq!(est.mask, 0b1101);
+        assert_eq!(st.states[1], ChannelState::Excluded);
+    }
     let (est, st) = rig.step(x, false);
     assert_eq!(est.mask, 0b1111);
     assert_eq!(st.states[1], ChannelState::Ok);

@@ -161,8 +161,13 @@ fn invalid_channels_are_excluded_and_stay_excluded() {
         assert_eq!(f.gyro_status.states[2], ChannelState::Excluded);
         assert!(f.events.is_empty());
     }
-    // Back only by command.
+    // Back only by command, after a probation out of the solution.
     assert_eq!(fuser.readmit(SensorType::Gyro, 2), Ok(true));
+    for _ in 1..cfg.fdi.readmit_probation_samples {
+        let f = fuser.fuse(&healthy, &ac, ALL_VALID);
+        assert_eq!(f.gyro_mask, 0b1011);
+        assert!(fuser.monitor(SensorType::Gyro).on_probation(2));
+    }
     let f = fuser.fuse(&healthy, &ac, ALL_VALID);
     assert_eq!(f.gyro_mask, 0b1111);
     assert_within(f.rate, rate, rounding_bound(&g, GYRO_LSB, 1.0));

@@ -88,6 +88,34 @@ fn fuse_does_not_allocate() {
     }
 }
 
+/// A channel re-admitted by command is tested on every sample of its probation, out of the
+/// solution: that must not touch the heap either (only its return at the end reconfigures).
+#[test]
+fn a_probation_does_not_allocate() {
+    assert!(allocations_during(|| drop(std::hint::black_box(vec![1u8; 8]))) > 0);
+    let cfg = FusionConfig::default();
+    let samples = cfg.fdi.readmit_probation_samples;
+    let mut fuser = ImuFuser::new(&cfg, 0.0025566, 0.0383).unwrap();
+    for k in 0..2000u32 {
+        let (g, a) = frame(k, 0);
+        let mask = if k == 10 { 0x000E_000F } else { 0x000F_000F };
+        fuser.fuse(&g, &a, mask);
+    }
+    let accel = ipc_types::SensorType::Accel;
+    assert_eq!(fuser.readmit(accel, 0), Ok(true));
+    let mut sum = 0.0;
+    let allocations = allocations_during(|| {
+        for k in 2000..2000 + samples - 1 {
+            let (g, a) = frame(k, 0);
+            let f = fuser.fuse(&g, &a, 0x000F_000F);
+            sum += f.specific_force[2];
+        }
+    });
+    assert!(sum.is_finite());
+    assert!(fuser.monitor(accel).on_probation(0), "the probation ran");
+    assert_eq!(allocations, 0, "allocations during the probation");
+}
+
 /// The Kalman fuser alone: its update and channel changes must not touch the heap either.
 #[test]
 fn update_and_channel_changes_do_not_allocate() {

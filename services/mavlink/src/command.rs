@@ -4,8 +4,8 @@
 //!
 //! The command is `MAV_CMD_USER_1` (31010, left to each system by the MAVLink common set) with
 //! `param1` = 0 for a gyro, 1 for an accelerometer and `param2` = the channel index; rins answers
-//! `MAV_RESULT_IN_PROGRESS` at once, then `ACCEPTED` once the channel stayed in the solution
-//! through its probation (or was not excluded), `FAILED` when the fault is still present or fusion
+//! `MAV_RESULT_IN_PROGRESS` at once, then `ACCEPTED` once the channel passed its probation
+//! against the other channels (or was not excluded), `FAILED` when the fault is still present or fusion
 //! did not answer, `DENIED` for a channel the block does not have or when commands are not
 //! accepted, `TEMPORARILY_REJECTED` when fusion is busy with other re-admissions.
 

@@ -1,5 +1,8 @@
 //! `[mavlink]`: whether the MAVLink output runs, where it sends, how it presents itself, what it
-//! streams at which rate, and whether it takes commands.
+//! streams at which rate, whether it signs its messages, and whether and from whom it takes
+//! commands.
+
+use std::net::{IpAddr, SocketAddr};
 
 use serde::{Deserialize, Serialize};
 
@@ -28,13 +31,96 @@ pub struct MavlinkConfig {
     /// `hexarotor`, `octorotor`, `ground-rover`.
     pub display_vehicle: String,
     /// Whether COMMAND_LONG re-admissions from the link are carried out (off: the stream is
-    /// output only, commands are answered "denied").
+    /// output only, commands are answered "denied"). Needs `signing_key_file`, or
+    /// `allow_unsigned_commands` to take them from anyone who can reach the link.
     pub accept_commands: bool,
+    /// The MAVLink 2 signing key: a file of exactly 64 hexadecimal digits (the 32-byte secret key,
+    /// optionally followed by one newline), a regular file owned by the user rins runs as, with
+    /// no permission for group or others. When set, every message sent is signed, and commands
+    /// and TIMESYNC requests are carried out only when signed with this key.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub signing_key_file: Option<String>,
+    /// The link id rins's signatures carry (the signing specification's `link_id`): receivers keep
+    /// a timestamp per link, system and component.
+    pub signing_link_id: u8,
+    /// Carries out commands without a signature (no key set): anyone who can send a datagram to
+    /// an endpoint can then re-admit a channel. Only for a link that nobody else can reach.
+    pub allow_unsigned_commands: bool,
+    /// The senders commands are taken from, by MAVLink system id and optionally component id;
+    /// empty: any sender. Commands from others are refused and counted.
+    pub command_sources: Vec<CommandSource>,
+    /// The network addresses commands are taken from: `IP` (any port) or `IP:PORT`
+    /// (`[IPv6]:PORT`); empty: any address. Commands from others are refused and counted.
+    pub command_addresses: Vec<String>,
+    /// COMMAND_ACKs sent per second at most, on average: a flood of commands cannot make rins
+    /// flood the link with answers. Acknowledgements beyond it are dropped and counted.
+    pub command_ack_rate_hz: f64,
+    /// COMMAND_ACKs that may be sent at once before `command_ack_rate_hz` applies.
+    pub command_ack_burst: u32,
     /// Messages queued between the navigation loop and the network thread; beyond it they are
     /// dropped and counted, never waited for.
     pub queue_capacity: usize,
     /// `[mavlink.rates]`: messages per second of each stream.
     pub rates: MavlinkRates,
+}
+
+/// A sender commands are taken from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct CommandSource {
+    /// Its MAVLink system id (a ground station is usually 255).
+    pub system: u8,
+    /// Its component id; absent: any component of that system.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub component: Option<u8>,
+}
+
+impl CommandSource {
+    /// Whether a message from `(system, component)` comes from this source. A 32-bit system id
+    /// (a MAVLink 2 extension) never matches: the list names 8-bit ids.
+    pub fn matches(&self, system: u32, component: u8) -> bool {
+        system == u32::from(self.system) && self.component.is_none_or(|c| c == component)
+    }
+}
+
+/// A network address commands are taken from: a host (any port) or one socket.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CommandAddress {
+    /// Any port of this address.
+    Ip(IpAddr),
+    /// This address and port only.
+    Socket(SocketAddr),
+}
+
+impl CommandAddress {
+    /// Parses `IP`, `IP:PORT` or `[IPv6]:PORT`; the error says what is wrong, for the caller to
+    /// prefix with the field. Names are refused: an allow-list must not depend on a resolver.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        if let Ok(ip) = text.parse::<IpAddr>() {
+            return Ok(Self::Ip(ip.to_canonical()));
+        }
+        match text.parse::<SocketAddr>() {
+            Ok(s) if s.port() == 0 => Err("port 0: use 1..=65535, or no port for any".into()),
+            Ok(s) => Ok(Self::Socket(SocketAddr::new(
+                s.ip().to_canonical(),
+                s.port(),
+            ))),
+            Err(_) => Err(
+                "expected an IP address, IP:PORT or [IPv6]:PORT (host names are not resolved)"
+                    .into(),
+            ),
+        }
+    }
+
+    /// Whether a datagram from `from` comes from this address. IPv4 peers seen on an IPv6
+    /// socket (`::ffff:a.b.c.d`) match their IPv4 form.
+    pub fn matches(&self, from: SocketAddr) -> bool {
+        let ip = from.ip().to_canonical();
+        match self {
+            Self::Ip(a) => *a == ip,
+            Self::Socket(s) => s.ip() == ip && s.port() == from.port(),
+        }
+    }
 }
 
 /// Messages per second of each stream; 0 turns a stream off. Streams that follow the solution
@@ -70,6 +156,13 @@ impl Default for MavlinkConfig {
             profile: "onboard".into(),
             display_vehicle: "quadrotor".into(),
             accept_commands: false,
+            signing_key_file: None,
+            signing_link_id: 0,
+            allow_unsigned_commands: false,
+            command_sources: Vec::new(),
+            command_addresses: Vec::new(),
+            command_ack_rate_hz: 10.0,
+            command_ack_burst: 10,
             queue_capacity: 512,
             rates: MavlinkRates::default(),
         }
@@ -90,6 +183,10 @@ impl Default for MavlinkRates {
         }
     }
 }
+
+/// The most COMMAND_ACKs per second and at once that may be configured: far above what an
+/// operator sends, far below what would load the link.
+pub const MAX_ACK_RATE_HZ: f64 = 1000.0;
 
 /// The highest rate a stream may ask for: one message per fused sample at the sensor block's
 /// fastest rate.
@@ -143,6 +240,7 @@ impl MavlinkConfig {
                 self.queue_capacity
             ));
         }
+        self.validate_commands()?;
         for (name, hz) in self.rates.named() {
             if !(hz.is_finite() && (0.0..=MAX_RATE_HZ).contains(&hz)) {
                 return Err(format!(
@@ -151,6 +249,61 @@ impl MavlinkConfig {
             }
         }
         Ok(())
+    }
+
+    /// Checks the signing and command fields.
+    fn validate_commands(&self) -> Result<(), String> {
+        if let Some(path) = &self.signing_key_file {
+            if path.is_empty() {
+                return Err(
+                    "mavlink.signing_key_file = \"\": name the key file, or remove the key to send unsigned"
+                        .into(),
+                );
+            }
+            if self.allow_unsigned_commands {
+                return Err(format!(
+                    "mavlink.allow_unsigned_commands = true with mavlink.signing_key_file = {path:?}: a signed link refuses unsigned commands; remove one of them"
+                ));
+            }
+        } else if self.accept_commands && !self.allow_unsigned_commands {
+            return Err(
+                "mavlink.accept_commands = true without mavlink.signing_key_file: commands must be signed; set the key file, or allow_unsigned_commands = true to let anyone who can reach the link re-admit channels"
+                    .into(),
+            );
+        }
+        for (i, s) in self.command_sources.iter().enumerate() {
+            if s.system == 0 {
+                return Err(format!(
+                    "mavlink.command_sources[{i}].system = 0: 0 is the broadcast id, use 1..=255"
+                ));
+            }
+        }
+        for (i, a) in self.command_addresses.iter().enumerate() {
+            CommandAddress::parse(a)
+                .map_err(|why| format!("mavlink.command_addresses[{i}] = {a:?}: {why}"))?;
+        }
+        let hz = self.command_ack_rate_hz;
+        if !(hz.is_finite() && hz > 0.0 && hz <= MAX_ACK_RATE_HZ) {
+            return Err(format!(
+                "mavlink.command_ack_rate_hz = {hz}: must be above 0, at most {MAX_ACK_RATE_HZ}"
+            ));
+        }
+        if !(1..=MAX_ACK_RATE_HZ as u32).contains(&self.command_ack_burst) {
+            return Err(format!(
+                "mavlink.command_ack_burst = {}: must be 1..={}",
+                self.command_ack_burst, MAX_ACK_RATE_HZ as u32
+            ));
+        }
+        Ok(())
+    }
+
+    /// The parsed `command_addresses`; an entry that does not parse is left out (a validated
+    /// configuration has none).
+    pub fn command_addresses(&self) -> Vec<CommandAddress> {
+        self.command_addresses
+            .iter()
+            .filter_map(|a| CommandAddress::parse(a).ok())
+            .collect()
     }
 
     /// The profile this configuration asks for.
@@ -244,5 +397,97 @@ mod tests {
             })
             .starts_with("mavlink.endpoints = []")
         );
+    }
+
+    #[test]
+    fn commands_need_a_key_or_an_explicit_opt_out() {
+        let accepting = MavlinkConfig {
+            accept_commands: true,
+            ..MavlinkConfig::default()
+        };
+        let e = accepting.validate().unwrap_err();
+        assert!(
+            e.starts_with("mavlink.accept_commands = true without mavlink.signing_key_file"),
+            "{e}"
+        );
+        let unsigned = MavlinkConfig {
+            allow_unsigned_commands: true,
+            ..accepting.clone()
+        };
+        assert_eq!(unsigned.validate(), Ok(()));
+        let signed = MavlinkConfig {
+            signing_key_file: Some("/etc/rins/mavlink.key".into()),
+            ..accepting.clone()
+        };
+        assert_eq!(signed.validate(), Ok(()));
+        let both = MavlinkConfig {
+            allow_unsigned_commands: true,
+            ..signed.clone()
+        };
+        let e = both.validate().unwrap_err();
+        assert!(
+            e.starts_with("mavlink.allow_unsigned_commands = true with mavlink.signing_key_file = \"/etc/rins/mavlink.key\""),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn command_fields_name_the_field_and_value() {
+        let bad = |f: fn(&mut MavlinkConfig)| {
+            let mut c = MavlinkConfig::default();
+            f(&mut c);
+            c.validate().unwrap_err()
+        };
+        assert!(
+            bad(|c| c.signing_key_file = Some(String::new()))
+                .starts_with("mavlink.signing_key_file = \"\"")
+        );
+        assert!(
+            bad(|c| c.command_addresses = vec!["10.0.0.1".into(), "gcs.local".into()])
+                .starts_with("mavlink.command_addresses[1] = \"gcs.local\"")
+        );
+        assert!(bad(|c| c.command_addresses = vec!["10.0.0.1:0".into()]).contains("port 0"));
+        assert!(
+            bad(|c| c.command_sources = vec![CommandSource {
+                system: 0,
+                component: None
+            }])
+            .starts_with("mavlink.command_sources[0].system = 0")
+        );
+        assert!(
+            bad(|c| c.command_ack_rate_hz = 0.0).starts_with("mavlink.command_ack_rate_hz = 0")
+        );
+        assert!(
+            bad(|c| c.command_ack_rate_hz = f64::INFINITY)
+                .starts_with("mavlink.command_ack_rate_hz = inf")
+        );
+        assert!(bad(|c| c.command_ack_burst = 0).starts_with("mavlink.command_ack_burst = 0"));
+    }
+
+    #[test]
+    fn the_allow_lists_parse_from_toml_and_match() {
+        let c: MavlinkConfig = toml::from_str(
+            r#"
+            accept_commands = true
+            signing_key_file = "/k"
+            command_sources = [{ system = 255, component = 190 }, { system = 254 }]
+            command_addresses = ["192.168.7.2", "[::1]:14550"]
+            "#,
+        )
+        .unwrap();
+        assert_eq!(c.validate(), Ok(()));
+        let gcs = c.command_sources[0];
+        assert!(gcs.matches(255, 190));
+        assert!(!gcs.matches(255, 191));
+        assert!(!gcs.matches(255 + 256, 190));
+        assert!(c.command_sources[1].matches(254, 7));
+        let addresses = c.command_addresses();
+        let at = |s: &str| s.parse::<SocketAddr>().unwrap();
+        assert!(addresses[0].matches(at("192.168.7.2:40000")));
+        // The same peer seen on an IPv6 socket.
+        assert!(addresses[0].matches(at("[::ffff:192.168.7.2]:40000")));
+        assert!(!addresses[0].matches(at("192.168.7.3:40000")));
+        assert!(addresses[1].matches(at("[::1]:14550")));
+        assert!(!addresses[1].matches(at("[::1]:14551")));
     }
 }

@@ -11,7 +11,9 @@
 //! - [`status_text`]: the STATUSTEXT messages of channel exclusions, returns, lane switches and
 //!   restarts; [`events`] finds them in the inputs.
 //! - [`highres_imu`], [`vibration`]: the fused IMU and how much it shakes.
-//! - [`timesync`], [`command`]: what rins answers on the link (TIMESYNC, a channel re-admission).
+//! - [`timesync`], [`command`]: what rins answers on the link (TIMESYNC, a channel re-admission);
+//!   [`command_gate`]: from whom it takes commands and how fast it answers them; [`signing`]: the
+//!   MAVLink 2 signing key, signing and verification.
 //! - [`stream`]: all of it as one state machine paced by [`rate_gate`]; [`link`] moves the messages
 //!   to the network on its own threads; [`service`] is the process around them, [`config`] its
 //!   `[mavlink]` table and [`endpoint`] its addresses.
@@ -21,6 +23,7 @@
 
 pub mod attitude;
 pub mod command;
+pub mod command_gate;
 pub mod config;
 pub mod endpoint;
 pub mod events;
@@ -31,6 +34,7 @@ pub mod odometry;
 pub mod position;
 pub mod rate_gate;
 pub mod service;
+pub mod signing;
 pub mod status_text;
 pub mod stream;
 pub mod sys_status;

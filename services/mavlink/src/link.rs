@@ -1,8 +1,9 @@
 //! The network side of the MAVLink output: one thread sends what the navigation loop queued, one
-//! thread per socket reads what peers send (TIMESYNC is answered there and then, commands go to
-//! the navigation loop). The navigation loop never touches a socket: it hands messages over a
-//! bounded queue and counts what did not fit, so a slow or absent network never holds up the
-//! solution.
+//! thread per socket reads what peers send (TIMESYNC is answered there and then, commands that
+//! pass the [`CommandGate`] go to the navigation loop). The navigation loop never touches a
+//! socket: it hands messages over a bounded queue and counts what did not fit, so a slow or absent
+//! network never holds up the solution. With a signing key, every frame sent is signed and only
+//! frames signed with the key are acted on.
 
 use std::io;
 use std::net::{SocketAddr, UdpSocket};
@@ -12,10 +13,15 @@ use std::thread::JoinHandle;
 use std::time::Duration;
 
 use crossbeam_channel::{Receiver, Sender, TrySendError, bounded};
-use mavlink::{MavHeader, MavlinkReader, MavlinkVersion};
+use mavlink::{
+    MAVLinkMessageRaw, MAVLinkV2MessageRaw, MavHeader, MavlinkReader, MavlinkVersion, Message,
+    SigningData,
+};
 
+use crate::command_gate::{CommandGate, Refusal};
 use crate::dialect::{COMMAND_LONG_DATA, MavMessage};
 use crate::endpoint::Endpoint;
+use crate::signing::{self, KEY_BYTES, SignatureCheck, Verifier};
 use crate::timesync;
 
 /// Largest MAVLink 2 frame (header 10, payload 255, checksum 2, signature 13).
@@ -45,12 +51,73 @@ pub struct LinkCounters {
     pub sent: AtomicU64,
     /// Sends the system refused (unreachable peer, no route).
     pub send_errors: AtomicU64,
-    /// Datagrams received that were not MAVLink 2 messages of the common set.
+    /// Datagrams received that were not, in whole, MAVLink 2 messages of the common set: one per
+    /// such datagram, whatever it held besides.
     pub undecodable: AtomicU64,
     /// TIMESYNC requests answered.
     pub timesync_answered: AtomicU64,
     /// Commands dropped because the navigation loop had not taken the earlier ones.
     pub commands_dropped: AtomicU64,
+    /// Commands and TIMESYNC requests refused because they were not signed (a key is set, or
+    /// commands are accepted without one and unsigned ones are not allowed).
+    pub unsigned_refused: AtomicU64,
+    /// Commands and TIMESYNC requests refused because their signature was not made with the key.
+    pub bad_signature_refused: AtomicU64,
+    /// Commands and TIMESYNC requests refused because, signed with the key, they were not newer
+    /// than their stream's last frame (a replay).
+    pub replay_refused: AtomicU64,
+    /// Commands refused because their sender is not in `command_sources`.
+    pub sender_refused: AtomicU64,
+    /// Commands refused because their address is not in `command_addresses`.
+    pub address_refused: AtomicU64,
+    /// COMMAND_ACKs not sent because they exceeded `command_ack_rate_hz`.
+    pub acks_dropped: AtomicU64,
+}
+
+impl LinkCounters {
+    /// Counts `refusal`; the first of each kind is logged, with who sent it, so that a link set up
+    /// wrongly (a ground station not signing) shows at once without a flood of log lines.
+    fn refused(&self, refusal: Refusal, sender: (u32, u8), from: SocketAddr) {
+        let (counter, why) = match refusal {
+            Refusal::Unsigned => (&self.unsigned_refused, "not signed"),
+            Refusal::BadSignature => (&self.bad_signature_refused, "not signed with the key"),
+            Refusal::Replayed => (&self.replay_refused, "a replayed signature"),
+            Refusal::Sender => (&self.sender_refused, "sender not in command_sources"),
+            Refusal::Address => (&self.address_refused, "address not in command_addresses"),
+        };
+        if counter.fetch_add(1, Ordering::Relaxed) == 0 {
+            tracing::warn!(
+                %from,
+                system = sender.0,
+                component = sender.1,
+                "MAVLink message refused: {why} (further ones are only counted)"
+            );
+        }
+    }
+
+    /// The refusals of every kind.
+    pub fn refused_total(&self) -> u64 {
+        [
+            &self.unsigned_refused,
+            &self.bad_signature_refused,
+            &self.replay_refused,
+            &self.sender_refused,
+            &self.address_refused,
+        ]
+        .iter()
+        .map(|c| c.load(Ordering::Relaxed))
+        .sum()
+    }
+}
+
+/// How the link is secured: the signing key and who may send commands.
+pub struct LinkSecurity {
+    /// The signing key; `None`: frames are sent unsigned and signatures are not checked.
+    pub key: Option<[u8; KEY_BYTES]>,
+    /// The link id of rins's signatures.
+    pub link_id: u8,
+    /// Who may send commands.
+    pub gate: CommandGate,
 }
 
 /// One socket and where its stream goes.
@@ -61,15 +128,16 @@ struct Socket {
     listening: bool,
 }
 
-/// Who rins speaks as, and the sequence number every frame it sends shares.
+/// Who rins speaks as, the sequence number every frame it sends shares, and its signer.
 struct Speaker {
     system: u8,
     component: u8,
     sequence: AtomicU8,
+    signer: Option<SigningData>,
 }
 
 impl Speaker {
-    /// `msg` framed as MAVLink 2 into `buf`; the frame's length.
+    /// `msg` framed as MAVLink 2 into `buf`, signed when a key is set; the frame's length.
     fn frame(&self, msg: &MavMessage, buf: &mut [u8; MAX_FRAME]) -> Option<usize> {
         let header = MavHeader {
             system_id: u32::from(self.system),
@@ -77,9 +145,36 @@ impl Speaker {
             sequence: self.sequence.fetch_add(1, Ordering::Relaxed),
         };
         let mut cursor = io::Cursor::new(&mut buf[..]);
-        mavlink::write_v2_msg(&mut cursor, header, msg).ok()?;
+        mavlink::write_v2_msg_signed(&mut cursor, header, msg, self.signer.as_ref()).ok()?;
         Some(cursor.position() as usize)
     }
+}
+
+/// Every MAVLink 2 message of the common set in `datagram`, in order, handed to `on_message`
+/// with its raw frame (for the signature); returns whether the datagram was nothing but such
+/// messages (an empty datagram is not). Bytes between, before or after frames, frames with a bad
+/// checksum, of another MAVLink version or of an unknown or malformed message make it not so.
+pub fn decode_datagram(
+    datagram: &[u8],
+    mut on_message: impl FnMut(&MAVLinkV2MessageRaw, MavMessage),
+) -> bool {
+    let mut reader = MavlinkReader::new(datagram);
+    let mut framed = 0usize;
+    let mut clean = true;
+    // The reader skips what is not a valid frame and reports only the end of the bytes: what it
+    // skipped shows as bytes not covered by the frames it returned.
+    while let Ok(raw) = reader.read_raw_message::<MavMessage>(MavlinkVersion::V2) {
+        let MAVLinkMessageRaw::V2(raw) = raw else {
+            clean = false;
+            continue;
+        };
+        framed += raw.raw_bytes().len();
+        match MavMessage::parse(MavlinkVersion::V2, raw.message_id(), raw.payload()) {
+            Ok(msg) => on_message(&raw, msg),
+            Err(_) => clean = false,
+        }
+    }
+    clean && framed > 0 && framed == datagram.len()
 }
 
 /// The running link: the queue into it, the commands out of it, its counters.
@@ -122,12 +217,14 @@ fn peer_of(peer: &Mutex<Option<SocketAddr>>) -> Option<SocketAddr> {
 }
 
 impl Link {
-    /// Opens every endpoint and starts the threads; rins speaks as `(system, component)`. An
-    /// endpoint that cannot be opened is an error naming it.
+    /// Opens every endpoint and starts the threads; rins speaks as `(system, component)`, signs
+    /// and admits commands as `security` says. An endpoint that cannot be opened is an error
+    /// naming it.
     pub fn start(
         endpoints: &[Endpoint],
         speaker: (u8, u8),
         queue_capacity: usize,
+        security: LinkSecurity,
     ) -> io::Result<Self> {
         let mut sockets = Vec::with_capacity(endpoints.len());
         for e in endpoints {
@@ -138,7 +235,15 @@ impl Link {
             system: speaker.0,
             component: speaker.1,
             sequence: AtomicU8::new(0),
+            signer: security
+                .key
+                .map(|key| signing::outgoing(key, security.link_id)),
         });
+        // One verifier for every socket: a frame replayed onto another endpoint is still a replay.
+        let verifier = security
+            .key
+            .map(|key| Arc::new(Mutex::new(Verifier::new(key))));
+        let gate = Arc::new(security.gate);
         let counters = Arc::new(LinkCounters::default());
         let stop = Arc::new(AtomicBool::new(false));
         let (tx, rx) = bounded::<MavMessage>(queue_capacity);
@@ -153,6 +258,8 @@ impl Link {
                 counters: Arc::clone(&counters),
                 commands: cmd_tx.clone(),
                 stop: Arc::clone(&stop),
+                verifier: verifier.clone(),
+                gate: Arc::clone(&gate),
             };
             threads.push(
                 std::thread::Builder::new()
@@ -223,7 +330,8 @@ fn send_loop(
     }
 }
 
-/// Reads one socket: answers TIMESYNC, forwards commands, learns a listening socket's peer.
+/// Reads one socket: answers TIMESYNC, forwards admitted commands, learns a listening socket's
+/// peer.
 struct ReaderThread {
     socket: UdpSocket,
     peer: Arc<Mutex<Option<SocketAddr>>>,
@@ -232,6 +340,9 @@ struct ReaderThread {
     counters: Arc<LinkCounters>,
     commands: Sender<InboundCommand>,
     stop: Arc<AtomicBool>,
+    /// The signature check, when a key is set.
+    verifier: Option<Arc<Mutex<Verifier>>>,
+    gate: Arc<CommandGate>,
 }
 
 impl ReaderThread {
@@ -255,32 +366,61 @@ impl ReaderThread {
                     continue;
                 }
             };
-            if self.listening {
-                *self.peer.lock().unwrap_or_else(PoisonError::into_inner) = Some(from);
-            }
             // A datagram may carry several frames.
-            let mut reader = MavlinkReader::new(&datagram[..n]);
-            loop {
-                match reader.read_message::<MavMessage>(MavlinkVersion::V2) {
-                    Ok((header, msg)) => self.on_message(header, msg, from, &mut frame),
-                    Err(mavlink::error::MessageReadError::Io(_)) => break,
-                    Err(_) => {
-                        self.counters.undecodable.fetch_add(1, Ordering::Relaxed);
-                        break;
-                    }
-                }
+            let mut authentic = false;
+            let clean = decode_datagram(&datagram[..n], |raw, msg| {
+                authentic |= self.on_message(raw, msg, from, &mut frame);
+            });
+            if !clean {
+                self.counters.undecodable.fetch_add(1, Ordering::Relaxed);
+            }
+            // The stream follows only a peer that spoke MAVLink (signed with the key, when one
+            // is set): a stray or forged datagram cannot divert it.
+            if self.listening && authentic {
+                *self.peer.lock().unwrap_or_else(PoisonError::into_inner) = Some(from);
             }
         }
     }
 
+    /// What `raw`'s signature shows.
+    fn signature(&self, raw: &MAVLinkV2MessageRaw) -> SignatureCheck {
+        match &self.verifier {
+            Some(v) => v
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .check(raw, signing::timestamp_now()),
+            None => SignatureCheck::NotChecked,
+        }
+    }
+
+    /// Acts on one message; returns whether it is authentic (signed with the key, or no key set).
     fn on_message(
         &self,
-        header: MavHeader,
+        raw: &MAVLinkV2MessageRaw,
         msg: MavMessage,
         from: SocketAddr,
         frame: &mut [u8; MAX_FRAME],
-    ) {
+    ) -> bool {
+        let signature = self.signature(raw);
+        let authentic = matches!(
+            signature,
+            SignatureCheck::Valid | SignatureCheck::NotChecked
+        );
+        let header = MavHeader {
+            system_id: raw.system_id(),
+            component_id: raw.component_id(),
+            sequence: raw.sequence(),
+        };
+        let sender = (header.system_id, header.component_id);
         match msg {
+            MavMessage::TIMESYNC(_) if !authentic => {
+                let refusal = match signature {
+                    SignatureCheck::BadSignature => Refusal::BadSignature,
+                    SignatureCheck::Replayed => Refusal::Replayed,
+                    _ => Refusal::Unsigned,
+                };
+                self.counters.refused(refusal, sender, from);
+            }
             MavMessage::TIMESYNC(request) => {
                 let now = rins_runtime::clock::monotonic_ns();
                 if let Some(mut answer) = timesync::answer(&request, now, self.speaker.system) {
@@ -296,6 +436,10 @@ impl ReaderThread {
                 }
             }
             MavMessage::COMMAND_LONG(command) => {
+                if let Err(refusal) = self.gate.admit(signature, sender, from) {
+                    self.counters.refused(refusal, sender, from);
+                    return authentic;
+                }
                 let inbound = InboundCommand {
                     // A system id beyond 255 (a MAVLink 2 extension) cannot be answered in kind.
                     from: (
@@ -312,5 +456,75 @@ impl ReaderThread {
             }
             _ => {}
         }
+        authentic
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A signed COMMAND_LONG frame.
+    fn signed_command(signer: &SigningData) -> Vec<u8> {
+        let header = MavHeader {
+            system_id: 255,
+            component_id: 190,
+            sequence: 3,
+        };
+        let mut bytes = Vec::new();
+        mavlink::write_v2_msg_signed(
+            &mut bytes,
+            header,
+            &MavMessage::COMMAND_LONG(COMMAND_LONG_DATA::default()),
+            Some(signer),
+        )
+        .unwrap();
+        bytes
+    }
+
+    #[test]
+    fn mangled_datagrams_never_panic_and_never_pass_as_signed() {
+        let key = [3u8; KEY_BYTES];
+        let signer = signing::outgoing(key, 0);
+        let mut verifier = Verifier::new(key);
+        let now = signing::timestamp_now();
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let mut valid = 0;
+        for _ in 0..20_000 {
+            let original = signed_command(&signer);
+            let mut d = original.clone();
+            // One to four changed bytes, then maybe cut or lengthened.
+            for _ in 0..=(next() % 4) {
+                let i = (next() as usize) % d.len();
+                d[i] ^= (next() as u8) | 1;
+            }
+            match next() % 3 {
+                0 => d.truncate((next() as usize) % (d.len() + 1)),
+                // Up to the largest datagram read, with frame starts among the bytes.
+                1 => d.extend((0..next() % 2000).map(|_| match next() % 8 {
+                    0 => 0xfd,
+                    _ => next() as u8,
+                })),
+                _ => {}
+            }
+            // Two changes of one byte may cancel out: only a frame that did change counts.
+            let changed = !d.starts_with(&original);
+            decode_datagram(&d, |raw, _| {
+                if verifier.check(raw, now) == SignatureCheck::Valid && changed {
+                    valid += 1;
+                }
+            });
+        }
+        // Whatever byte changed — one the checksum covers, the signature's or its timestamp's —
+        // the frame never passes as signed with the key.
+        assert_eq!(valid, 0);
+        // Nothing at all is not a message either.
+        assert!(!decode_datagram(&[], |_, _| {}));
     }
 }

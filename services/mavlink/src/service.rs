@@ -1,6 +1,7 @@
 //! The MAVLink process: the merged navigation stream, the fused IMU and the watchdog's report in;
 //! MAVLink 2 over UDP out through the [`Link`]'s network thread; re-admission commands from the
-//! link carried to fusion and acknowledged with fusion's answer.
+//! link carried to fusion and acknowledged with fusion's answer, no faster than the configured
+//! acknowledgement rate.
 
 use std::time::{Duration, Instant};
 
@@ -13,10 +14,11 @@ use rins_runtime::service::{Service, ServiceContext};
 use rins_runtime::service_loop::ServiceLoop;
 
 use crate::command::{Decision, ack, decide, result_of};
+use crate::command_gate::{AckLimiter, CommandGate};
 use crate::config::MavlinkConfig;
 use crate::dialect::{MavCmd, MavMessage, MavResult};
 use crate::endpoint::Endpoint;
-use crate::link::{InboundCommand, Link, LinkCounters};
+use crate::link::{InboundCommand, Link, LinkCounters, LinkSecurity};
 use crate::stream::MavlinkStream;
 
 /// The longest sleep waiting for a solution: how often the heartbeat, the commands and the stop
@@ -53,6 +55,24 @@ struct Commands {
     next_id: u32,
     own: (u8, u8),
     accept: bool,
+    acks: AckLimiter,
+}
+
+/// Queues `ack` of `command` to `peer` if the limiter lets it go; counts it dropped otherwise.
+fn send_ack(
+    link: &Link,
+    limiter: &mut AckLimiter,
+    command: MavCmd,
+    result: MavResult,
+    peer: (u8, u8),
+) {
+    if limiter.allow(monotonic_ns()) {
+        link.queue(MavMessage::COMMAND_ACK(ack(command, result, peer)));
+    } else {
+        link.counters
+            .acks_dropped
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    }
 }
 
 impl Commands {
@@ -60,13 +80,8 @@ impl Commands {
     fn on_command(&mut self, c: &InboundCommand, link: &Link) -> Result<()> {
         let id = REQUEST_ID_BASE | (self.next_id & !REQUEST_ID_BASE);
         self.next_id = self.next_id.wrapping_add(1);
-        let answer = |result| {
-            link.queue(MavMessage::COMMAND_ACK(ack(
-                c.command.command,
-                result,
-                c.from,
-            )));
-        };
+        let acks = &mut self.acks;
+        let mut answer = |result| send_ack(link, acks, c.command.command, result, c.from);
         match decide(&c.command, self.own, self.accept, id) {
             Decision::Ignore => {}
             Decision::Answer(result) => answer(result),
@@ -104,21 +119,14 @@ impl Commands {
                 continue;
             };
             let p = self.pending.swap_remove(i);
-            link.queue(MavMessage::COMMAND_ACK(ack(
-                p.command,
-                result_of(&reply),
-                p.peer,
-            )));
+            send_ack(link, &mut self.acks, p.command, result_of(&reply), p.peer);
         }
         let now = Instant::now();
+        let acks = &mut self.acks;
         self.pending.retain(|p| {
             let waiting = now < p.deadline;
             if !waiting {
-                link.queue(MavMessage::COMMAND_ACK(ack(
-                    p.command,
-                    MavResult::MAV_RESULT_FAILED,
-                    p.peer,
-                )));
+                send_ack(link, acks, p.command, MavResult::MAV_RESULT_FAILED, p.peer);
             }
             waiting
         });
@@ -127,13 +135,14 @@ impl Commands {
 }
 
 /// The link's counters into the heartbeat's: messages queued are published, messages the queue
-/// could not take are lost, undecodable datagrams are malformed.
+/// could not take are lost, undecodable datagrams are malformed, commands not carried out for
+/// the link's reasons (refused by the gate, or dropped for a full queue) are rejected.
 fn copy_counters(link: &LinkCounters, counters: &mut ipc_types::Health) {
     use std::sync::atomic::Ordering::Relaxed;
     counters.published = link.queued.load(Relaxed);
     counters.lost = link.dropped.load(Relaxed);
     counters.malformed = link.undecodable.load(Relaxed);
-    counters.rejected = link.commands_dropped.load(Relaxed);
+    counters.rejected = link.commands_dropped.load(Relaxed) + link.refused_total();
 }
 
 impl Service for MavlinkService {
@@ -146,6 +155,13 @@ impl Service for MavlinkService {
                 Endpoint::parse(e).map_err(|why| anyhow::anyhow!("mavlink endpoint {e:?}: {why}"))
             })
             .collect::<Result<Vec<_>>>()?;
+        // Before anything else: a key that cannot be used stops the start, naming the file.
+        let key = crate::signing::key_for(&config)?;
+        let security = LinkSecurity {
+            key,
+            link_id: config.signing_link_id,
+            gate: CommandGate::new(&config, key.is_some()),
+        };
         let node = ctx.create_node(ServiceKind::Mavlink)?;
         let mut lp = ServiceLoop::new(&node, ServiceKind::Mavlink, &ctx.shutdown)?;
         let mut nav = NavSubscriber::new(&node)?;
@@ -159,8 +175,9 @@ impl Service for MavlinkService {
             next_id: 0,
             own,
             accept: config.accept_commands,
+            acks: AckLimiter::new(config.command_ack_rate_hz, config.command_ack_burst),
         };
-        let link = Link::start(&endpoints, own, config.queue_capacity)
+        let link = Link::start(&endpoints, own, config.queue_capacity, security)
             .context("cannot open the MAVLink endpoints")?;
         tracing::info!(
             endpoints = %config.endpoints.join(","),
@@ -168,6 +185,7 @@ impl Service for MavlinkService {
             component = own.1,
             profile = %config.profile,
             accept_commands = config.accept_commands,
+            signed = key.is_some(),
             "streaming MAVLink 2"
         );
         let mut stream = MavlinkStream::new(&config);
@@ -203,8 +221,58 @@ impl Service for MavlinkService {
             send_errors = c.send_errors.load(Relaxed),
             undecodable = c.undecodable.load(Relaxed),
             timesync_answered = c.timesync_answered.load(Relaxed),
+            commands_dropped = c.commands_dropped.load(Relaxed),
+            unsigned_refused = c.unsigned_refused.load(Relaxed),
+            bad_signature_refused = c.bad_signature_refused.load(Relaxed),
+            replay_refused = c.replay_refused.load(Relaxed),
+            sender_refused = c.sender_refused.load(Relaxed),
+            address_refused = c.address_refused.load(Relaxed),
+            acks_dropped = c.acks_dropped.load(Relaxed),
             "MAVLink output stopped"
         );
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::command_gate::CommandGate;
+    use std::sync::atomic::Ordering::Relaxed;
+
+    #[test]
+    fn a_flood_of_acknowledgements_keeps_to_the_limit_and_is_counted() {
+        let sink = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+        let endpoint = Endpoint::UdpOut {
+            host: "127.0.0.1".into(),
+            port: sink.local_addr().unwrap().port(),
+        };
+        let config = MavlinkConfig::default();
+        let link = Link::start(
+            &[endpoint],
+            (1, 197),
+            1024,
+            LinkSecurity {
+                key: None,
+                link_id: 0,
+                gate: CommandGate::new(&config, false),
+            },
+        )
+        .unwrap();
+        // A burst of 3 and one a second: 1000 acknowledgements asked for within far less than a
+        // second let the burst through, at most one more.
+        let mut limiter = AckLimiter::new(1.0, 3);
+        for _ in 0..1000 {
+            send_ack(
+                &link,
+                &mut limiter,
+                MavCmd::MAV_CMD_USER_1,
+                MavResult::MAV_RESULT_DENIED,
+                (255, 190),
+            );
+        }
+        let queued = link.counters.queued.load(Relaxed);
+        assert!((3..=4).contains(&queued), "{queued}");
+        assert_eq!(link.counters.acks_dropped.load(Relaxed), 1000 - queued);
     }
 }

@@ -25,10 +25,12 @@ pub struct NavigatorConfig {
     pub align_s: f64,
     /// Magnetic declination, degrees, positive east.
     pub declination_deg: f64,
-    /// Initial latitude, degrees.
-    pub initial_latitude_deg: f64,
-    /// Initial longitude, degrees.
-    pub initial_longitude_deg: f64,
+    /// Initial latitude, degrees. Absent (with the longitude): the horizontal position is unknown
+    /// until an absolute fix sets it, and the integrity says so (`position-unknown`); navigation
+    /// starts at a placeholder of latitude and longitude 0 (gravity at 45°).
+    pub initial_latitude_deg: Option<f64>,
+    /// Initial longitude, degrees; given together with the latitude.
+    pub initial_longitude_deg: Option<f64>,
     /// Initial altitude, m; replaced by the first valid baro reading when there is one.
     pub initial_altitude_m: f64,
     /// Largest accepted IMU sample interval, s; longer gaps are skipped as device-time glitches.
@@ -76,8 +78,8 @@ impl Default for NavigatorConfig {
         Self {
             align_s: align.window_s,
             declination_deg: 0.0,
-            initial_latitude_deg: 0.0,
-            initial_longitude_deg: 0.0,
+            initial_latitude_deg: None,
+            initial_longitude_deg: None,
             initial_altitude_m: 0.0,
             max_dt_s: strapdown.max_dt_s,
             coning_correction: strapdown.coning_correction,
@@ -130,18 +132,39 @@ impl NavigatorConfig {
             |x| x.abs() <= 180.0,
             "must be in [-180, 180] degrees",
         )?;
-        check(
-            "initial_latitude_deg",
-            self.initial_latitude_deg,
-            |x| x.abs() <= 89.9,
-            "must be in [-89.9, 89.9] degrees (longitude is undefined at the poles)",
-        )?;
-        check(
-            "initial_longitude_deg",
-            self.initial_longitude_deg,
-            |x| x.abs() <= 180.0,
-            "must be in [-180, 180] degrees",
-        )?;
+        match (self.initial_latitude_deg, self.initial_longitude_deg) {
+            (Some(lat), Some(lon)) => {
+                check(
+                    "initial_latitude_deg",
+                    lat,
+                    |x| x.abs() <= 89.9,
+                    "must be in [-89.9, 89.9] degrees (longitude is undefined at the poles)",
+                )?;
+                check(
+                    "initial_longitude_deg",
+                    lon,
+                    |x| x.abs() <= 180.0,
+                    "must be in [-180, 180] degrees",
+                )?;
+            }
+            (None, None) => {}
+            (Some(lat), None) => {
+                return Err(ConfigError::new(
+                    "initial_latitude_deg",
+                    lat,
+                    "is given without initial_longitude_deg: give both, or neither",
+                )
+                .within("navigator"));
+            }
+            (None, Some(lon)) => {
+                return Err(ConfigError::new(
+                    "initial_longitude_deg",
+                    lon,
+                    "is given without initial_latitude_deg: give both, or neither",
+                )
+                .within("navigator"));
+            }
+        }
         check(
             "initial_altitude_m",
             self.initial_altitude_m,
@@ -274,10 +297,11 @@ impl NavigatorConfig {
             stale_after_s: self.aiding_timeout_s,
             declination_rad: self.declination_deg.to_radians(),
             origin: [
-                self.initial_latitude_deg.to_radians(),
-                self.initial_longitude_deg.to_radians(),
+                self.initial_latitude_deg.unwrap_or(0.0).to_radians(),
+                self.initial_longitude_deg.unwrap_or(0.0).to_radians(),
                 self.initial_altitude_m,
             ],
+            origin_known: self.initial_latitude_deg.is_some(),
             integrity: self.integrity,
         }
     }
@@ -286,8 +310,10 @@ impl NavigatorConfig {
     pub fn align_config(&self) -> AlignConfig {
         AlignConfig {
             window_s: self.align_s,
+            // Unknown latitude: gravity at 45°, within 0.03 m/s² of any latitude's, well inside
+            // the alignment's tolerance.
             gravity_mps2: normal_gravity(
-                self.initial_latitude_deg.to_radians(),
+                self.initial_latitude_deg.unwrap_or(45.0).to_radians(),
                 self.initial_altitude_m,
             ),
             specific_force_tolerance_mps2: self.align_specific_force_tolerance_mps2,

@@ -102,7 +102,9 @@ impl AidedNavigator {
         // Back after an outage: the position has coasted, its covariance grown and its
         // correlations with velocity and attitude stretched far beyond what one fix can sort out;
         // the fix re-sets the position (and velocity) instead of being gated against it.
-        let returning = self.is_stale(AidingSource::Gnss);
+        // Without a known position, the first fix sets it the same way: gated against a
+        // placeholder, it would only ever be rejected.
+        let returning = self.is_stale(AidingSource::Gnss) || self.integrity.position_unknown();
         self.last_reading_us[AidingSource::Gnss as usize] = Some(m.t_us);
         if returning && self.gnss.monitor.rejected().is_none() {
             return self.reset_from_fix(m);
@@ -229,6 +231,7 @@ impl AidedNavigator {
         }
         self.gnss.history.clear();
         self.last_accepted_us[AidingSource::Gnss as usize] = Some(m.t_us);
+        self.integrity.set_position_unknown(false);
         GnssOutcome::Readmitted
     }
 }

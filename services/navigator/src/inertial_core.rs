@@ -22,6 +22,7 @@ use crate::mag_heading::{FieldReference, MagAidingConfig};
 use crate::mechanisation::{ImuBias, NominalState, StepOutcome, StrapdownConfig};
 use crate::stance::{StanceConfig, StanceDetector};
 use crate::tilt_aiding::{TiltAiding, TiltAidingConfig};
+use crate::unisolated_fault::{FusionFault, UnisolatedFaultBound};
 use ipc_types::Integrity;
 
 /// Settings of the zero-velocity aiding (`[navigator.zupt]`).
@@ -76,6 +77,9 @@ pub struct AidedConfig {
     pub declination_rad: f64,
     /// Position where navigation starts: latitude, longitude (rad), altitude (m).
     pub origin: [f64; 3],
+    /// The origin's latitude and longitude were configured; otherwise they are placeholders and
+    /// the horizontal position is unknown until an absolute fix sets it.
+    pub origin_known: bool,
     /// The integrity monitor and its recovery policies (`[navigator.integrity]`).
     pub integrity: IntegrityConfig,
 }
@@ -163,6 +167,8 @@ pub struct AidedNavigator {
     tilt: TiltAiding,
     /// GNSS aiding: state history and the receiver's consistency monitor.
     pub(crate) gnss: GnssAidingState,
+    /// A fault fusion detected and has not isolated (see [`crate::unisolated_fault`]).
+    fusion_fault: UnisolatedFaultBound,
 }
 
 impl AidedNavigator {
@@ -185,11 +191,35 @@ impl AidedNavigator {
             last_reading_us: [None; AidingSource::COUNT],
             navigating_since_us: None,
             reference_from_next_mag: false,
-            integrity: IntegrityMonitor::new(config.integrity, config.configured_sources()),
+            integrity: Self::integrity_monitor(&config),
             attitude_recovery: AttitudeRecovery::default(),
             tilt: TiltAiding::default(),
             gnss: GnssAidingState::new(config.gnss),
+            fusion_fault: UnisolatedFaultBound::default(),
         }
+    }
+
+    fn integrity_monitor(config: &AidedConfig) -> IntegrityMonitor {
+        let mut monitor = IntegrityMonitor::new(config.integrity, config.configured_sources());
+        monitor.set_position_unknown(!config.origin_known);
+        monitor
+    }
+
+    /// Fusion's fault report for the IMU sample about to be fed (see
+    /// [`crate::unisolated_fault`]).
+    pub fn on_fusion_fault(&mut self, fault: FusionFault) {
+        let ended = self.fusion_fault.current().gyro_unisolated && !fault.gyro_unisolated;
+        if ended {
+            self.integrity
+                .on_fault_episode_end(self.fusion_fault.bound_rad());
+        }
+        self.fusion_fault.set(fault);
+    }
+
+    /// The horizontal position is known now (an absolute fix set it, or the solution taken over
+    /// had one), or not.
+    pub fn set_position_known(&mut self, known: bool) {
+        self.integrity.set_position_unknown(!known);
     }
 
     /// Navigates from now on from another filter's solution at device time `t_us`: its nominal
@@ -213,8 +243,8 @@ impl AidedNavigator {
         self.field_reference = None;
         self.reference_from_next_mag = true;
         self.navigating_since_us = Some(t_us);
-        self.integrity =
-            IntegrityMonitor::new(self.config.integrity, self.config.configured_sources());
+        self.integrity = Self::integrity_monitor(&self.config);
+        self.fusion_fault = UnisolatedFaultBound::default();
         self.attitude_recovery = AttitudeRecovery::default();
         self.tilt.reset();
         self.gnss.reset(self.config.gnss);
@@ -336,6 +366,14 @@ impl AidedNavigator {
                         if self.integrity.on_propagated(t_us) {
                             self.attitude_recovery.lose(ekf, &self.config.integrity);
                         }
+                        let widen = self.fusion_fault.on_step(dt_s);
+                        for k in 0..3 {
+                            ekf.inflate_component(crate::ekf::ATT + k, widen);
+                        }
+                        self.integrity.on_fusion_fault(
+                            self.fusion_fault.current().unisolated(),
+                            crate::integrity::attitude_sigma_rad(ekf),
+                        );
                     }
                     // Forward beyond `max_dt_s`: nothing arrived for that long, an outage like
                     // any other; not forward: the device time did not advance.

@@ -20,7 +20,11 @@
 //! - an error standard deviation beyond its limit (tilt, heading, vertical, horizontal);
 //! - a configured aiding source silent (the filter coasts);
 //! - recovering: after an invalid episode or a reset from an aiding source, until
-//!   `recovery_s` has passed and every configured source that reports has been accepted again.
+//!   `recovery_s` has passed and every configured source that reports has been accepted again;
+//! - a fault among the redundant IMU channels that fusion detects but cannot yet isolate; after
+//!   its isolation while the attitude σ it widened is above `fault_attitude_sigma_deg`, and for
+//!   good once the episode integrated more than that (see [`crate::unisolated_fault`]);
+//! - no configured initial position and no absolute fix yet: the horizontal position is unknown.
 //!
 //! **Ok** otherwise. The monitor is allocation-free and works in device time, like the filter.
 
@@ -79,6 +83,11 @@ pub struct IntegrityConfig {
     pub gravity_max_rate_dps: f64,
     /// Re-levelling ends once the tilt σ is below this, degrees.
     pub relevelled_tilt_sigma_deg: f64,
+    /// After a fault fusion could not isolate at once, the integrity stays degraded until every
+    /// attitude error σ is below this (or below its value when the fault was detected, if that
+    /// was larger), degrees: the attitude σ was widened by the error the fault may have left. When
+    /// that error bound itself exceeded this, the integrity stays degraded while the filter runs.
+    pub fault_attitude_sigma_deg: f64,
 }
 
 impl Default for IntegrityConfig {
@@ -101,6 +110,7 @@ impl Default for IntegrityConfig {
             gravity_force_tolerance_mps2: 0.3,
             gravity_max_rate_dps: 10.0,
             relevelled_tilt_sigma_deg: 0.3,
+            fault_attitude_sigma_deg: 1.0,
         }
     }
 }
@@ -144,7 +154,8 @@ impl IntegrityConfig {
             self.gravity_force_tolerance_mps2,
         )?;
         positive("gravity_max_rate_dps", self.gravity_max_rate_dps)?;
-        positive("relevelled_tilt_sigma_deg", self.relevelled_tilt_sigma_deg)
+        positive("relevelled_tilt_sigma_deg", self.relevelled_tilt_sigma_deg)?;
+        positive("fault_attitude_sigma_deg", self.fault_attitude_sigma_deg)
     }
 }
 
@@ -223,6 +234,14 @@ pub struct IntegrityMonitor {
     last: (Integrity, u32),
     /// Resets from each source so far.
     resets: [u64; AidingSource::COUNT],
+    /// Fusion reports a fault it has detected and not isolated (last IMU sample).
+    fault_unisolated: bool,
+    /// Since a fault episode began: the attitude σ (rad) below which the hold after it ends.
+    fault_release_sigma_rad: Option<f64>,
+    /// No initial position was configured and no absolute fix has set one.
+    position_unknown: bool,
+    /// A fault episode left more attitude error than the limit: held degraded for good.
+    fault_latched: bool,
 }
 
 impl IntegrityMonitor {
@@ -241,7 +260,43 @@ impl IntegrityMonitor {
             recovering_since_us: None,
             last: (Integrity::Ok, 0),
             resets: [0; AidingSource::COUNT],
+            fault_unisolated: false,
+            fault_release_sigma_rad: None,
+            position_unknown: false,
+            fault_latched: false,
         }
+    }
+
+    /// Fusion's verdict on the IMU sample being integrated: whether it carries a fault detected
+    /// and not isolated. `attitude_sigma_rad` is the largest attitude error σ now; at the start of
+    /// an episode it sets the level the hold after the episode returns to.
+    pub fn on_fusion_fault(&mut self, unisolated: bool, attitude_sigma_rad: f64) {
+        if unisolated && self.fault_release_sigma_rad.is_none() {
+            let limit = self.config.fault_attitude_sigma_deg.to_radians();
+            self.fault_release_sigma_rad = Some(limit.max(attitude_sigma_rad));
+        }
+        self.fault_unisolated = unisolated;
+    }
+
+    /// A gyro fault episode ended (isolated, or the parity returned) having integrated up to
+    /// `bound_rad` of attitude error. Beyond `fault_attitude_sigma_deg` nothing the navigator
+    /// measures afterwards can be trusted to have found that error: the tilt is weakly observable
+    /// without horizontal aiding, and a gravity re-levelling in flight takes any acceleration for
+    /// tilt. The hold then lasts until the filter starts afresh (a new alignment or a take-over).
+    pub fn on_fault_episode_end(&mut self, bound_rad: f64) {
+        if !(bound_rad <= self.config.fault_attitude_sigma_deg.to_radians()) {
+            self.fault_latched = true;
+        }
+    }
+
+    /// Whether the horizontal position is unknown (no configured origin, no absolute fix yet).
+    pub fn set_position_unknown(&mut self, unknown: bool) {
+        self.position_unknown = unknown;
+    }
+
+    /// The horizontal position is unknown.
+    pub fn position_unknown(&self) -> bool {
+        self.position_unknown
     }
 
     /// The settings the monitor was built with.
@@ -398,6 +453,19 @@ impl IntegrityMonitor {
         if self.covariance_beyond_limits(ekf) {
             degraded |= why::COVARIANCE;
         }
+        if self.fault_unisolated || self.fault_latched {
+            degraded |= why::SENSOR_FAULT_UNISOLATED;
+        } else if let Some(release) = self.fault_release_sigma_rad {
+            // A NaN σ never releases.
+            if attitude_sigma_rad(ekf) <= release {
+                self.fault_release_sigma_rad = None;
+            } else {
+                degraded |= why::SENSOR_FAULT_UNISOLATED;
+            }
+        }
+        if self.position_unknown {
+            degraded |= why::POSITION_UNKNOWN;
+        }
 
         // Leaving an invalid episode starts a recovery; a recovery ends once it has lasted and
         // every source that reports has agreed again.
@@ -444,6 +512,15 @@ impl IntegrityMonitor {
             || over(ekf.sigma(POS + 2), c.max_vertical_sigma_m)
             || over(horizontal, c.max_horizontal_sigma_m)
     }
+}
+
+/// The largest attitude error σ over the three axes, rad (NaN when any is).
+pub fn attitude_sigma_rad(ekf: &ErrorStateEkf) -> f64 {
+    let sigmas = [ATT, ATT + 1, ATT + 2].map(|i| ekf.sigma(i));
+    if sigmas.iter().any(|s| s.is_nan()) {
+        return f64::NAN;
+    }
+    sigmas.into_iter().fold(0.0, f64::max)
 }
 
 /// The reason bit of an inconsistent source.

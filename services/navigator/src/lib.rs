@@ -31,6 +31,7 @@ pub mod stance;
 pub mod state_history;
 pub mod takeover;
 pub mod tilt_aiding;
+pub mod unisolated_fault;
 
 pub use alignment::{AlignConfig, AlignError, Alignment, StaticAligner};
 pub use config::{ConfigError, NavigatorConfig};

@@ -18,7 +18,7 @@
 //! arrived (else the configured altitude, and the first valid reading after alignment then sets it),
 //! velocity zero, heading from the magnetometer when it reported during the window.
 
-use ipc_types::{Integrity, NAV_STATES, NavMode, NavState, aiding};
+use ipc_types::{Integrity, NAV_STATES, NavMode, NavState, aiding, integrity_reason};
 
 use crate::alignment::{AlignError, Alignment};
 use crate::attitude::quaternion_to_array;
@@ -29,6 +29,7 @@ use crate::gnss_updates::{GnssMeasurement, GnssOutcome};
 use crate::inertial_core::AidedNavigator;
 use crate::mechanisation::{NominalState, StepOutcome};
 use crate::takeover::{TakeOverError, peer_solution};
+use crate::unisolated_fault::FusionFault;
 
 /// One navigation solution.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -142,6 +143,8 @@ impl Navigator {
             &sol.covariance_diag,
         );
         self.state_time_us = sol.device_time_us;
+        self.core
+            .set_position_known(peer.integrity_reasons & integrity_reason::POSITION_UNKNOWN == 0);
         self.integrity = self.core.evaluate_integrity();
         Ok(())
     }
@@ -223,6 +226,13 @@ impl Navigator {
         }
         self.integrity = self.core.evaluate_integrity();
         self.core.is_navigating().then(|| self.output())
+    }
+
+    /// Fusion's fault report of the fused sample about to be fed: its flags and rate variance
+    /// (see [`crate::unisolated_fault`]).
+    pub fn on_fusion_status(&mut self, flags: u32, rate_var: [f64; 3]) {
+        self.core
+            .on_fusion_fault(FusionFault::from_fused(flags, rate_var));
     }
 
     /// A fused IMU sample at device time `device_time_us` without a usable solution: nothing is

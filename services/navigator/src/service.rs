@@ -35,6 +35,7 @@ pub fn step(nav: &mut Navigator, imu: &FusedImu, last: &NavState) -> NavState {
     };
     let t_us = imu.header.origin_device_time_us;
     let solution = if fused_sample_usable(imu.flags) {
+        nav.on_fusion_status(imu.flags, imu.rate_var);
         nav.on_imu(t_us, imu.rate_rps, imu.specific_force_mps2)
     } else {
         nav.on_unusable_imu(t_us)

@@ -144,7 +144,8 @@ fn hover(
     fix_at: impl Fn(f64) -> [f64; 2],
 ) -> (AidedNavigator, Vec<(f64, GnssOutcome)>, f64) {
     let mut config = NavigatorConfig {
-        initial_latitude_deg: LAT.to_degrees(),
+        initial_latitude_deg: Some(LAT.to_degrees()),
+        initial_longitude_deg: Some(0.0),
         initial_altitude_m: ALT,
         ..NavigatorConfig::default()
     };

@@ -19,8 +19,8 @@ const YAW_DEG: f64 = 60.0;
 
 fn config() -> NavigatorConfig {
     NavigatorConfig {
-        initial_latitude_deg: 47.0,
-        initial_longitude_deg: 8.0,
+        initial_latitude_deg: Some(47.0),
+        initial_longitude_deg: Some(8.0),
         initial_altitude_m: HEIGHT,
         ..NavigatorConfig::default()
     }
@@ -338,4 +338,92 @@ fn a_gap_in_the_imu_stream_is_an_outage_and_loses_the_attitude() {
     // A short gap, within the strapdown's largest step, is integrated across: nothing to report.
     let out = v.step(&mut nav, 5050).expect("navigating");
     assert_eq!(out.integrity, Integrity::Ok, "{out:?}");
+}
+
+/// A gyro bias fusion detects but cannot isolate: the fused rate carries it and the fused rate
+/// variance carries fusion's bound on it. The integrity is degraded from the first such sample,
+/// and, the episode having integrated more than the 1° limit, stays so after the isolation, so
+/// that no sample with more than the limit of attitude error is called ok.
+#[test]
+fn a_fault_fusion_cannot_isolate_degrades_the_integrity_until_its_error_is_covered() {
+    use ipc_types::fused_flags::GYRO_FAULT_DETECTED_NOT_ISOLATED as UNISOLATED;
+    let mut nav = Navigator::new(config()).unwrap();
+    let (mut v, before) = Vehicle::aligned(&mut nav, 3000);
+    // 0.015 rad/s on the fused roll rate (a 0.02 rad/s channel bias, three quarters of which
+    // reach the solution), unisolated for 2 s: 1.7° of roll error.
+    let bias = 0.015;
+    let quiet_var = [1e-8; 3];
+    let mut first_degraded = None;
+    let mut worst_ok_error_deg: f64 = 0.0;
+    let (mut widest_sigma_deg, mut last_roll_deg) = (0.0f64, f64::NAN);
+    for k in 3001..=12_000u64 {
+        let unisolated = k <= 5000;
+        v.extra_rate = if unisolated {
+            Vector3::new(bias, 0.0, 0.0)
+        } else {
+            Vector3::zeros()
+        };
+        let (flags, var) = if unisolated {
+            (UNISOLATED, [bias * bias + 1e-8; 3])
+        } else {
+            (0, quiet_var)
+        };
+        nav.on_fusion_status(flags, var);
+        let out = v.step(&mut nav, k).expect("navigating");
+        let roll_deg = euler_from_quaternion(&UnitQuaternion::from_quaternion(Quaternion::new(
+            out.quaternion[0],
+            out.quaternion[1],
+            out.quaternion[2],
+            out.quaternion[3],
+        )))[0]
+            .to_degrees();
+        widest_sigma_deg = widest_sigma_deg.max(out.covariance_diag[0].sqrt().to_degrees());
+        last_roll_deg = roll_deg;
+        if out.integrity == Integrity::Ok {
+            worst_ok_error_deg = worst_ok_error_deg.max(roll_deg.abs());
+        } else {
+            assert!(
+                out.integrity_reasons & why::SENSOR_FAULT_UNISOLATED != 0,
+                "{out:?}"
+            );
+            first_degraded.get_or_insert(k);
+        }
+    }
+    assert_eq!(first_degraded, Some(3001), "degraded from the first sample");
+    assert!(worst_ok_error_deg < 1.0, "{worst_ok_error_deg}° while ok");
+    // The episode's 1.7° were added to the attitude σ; more than the limit was integrated, so
+    // the integrity stays degraded for as long as this filter runs.
+    let sigma_before = before.covariance_diag[0].sqrt().to_degrees();
+    assert!(
+        widest_sigma_deg > sigma_before + 0.5,
+        "σ roll {widest_sigma_deg} from {sigma_before}"
+    );
+    let out = nav.output();
+    assert_eq!(out.integrity, Integrity::Degraded, "{out:?}");
+    assert_eq!(
+        out.integrity_reasons,
+        why::SENSOR_FAULT_UNISOLATED,
+        "{out:?}"
+    );
+    assert!(last_roll_deg.is_finite());
+}
+
+/// Without a configured position the horizontal position is a placeholder: never ok.
+#[test]
+fn without_an_initial_position_the_integrity_says_the_position_is_unknown() {
+    let config = NavigatorConfig {
+        initial_latitude_deg: None,
+        initial_longitude_deg: None,
+        ..config()
+    };
+    let mut nav = Navigator::new(config).unwrap();
+    let mut v = Vehicle::new();
+    let mut last = None;
+    for k in 0..=3000 {
+        last = v.step(&mut nav, k);
+    }
+    let last = last.expect("aligned");
+    assert_eq!(last.integrity, Integrity::Degraded, "{last:?}");
+    assert_eq!(last.integrity_reasons, why::POSITION_UNKNOWN, "{last:?}");
+    assert_eq!(last.mode, NavMode::Navigating);
 }

@@ -19,8 +19,8 @@ const BARO_HEIGHT: f64 = 450.0;
 
 fn config() -> NavigatorConfig {
     NavigatorConfig {
-        initial_latitude_deg: 47.0,
-        initial_longitude_deg: 8.0,
+        initial_latitude_deg: Some(47.0),
+        initial_longitude_deg: Some(8.0),
         initial_altitude_m: 400.0,
         declination_deg: 2.0,
         ..NavigatorConfig::default()
@@ -294,19 +294,29 @@ fn output_fills_the_ipc_payload() {
 #[test]
 fn configuration_parses_partially_and_rejects_unknown_or_out_of_range_fields() {
     let parsed: NavigatorConfig =
-        toml::from_str("align_s = 2.0\ninitial_latitude_deg = 47.5\n").unwrap();
+        toml::from_str("align_s = 2.0\ninitial_latitude_deg = 47.5\ninitial_longitude_deg = 8.5\n")
+            .unwrap();
     assert_eq!(parsed.align_s, 2.0);
-    assert_eq!(parsed.initial_latitude_deg, 47.5);
+    assert_eq!(parsed.initial_latitude_deg, Some(47.5));
     assert!(parsed.baro.enabled && parsed.mag.enabled);
     assert!(parsed.validate().is_ok());
     assert!(toml::from_str::<NavigatorConfig>("align_seconds = 2.0\n").is_err());
 
     type Spoil = fn(&mut NavigatorConfig);
-    let cases: [(&str, Spoil); 8] = [
+    let cases: [(&str, Spoil); 10] = [
         ("align_s", |c| c.align_s = -1.0),
-        ("initial_latitude_deg", |c| c.initial_latitude_deg = 91.0),
+        ("initial_latitude_deg", |c| {
+            (c.initial_latitude_deg, c.initial_longitude_deg) = (Some(91.0), Some(0.0))
+        }),
         ("initial_longitude_deg", |c| {
-            c.initial_longitude_deg = f64::NAN
+            (c.initial_latitude_deg, c.initial_longitude_deg) = (Some(0.0), Some(f64::NAN))
+        }),
+        // One of the pair alone is refused, naming it.
+        ("initial_latitude_deg", |c| {
+            c.initial_latitude_deg = Some(47.0)
+        }),
+        ("initial_longitude_deg", |c| {
+            c.initial_longitude_deg = Some(8.0)
         }),
         ("baro.sigma_floor_m", |c| c.baro.sigma_floor_m = 0.0),
         ("max_dt_s", |c| c.max_dt_s = f64::INFINITY),

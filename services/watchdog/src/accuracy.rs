@@ -3,7 +3,7 @@
 
 use nalgebra::{Quaternion, UnitQuaternion};
 
-use crate::horizontal::HorizontalTrack;
+use crate::horizontal::{HorizontalTrack, Position};
 
 /// RMS and largest of a stream of errors.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -59,13 +59,39 @@ pub struct Accuracy {
     pub altitude_m: ErrorStats,
     /// Distance the truth travelled over the ground and the solution's horizontal error.
     pub horizontal: HorizontalTrack,
+    /// Attitude error of the samples whose integrity said ok, degrees: what a user trusting the
+    /// integrity could have been misled by.
+    pub attitude_deg_while_ok: ErrorStats,
+    /// Horizontal position error of the samples whose integrity said ok, m.
+    pub horizontal_m_while_ok: ErrorStats,
+}
+
+/// One navigation sample with the simulator's truth of its frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScoredSample {
+    /// Truth attitude quaternion [w, x, y, z].
+    pub truth_q: [f64; 4],
+    /// Navigation attitude quaternion [w, x, y, z].
+    pub nav_q: [f64; 4],
+    /// Truth position.
+    pub truth: Position,
+    /// Navigation position.
+    pub nav: Position,
+    /// The navigator's integrity of this sample was ok.
+    pub integrity_ok: bool,
 }
 
 impl Accuracy {
-    /// Compares one navigation sample (attitude quaternion, altitude) with the simulator's truth.
-    pub fn push(&mut self, truth_q: [f64; 4], truth_alt: f64, nav_q: [f64; 4], nav_alt: f64) {
-        self.attitude_deg.push(attitude_error_deg(truth_q, nav_q));
-        self.altitude_m.push(nav_alt - truth_alt);
+    /// Compares one navigation sample with the simulator's truth.
+    pub fn push(&mut self, s: &ScoredSample) {
+        let attitude = attitude_error_deg(s.truth_q, s.nav_q);
+        self.attitude_deg.push(attitude);
+        self.altitude_m.push(s.nav.height_m - s.truth.height_m);
+        self.horizontal.push(s.truth, s.nav);
+        if s.integrity_ok {
+            self.attitude_deg_while_ok.push(attitude);
+            self.horizontal_m_while_ok.push(s.truth.distance_to(&s.nav));
+        }
     }
 }
 
@@ -84,6 +110,39 @@ mod tests {
         // q and -q are the same attitude.
         let neg = [-b.w, -b.i, -b.j, -b.k];
         assert!((attitude_error_deg(q(a), neg) - 0.5).abs() < 1e-9);
+    }
+
+    #[test]
+    fn errors_while_ok_count_only_the_samples_the_integrity_called_ok() {
+        let level = [1.0, 0.0, 0.0, 0.0];
+        let tilted = UnitQuaternion::from_euler_angles(2f64.to_radians(), 0.0, 0.0);
+        let at = |lat_rad| Position {
+            lat_rad,
+            lon_rad: 0.0,
+            height_m: 0.0,
+        };
+        let mut acc = Accuracy::default();
+        // 2° and ~64 m off while degraded, 0.5° and no position error while ok.
+        acc.push(&ScoredSample {
+            truth_q: level,
+            nav_q: [tilted.w, tilted.i, tilted.j, tilted.k],
+            truth: at(0.0),
+            nav: at(1e-5),
+            integrity_ok: false,
+        });
+        let small = UnitQuaternion::from_euler_angles(0.0, 0.5f64.to_radians(), 0.0);
+        acc.push(&ScoredSample {
+            truth_q: level,
+            nav_q: [small.w, small.i, small.j, small.k],
+            truth: at(0.0),
+            nav: at(0.0),
+            integrity_ok: true,
+        });
+        assert!((acc.attitude_deg.max().unwrap() - 2.0).abs() < 1e-9);
+        assert!((acc.attitude_deg_while_ok.max().unwrap() - 0.5).abs() < 1e-9);
+        assert!(acc.horizontal.errors().max().unwrap() > 60.0);
+        assert_eq!(acc.horizontal_m_while_ok.max(), Some(0.0));
+        assert_eq!(acc.attitude_deg_while_ok.count(), 1);
     }
 
     #[test]

@@ -10,7 +10,7 @@ use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{IpcNode, TopicSubscriber};
 use rins_runtime::nav_subscriber::NavSubscriber;
 
-use crate::accuracy::Accuracy;
+use crate::accuracy::{Accuracy, ScoredSample};
 use crate::fault_tracking::FaultTracker;
 use crate::horizontal::Position;
 use crate::link::LinkRate;
@@ -291,24 +291,21 @@ impl Monitor {
                 sigma,
             );
             if known {
-                self.accuracy.push(
-                    truth.quaternion,
-                    truth.altitude_m,
-                    nav.quaternion,
-                    nav.altitude_m,
-                );
-                self.accuracy.horizontal.push(
-                    Position {
+                self.accuracy.push(&ScoredSample {
+                    truth_q: truth.quaternion,
+                    nav_q: nav.quaternion,
+                    truth: Position {
                         lat_rad: truth.latitude_rad,
                         lon_rad: truth.longitude_rad,
                         height_m: truth.altitude_m,
                     },
-                    Position {
+                    nav: Position {
                         lat_rad: nav.latitude_rad,
                         lon_rad: nav.longitude_rad,
                         height_m: nav.altitude_m,
                     },
-                );
+                    integrity_ok: integrity == Integrity::Ok,
+                });
             }
         }
         self.last_nav = Some(nav);

@@ -26,13 +26,35 @@ pub fn redundancy_of(fused: &FusedImu, age_ms: u32) -> RedundancyReport {
     }
 }
 
-/// The report fields of a navigation sample that is `age_ms` old.
+/// A navigation sample older than this means the output stopped (it flows at the IMU rate, and the
+/// two lanes cover each other's restarts): from then on the report says so instead of repeating
+/// the last sample's mode.
+pub const NAV_OUTPUT_STALE_MS: u32 = 1000;
+
+/// Whether a navigation sample `age_ms` old still shows the output flowing.
+pub fn nav_output_flowing(age_ms: u32) -> bool {
+    age_ms <= NAV_OUTPUT_STALE_MS
+}
+
+/// The report fields of a navigation sample that is `age_ms` old. Once it is older than
+/// [`NAV_OUTPUT_STALE_MS`] there is no solution to use: the mode and integrity are reported
+/// invalid, whatever the last sample said, so that no reader of the report takes a stopped
+/// output for a navigating one.
 pub fn nav_of(nav: &NavState, age_ms: u32) -> NavReport {
+    let flowing = nav_output_flowing(age_ms);
     NavReport {
         heard: 1,
-        mode: nav.mode,
+        mode: if flowing {
+            nav.mode
+        } else {
+            NavMode::Invalid as u8
+        },
         lane: nav.lane,
-        integrity: nav.integrity,
+        integrity: if flowing {
+            nav.integrity
+        } else {
+            Integrity::Invalid as u8
+        },
         aiding: nav.aiding,
         integrity_reasons: nav.integrity_reasons,
         age_ms,
@@ -99,6 +121,8 @@ pub struct NavView {
     pub stale: Vec<&'static str>,
     /// Age of the navigation sample, ms.
     pub age_ms: u32,
+    /// The navigation output flows: its last sample is at most [`NAV_OUTPUT_STALE_MS`] old.
+    pub output_flowing: bool,
 }
 
 fn sensor_arrays(r: &RedundancyReport, sensor: SensorType) -> (&[u8], &[u8]) {
@@ -211,7 +235,15 @@ pub fn redundancy_view(r: &RedundancyReport) -> Option<RedundancyView> {
 
 /// The navigation mode with what it coasts without, the lane and the aiding sources:
 /// `navigating, lane 0, aiding baro+mag`, `coasting: baro stale, lane 1, aiding mag`.
+/// A report whose sample is older than [`NAV_OUTPUT_STALE_MS`] reads `no navigation output for
+/// 3.2 s`.
 pub fn nav_summary(n: &NavReport) -> String {
+    if !nav_output_flowing(n.age_ms) {
+        return format!(
+            "no navigation output for {:.1} s",
+            f64::from(n.age_ms) * 1e-3
+        );
+    }
     let mode =
         NavMode::from_u8(n.mode).map_or_else(|| format!("mode {}", n.mode), |m| m.name().into());
     let mut out = mode;
@@ -249,6 +281,7 @@ pub fn nav_view(n: &NavReport) -> Option<NavView> {
         aiding: bit_names(n.aiding, &aiding::SOURCE_NAMES),
         stale: bit_names(n.aiding, &aiding::STALE_NAMES),
         age_ms: n.age_ms,
+        output_flowing: nav_output_flowing(n.age_ms),
     })
 }
 
@@ -266,6 +299,34 @@ mod tests {
         f.gyro_state[..4].fill(ChannelState::Ok as u8);
         f.accel_state[..4].fill(ChannelState::Ok as u8);
         f
+    }
+
+    /// A stopped output is not shown as the last sample's mode: not "navigating" once the newest
+    /// sample is older than a second, in the summary, the view and the report itself.
+    #[test]
+    fn a_stopped_navigation_output_is_reported_as_such() {
+        let nav = NavState {
+            mode: NavMode::Navigating as u8,
+            integrity: Integrity::Ok as u8,
+            aiding: aiding::BARO,
+            ..NavState::default()
+        };
+        let fresh = nav_of(&nav, NAV_OUTPUT_STALE_MS);
+        assert_eq!(nav_summary(&fresh), "navigating, lane 0, aiding baro");
+        assert!(nav_view(&fresh).expect("heard").output_flowing);
+        let stopped = nav_of(&nav, 3200);
+        assert_eq!(NavMode::from_u8(stopped.mode), Some(NavMode::Invalid));
+        assert_eq!(
+            Integrity::from_u8(stopped.integrity),
+            Some(Integrity::Invalid)
+        );
+        assert_eq!(nav_summary(&stopped), "no navigation output for 3.2 s");
+        let view = nav_view(&stopped).expect("heard");
+        assert!(!view.output_flowing);
+        assert_eq!(
+            (view.mode.as_str(), view.integrity.as_str()),
+            ("invalid", "invalid")
+        );
     }
 
     #[test]

@@ -40,7 +40,13 @@ pub fn status_line(
     if redundancy.heard != 0 {
         line.push_str(&format!(" | {}", redundancy_summary(redundancy)));
     }
+    // No sample over the last period: the output stopped, whatever the last sample said.
+    let nav_flowing = COUNTED
+        .iter()
+        .zip(rates_hz)
+        .any(|(name, rate)| *name == "nav" && *rate > 0.0);
     match nav {
+        Some(_) if !nav_flowing => line.push_str(" | no navigation output"),
         Some(nav) => {
             let [r, p, y] = euler_deg(nav.quaternion);
             let mode = NavMode::from_u8(nav.mode);
@@ -138,6 +144,26 @@ mod tests {
                 && line.contains("integrity INVALID: imu-unusable,covariance"),
             "{line}"
         );
+        assert!(!line.contains("navigating"), "{line}");
+    }
+
+    /// The last sample said navigating, but none came over the period: the line says the output
+    /// stopped, not "navigating" beside `nav 0/s`.
+    #[test]
+    fn a_stopped_navigation_output_is_not_shown_as_navigating() {
+        let nav = NavState {
+            mode: NavMode::Navigating as u8,
+            ..NavState::default()
+        };
+        let line = status_line(
+            9.0,
+            &[1000.0, 50.0, 100.0, 0.0, 50.0, 0.0],
+            0,
+            &DeviceCounters::default(),
+            &RedundancyReport::default(),
+            Some(&nav),
+        );
+        assert!(line.ends_with("| no navigation output"), "{line}");
         assert!(!line.contains("navigating"), "{line}");
     }
 

@@ -70,6 +70,9 @@ pub struct Summary {
     pub nav_samples: u64,
     /// Child restarts.
     pub restarts: u64,
+    /// The services given up during the run (over their restart limit, or failing every start):
+    /// their stage was down when the run ended.
+    pub failed_services: Vec<String>,
     /// Longest time from a child's exit to the first sample of its output topic from its
     /// successor, ms, and how many restarts were timed so (0 and 0 without restarts).
     pub restart_to_publish_ms_max: f64,
@@ -92,6 +95,10 @@ pub struct Summary {
     /// Largest attitude error, degrees (simulator only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub att_err_deg_max: Option<f64>,
+    /// Largest attitude error while the navigator's integrity said ok, degrees (simulator only;
+    /// `None` when no sample was ok).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub att_err_deg_max_while_ok: Option<f64>,
     /// Altitude error against simulator truth after alignment, metres (simulator mode only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub alt_err_m_rms: Option<f64>,
@@ -105,6 +112,10 @@ pub struct Summary {
     /// Largest horizontal position error, m (simulator only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub horiz_pos_err_m_max: Option<f64>,
+    /// Largest horizontal position error while the navigator's integrity said ok, m (simulator
+    /// only; `None` when no sample was ok).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub horiz_err_m_max_while_ok: Option<f64>,
     /// Largest step of the horizontal solution from one sample to the next that the truth's
     /// motion does not explain, m (simulator only): what an accepted bad fix would show.
     #[serde(skip_serializing_if = "Option::is_none")]

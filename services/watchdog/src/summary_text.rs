@@ -10,6 +10,12 @@ pub fn summary_text(s: &Summary) -> String {
         "summary: {:.1} s, {} IMU frames, {} dropped, {} lost on the line, {} CRC errors, {} restarts, {} shared-memory entries left\n",
         s.duration_s, s.frames, s.dropped, s.lost_frames, s.crc_errors, s.restarts, s.shm_leaked
     );
+    if !s.failed_services.is_empty() {
+        out.push_str(&format!(
+            "  FAILED: {} given up (restarts kept failing); the stage was down at the end\n",
+            s.failed_services.join(", ")
+        ));
+    }
     if !s.processes.is_empty() {
         let peak: u64 = s.processes.iter().map(|p| p.peak_rss_kib).sum();
         out.push_str(&format!(
@@ -21,8 +27,11 @@ pub fn summary_text(s: &Summary) -> String {
         ));
     }
     if let (Some(rms), Some(max)) = (s.att_err_deg_rms, s.att_err_deg_max) {
+        let while_ok = s.att_err_deg_max_while_ok.map_or_else(String::new, |ok| {
+            format!(" (max {ok:.2}° while integrity ok)")
+        });
         out.push_str(&format!(
-            "  attitude error after alignment: RMS {rms:.2}°, max {max:.2}°\n"
+            "  attitude error after alignment: RMS {rms:.2}°, max {max:.2}°{while_ok}\n"
         ));
     }
     if let (Some(rms), Some(max)) = (s.alt_err_m_rms, s.alt_err_m_max) {
@@ -31,8 +40,11 @@ pub fn summary_text(s: &Summary) -> String {
         ));
     }
     if let (Some(rms), Some(max)) = (s.horiz_pos_err_m_rms, s.horiz_pos_err_m_max) {
+        let while_ok = s.horiz_err_m_max_while_ok.map_or_else(String::new, |ok| {
+            format!(" (max {ok:.2} m while integrity ok)")
+        });
         out.push_str(&format!(
-            "  horizontal position error after alignment: RMS {rms:.2} m, max {max:.2} m\n"
+            "  horizontal position error after alignment: RMS {rms:.2} m, max {max:.2} m{while_ok}\n"
         ));
     }
     if let (Some(err), Some(distance)) = (s.horiz_end_err_m, s.distance_m) {
@@ -100,6 +112,7 @@ mod tests {
             last_decode_error: "none".into(),
             nav_samples: 0,
             restarts: 0,
+            failed_services: Vec::new(),
             restart_to_publish_ms_max: 0.0,
             restart_measurements: 0,
             restart_to_publish_ms_by_service: Vec::new(),
@@ -109,10 +122,12 @@ mod tests {
             nav_integrity_samples: Default::default(),
             att_err_deg_rms: Some(1.5),
             att_err_deg_max: Some(2.38),
+            att_err_deg_max_while_ok: Some(0.61),
             alt_err_m_rms: None,
             alt_err_m_max: None,
             horiz_pos_err_m_rms: Some(0.84),
             horiz_pos_err_m_max: Some(1.3),
+            horiz_err_m_max_while_ok: Some(0.9),
             horiz_step_m_max: Some(0.2),
             distance_m: Some(125.8),
             horiz_end_err_m: Some(1.11),
@@ -134,7 +149,13 @@ mod tests {
             "{text}"
         );
         assert!(
-            text.contains("attitude error after alignment: RMS 1.50°, max 2.38°"),
+            text.contains(
+                "attitude error after alignment: RMS 1.50°, max 2.38° (max 0.61° while integrity ok)"
+            ),
+            "{text}"
+        );
+        assert!(
+            text.contains("RMS 0.84 m, max 1.30 m (max 0.90 m while integrity ok)"),
             "{text}"
         );
         assert!(!text.contains("altitude"), "{text}");
@@ -156,6 +177,24 @@ mod tests {
         let text = summary_text(&s);
         assert!(
             text.contains("horizontal end-point error: 0.20 m, 0.0 m travelled"),
+            "{text}"
+        );
+    }
+
+    /// A service given up is the summary's second line, by name, and absent otherwise.
+    #[test]
+    fn a_service_given_up_is_named_as_failed() {
+        let ok = summary_text(&summary());
+        assert!(!ok.contains("FAILED"), "{ok}");
+        let text = summary_text(&Summary {
+            failed_services: vec!["fusion".into()],
+            ..summary()
+        });
+        assert_eq!(
+            text.lines().nth(1),
+            Some(
+                "  FAILED: fusion given up (restarts kept failing); the stage was down at the end"
+            ),
             "{text}"
         );
     }

@@ -18,7 +18,7 @@ use crate::output_deadline::OutputDeadline;
 use crate::restart_policy::GiveUp;
 use crate::restart_timing::RestartTiming;
 use crate::status::status_line;
-use crate::supervisor::{ChildEvent, Supervisor};
+use crate::supervisor::{ChildEvent, FAILED_STARTS_LIMIT, Supervisor};
 
 /// Period of the supervision loop: topics drained and children checked this often. Each turn
 /// wakes the watchdog and asks every topic and child; at 1 ms that was the pipeline's largest CPU
@@ -131,12 +131,25 @@ fn on_child_event(
             exits,
             window,
             action,
+            failed_starts,
         } => {
-            let why = format!(
-                "{name} exited ({status}) {exits} times within {:.0} s, more than \
-                 watchdog.max_restarts allows (watchdog.services.{name} may raise it)",
-                window.as_secs_f64()
-            );
+            let mut why = if failed_starts >= FAILED_STARTS_LIMIT {
+                format!(
+                    "{name} failed to start {failed_starts} times in a row (last: {status}); its \
+                     own error is above"
+                )
+            } else {
+                format!(
+                    "{name} exited ({status}) {exits} times within {:.0} s, more than \
+                     watchdog.max_restarts allows (watchdog.services.{name} may raise it)",
+                    window.as_secs_f64()
+                )
+            };
+            // A damaged management segment makes every node creation fail: said here too, with
+            // the file, whatever the child managed to print.
+            if let Err(e) = rins_runtime::ipc::mgmt_segment::check(settings) {
+                why.push_str(&format!(". {e}"));
+            }
             if let Err(e) = rins_runtime::ipc::remove_dead_nodes(settings) {
                 tracing::warn!(error = %ErrorChain(&e), "cannot clean up dead nodes");
             }

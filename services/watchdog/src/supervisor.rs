@@ -11,6 +11,13 @@ use anyhow::{Context, Result};
 use crate::process_usage::{ProcessUsage, UsageTracker, ticks_per_second};
 use crate::restart_policy::{GiveUp, RestartPolicy, RestartWindow};
 
+/// Starts in a row that failed — the child exited by itself with an error before it ran
+/// [`RestartPolicy::stable_after`] — after which the child is given up even within its restart
+/// limit. With the backoff capped at a few seconds, a child that can never start (its node cannot
+/// be created, say) would otherwise be restarted for ever without reaching the limit, and its
+/// stage would be down with nothing but a restart count to show for it.
+pub const FAILED_STARTS_LIMIT: u32 = 5;
+
 /// How to start one child, and how to restart it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChildSpec {
@@ -37,6 +44,8 @@ struct Managed {
     restarts: u64,
     window: RestartWindow,
     given_up: bool,
+    /// Starts in a row that failed (see [`FAILED_STARTS_LIMIT`]).
+    failed_starts: u32,
 }
 
 /// Every running child (name, pid) and this process as `watchdog`. A child is listed only while
@@ -99,6 +108,9 @@ pub enum ChildEvent {
         window: Duration,
         /// What giving up does.
         action: GiveUp,
+        /// Starts in a row that failed; [`FAILED_STARTS_LIMIT`] of them give the child up even
+        /// within its restart limit.
+        failed_starts: u32,
     },
 }
 
@@ -141,6 +153,7 @@ impl Supervisor {
             restart_at: None,
             restarts: 0,
             given_up: false,
+            failed_starts: 0,
         });
         Ok(pid)
     }
@@ -154,7 +167,17 @@ impl Supervisor {
                     Ok(Some(status)) => {
                         m.child = None;
                         let policy = &m.spec.policy;
-                        if !m.window.allow_restart(now) {
+                        // Killed by a signal (a kill storm, a hung child's SIGKILL) is no failure
+                        // of the start itself.
+                        let failed_start = now - m.started_at < policy.stable_after
+                            && status.code().is_some_and(|code| code != 0);
+                        m.failed_starts = if failed_start {
+                            m.failed_starts.saturating_add(1)
+                        } else {
+                            0
+                        };
+                        let within_limit = m.window.allow_restart(now);
+                        if !within_limit || m.failed_starts >= FAILED_STARTS_LIMIT {
                             m.given_up = true;
                             events.push(ChildEvent::GaveUp {
                                 name: m.spec.name.clone(),
@@ -162,6 +185,7 @@ impl Supervisor {
                                 exits: m.window.exits(),
                                 window: policy.window,
                                 action: policy.give_up,
+                                failed_starts: m.failed_starts,
                             });
                             continue;
                         }
@@ -200,6 +224,15 @@ impl Supervisor {
                 }
             }
         }
+    }
+
+    /// The children given up (over their restart limit, or failing every start), by name.
+    pub fn given_up(&self) -> Vec<String> {
+        self.children
+            .iter()
+            .filter(|m| m.given_up)
+            .map(|m| m.spec.name.clone())
+            .collect()
     }
 
     /// Restarts of every child so far.

@@ -74,6 +74,7 @@ fn a_crashing_child_is_restarted_up_to_its_limit_then_given_up() {
             exits,
             window,
             action,
+            failed_starts,
         }) => {
             assert_eq!(name, "altimeter");
             assert!(status.contains('3'), "{status}");
@@ -81,6 +82,8 @@ fn a_crashing_child_is_restarted_up_to_its_limit_then_given_up() {
                 (*exits, *window, *action),
                 (3, Duration::from_secs(60), GiveUp::LeaveDown)
             );
+            // Three failed starts are fewer than the limit: the restart limit gave it up.
+            assert_eq!(*failed_starts, 3);
         }
         other => panic!("the last event should be the give-up: {other:?}"),
     }
@@ -103,6 +106,66 @@ fn a_crashing_child_is_restarted_up_to_its_limit_then_given_up() {
     assert_eq!(supervisor.running().len(), 1);
     supervisor.stop_all(Duration::from_secs(2));
     assert!(supervisor.running().is_empty());
+}
+
+/// A child whose every start fails (it exits with an error at once) is given up after
+/// `FAILED_STARTS_LIMIT` starts, well within a restart limit that its growing backoff would take
+/// minutes to reach, if ever; one killed by signals as often is restarted on.
+#[test]
+fn a_child_failing_every_start_is_given_up_but_one_killed_by_signals_is_not() {
+    use rins_watchdog::supervisor::FAILED_STARTS_LIMIT;
+    let mut supervisor = Supervisor::new();
+    supervisor
+        .start(shell("fusion", "exit 1", RestartPolicy::default()))
+        .expect("start the failing child");
+    supervisor
+        .start(shell("altimeter", "kill -9 $$", RestartPolicy::default()))
+        .expect("start the killed child");
+    let started = Instant::now();
+    let events = poll_until(&mut supervisor, gave_up);
+    assert!(started.elapsed() < Duration::from_secs(5), "{events:?}");
+    let given_up: Vec<_> = events
+        .iter()
+        .filter_map(|e| match e {
+            ChildEvent::GaveUp {
+                name,
+                status,
+                exits,
+                failed_starts,
+                action,
+                ..
+            } => Some((
+                name.as_str(),
+                status.as_str(),
+                *exits,
+                *failed_starts,
+                *action,
+            )),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        given_up,
+        vec![(
+            "fusion",
+            "exit status: 1",
+            FAILED_STARTS_LIMIT as usize,
+            FAILED_STARTS_LIMIT,
+            GiveUp::Shutdown
+        )],
+        "{events:?}"
+    );
+    // The other goes on being restarted after as many deaths by SIGKILL.
+    let events = poll_until(&mut supervisor, |events| {
+        events
+            .iter()
+            .filter(|e| matches!(e, ChildEvent::Restarted { name, .. } if name == "altimeter"))
+            .count()
+            > FAILED_STARTS_LIMIT as usize
+    });
+    assert!(!gave_up(&events), "{events:?}");
+    assert_eq!(supervisor.given_up(), vec!["fusion".to_string()]);
+    supervisor.stop_all(Duration::from_secs(2));
 }
 
 #[test]

@@ -3,6 +3,8 @@
 //!
 //! - [`mc`]: Monte Carlo comparison of the redundant skewed block with an orthogonal triad built
 //!   from the same sensors, with and without a dead gyro channel.
+//! - [`fault_sweep`]: one fault per run injected into the configured chain in flight: detection,
+//!   isolation, and the attitude error while the navigator's integrity said ok.
 //! - [`fdi`]: fault detection and isolation on the real quadrotor recordings (false alarms, and
 //!   faults injected into the data).
 //! - [`datasets`]: loaders of recorded data sets (the four-IMU quadrotor flights).
@@ -13,6 +15,7 @@
 //! - [`stats`]: mean, 2σ and RMS helpers.
 
 pub mod datasets;
+pub mod fault_sweep;
 pub mod fdi;
 pub mod foot;
 pub mod installation;

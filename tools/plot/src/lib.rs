@@ -34,6 +34,8 @@ pub struct PlotReport {
     pub skipped: Vec<(String, String)>,
     /// Messages the reader skipped as damaged.
     pub damaged_messages: u64,
+    /// Chunks the reader skipped as damaged (their messages are lost, and not counted above).
+    pub damaged_chunks: u64,
     /// Where reading stopped early (a cut-off file), if it did.
     pub damage: Option<String>,
 }
@@ -102,10 +104,8 @@ pub fn plot_recording(
 ) -> Result<PlotReport, PlotError> {
     prepare_output(out)?;
     progress(&format!("reading {}", path.display()));
-    let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    // A regular file of bounded size: a FIFO, a device or a directory is refused at once.
+    let bytes = rins_recording::read_file_bytes(path)?;
     let mut messages = Messages::new(&bytes, &path.display().to_string())?;
     let mut collector = Collector::default();
     let mut count = 0u64;
@@ -118,6 +118,7 @@ pub fn plot_recording(
     }
     let mut report = PlotReport {
         damaged_messages: messages.skipped_count(),
+        damaged_chunks: messages.damaged_chunk_count(),
         damage: messages.damage().map(str::to_string),
         ..PlotReport::default()
     };

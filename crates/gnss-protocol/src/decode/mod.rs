@@ -1,24 +1,23 @@
 //! The receiver's byte stream → one [`GnssFix`] per receiver epoch.
 //!
-//! A u-blox receiver may send UBX frames and NMEA sentences on the same line; the `ublox` crate's
-//! parser finds both (and skips what is neither), the `nmea` crate parses the sentences. Parsing
-//! is the crates' work; this module assembles epochs, checks that the values are plausible (a
-//! valid checksum does not make a latitude of 400° sane), and counts everything it set aside.
+//! A u-blox receiver may send UBX frames and NMEA sentences on the same line; [`framer`] finds
+//! both (and skips what is neither), the `ublox` crate reads the frames, the `nmea` crate the
+//! sentences. This module assembles epochs, checks that the values are plausible (a valid
+//! checksum does not make a latitude of 400° sane), and counts everything it set aside.
 
+pub mod framer;
 mod nmea_epoch;
 mod sanity;
 mod ubx_pvt;
 
+use framer::{Framed, Framer};
 use ipc_types::{GnssFix, Stage};
+use ublox::UbxProtocol;
 use ublox::proto23::{PacketRef, Proto23};
-use ublox::{AnyPacketRef, FixedBuffer, Parser, UbxPacket};
 
 pub use nmea_epoch::{NmeaEpoch, SentenceOutcome};
 pub use sanity::is_plausible;
 pub use ubx_pvt::fix_from_nav_pvt;
-
-/// Bytes handed to the UBX/NMEA framer at a time (its buffer holds the unfinished rest).
-const CHUNK: usize = 256;
 
 /// What the decoder took in and set aside since it started.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -35,7 +34,8 @@ pub struct GnssDecoderStats {
     pub unparsable: u64,
     /// Well-formed messages of other kinds (GSV, GSA, other UBX classes): passed by.
     pub unsupported: u64,
-    /// Messages whose values are out of range or not numbers: not used.
+    /// Messages whose values are out of range or not numbers, and UBX headers declaring a length
+    /// no accepted message has (see [`framer::MAX_UBX_PAYLOAD`]): not used.
     pub malformed: u64,
     /// Epochs published.
     pub epochs: u64,
@@ -44,22 +44,12 @@ pub struct GnssDecoderStats {
 }
 
 /// Streaming decoder of a GNSS receiver's output. Allocation-free.
+#[derive(Default)]
 pub struct GnssDecoder {
-    framer: Parser<FixedBuffer<1024>, Proto23>,
+    framer: Framer,
     nmea: NmeaEpoch,
     seq: u64,
     stats: GnssDecoderStats,
-}
-
-impl Default for GnssDecoder {
-    fn default() -> Self {
-        Self {
-            framer: Parser::with_fixed_buffer(),
-            nmea: NmeaEpoch::default(),
-            seq: 0,
-            stats: GnssDecoderStats::default(),
-        }
-    }
 }
 
 impl GnssDecoder {
@@ -96,11 +86,10 @@ impl GnssDecoder {
             }
             on_epoch(fix);
         };
-        for chunk in bytes.chunks(CHUNK) {
-            let mut packets = framer.consume_ubx_rtcm_nmea(chunk);
-            while let Some(packet) = packets.next() {
-                match packet {
-                    Ok(AnyPacketRef::Ubx(UbxPacket::Proto23(PacketRef::NavPvt(pvt)))) => {
+        framer.push(bytes, |item| match item {
+            Framed::Ubx { class, id, payload } => {
+                match <Proto23 as UbxProtocol>::match_packet(class, id, payload) {
+                    Ok(PacketRef::NavPvt(pvt)) => {
                         let fix = fix_from_nav_pvt(&pvt);
                         if is_plausible(&fix) {
                             stats.ubx_frames += 1;
@@ -109,23 +98,24 @@ impl GnssDecoder {
                             stats.malformed += 1;
                         }
                     }
-                    Ok(AnyPacketRef::Nmea(sentence)) => match nmea.push(sentence.data) {
-                        SentenceOutcome::Used(done) => {
-                            stats.sentences += 1;
-                            if let Some(fix) = done {
-                                emit(fix, stats);
-                            }
-                        }
-                        SentenceOutcome::Checksum => stats.checksum_errors += 1,
-                        SentenceOutcome::Unparsable => stats.unparsable += 1,
-                        SentenceOutcome::Unsupported => stats.unsupported += 1,
-                        SentenceOutcome::Malformed => stats.malformed += 1,
-                    },
                     Ok(_) => stats.unsupported += 1,
-                    Err(ublox::ParserError::InvalidChecksum { .. }) => stats.checksum_errors += 1,
                     Err(_) => stats.unparsable += 1,
                 }
             }
-        }
+            Framed::UbxChecksum => stats.checksum_errors += 1,
+            Framed::UbxBadLength => stats.malformed += 1,
+            Framed::Nmea(sentence) => match nmea.push(sentence) {
+                SentenceOutcome::Used(done) => {
+                    stats.sentences += 1;
+                    if let Some(fix) = done {
+                        emit(fix, stats);
+                    }
+                }
+                SentenceOutcome::Checksum => stats.checksum_errors += 1,
+                SentenceOutcome::Unparsable => stats.unparsable += 1,
+                SentenceOutcome::Unsupported => stats.unsupported += 1,
+                SentenceOutcome::Malformed => stats.malformed += 1,
+            },
+        });
     }
 }

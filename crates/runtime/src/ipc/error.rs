@@ -108,6 +108,19 @@ pub enum IpcError {
         /// iceoryx2's error.
         source: ConfigCreationError,
     },
+    /// iceoryx2's management segment of the deployment cannot be used (or made owner-only).
+    #[error(
+        "{}: iceoryx2's management segment of this deployment {problem}; no node can be created \
+         on it. Stop every process of the deployment and remove the file (`rins up` removes it at \
+         start when no process of the deployment is alive)",
+        path.display()
+    )]
+    ManagementSegment {
+        /// The segment's file.
+        path: PathBuf,
+        /// What was found.
+        problem: String,
+    },
     /// The node name is not one iceoryx2 accepts.
     #[error("node name {name:?}")]
     NodeName {

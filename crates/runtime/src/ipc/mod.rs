@@ -5,6 +5,7 @@
 mod config_file;
 mod env;
 mod error;
+pub mod mgmt_segment;
 mod node;
 pub mod own_ports;
 mod settings;

@@ -70,6 +70,10 @@ pub fn create_node(name: &str, settings: &IpcSettings) -> Result<IpcNode, IpcErr
         name: name.to_string(),
         source,
     })?;
+    // The deployment's management segment: made owner-only before iceoryx2 would make it
+    // writable by everyone; a damaged one is refused here, naming it, rather than retried.
+    install_global_config(settings, &config)?;
+    super::mgmt_segment::prepare(settings, &config)?;
     // Creating a node also cleans up dead nodes, and so does the watchdog after a child died:
     // when two processes clean up the same dead node at the same moment, one of them can fail
     // (an internal error, or files of the root vanishing under it). A few short retries let the

@@ -55,6 +55,10 @@ pub struct FdiConfig {
     /// Averaging length of the parity offset estimate, samples (0: no offset estimate; see
     /// [`super::offset`]).
     pub parity_offset_window: u32,
+    /// Averaging length of the mean-shift test, samples (0: off; see [`super::mean_shift`]):
+    /// finds biases too small for the per-sample test, at the same false-alarm probability per
+    /// window.
+    pub mean_shift_window: u32,
     /// Learning phase at start, samples: the parity offset (and the adaptive noise) are learnt,
     /// parity declarations are suspended. Ignored when neither estimate is in use.
     pub learning_samples: u32,
@@ -91,9 +95,9 @@ pub struct FdiConfig {
     /// Samples in a row an excluded channel must be valid, off the converter rails, varying and
     /// consistent with the others before it returns by itself.
     pub readmit_after_samples: u32,
-    /// Fused samples a channel re-admitted by command must stay in the solution before the
-    /// command is answered `readmitted`; excluded again within them, the answer is
-    /// `fault-still-present`.
+    /// Samples a channel re-admitted by command is tested against the other channels, out of the
+    /// solution, before it rejoins and the command is answered `readmitted`; failing a test, it
+    /// stays excluded and the answer is `fault-still-present` (see [`super::probation`]).
     pub readmit_probation_samples: u32,
 }
 
@@ -109,6 +113,7 @@ impl Default for FdiConfig {
             parity_noise: ParityNoise::Configured,
             adaptive_window: 10_000,
             parity_offset_window: 60_000,
+            mean_shift_window: 200,
             learning_samples: 1_000,
             saturation_samples: 5,
             stuck_samples: 20,
@@ -143,6 +148,10 @@ pub struct FdiSettings {
     pub adaptive_window: u32,
     /// 0: no offset estimate.
     pub parity_offset_window: u32,
+    /// 0: no mean-shift test.
+    pub mean_shift_window: u32,
+    /// χ² threshold of the mean-shift test for each parity dimension (index m; entry 0 unused).
+    pub mean_shift_thresholds: [f64; MAX_PARITY + 1],
     /// Length of the learning phase (0 when neither the offset nor the adaptive noise is on).
     pub learning_samples: u32,
     /// Thresholds of the per-channel health checks.
@@ -161,6 +170,9 @@ pub struct FdiSettings {
     pub readmit: ReadmitPolicy,
     /// Samples in a row an excluded channel must pass every check before it returns by itself.
     pub readmit_after_samples: u32,
+    /// Samples a channel re-admitted by command is tested against the others, out of the
+    /// solution, before it rejoins (see [`super::probation`]).
+    pub readmit_probation_samples: u32,
     /// Per-sample exceedance probability α₁ behind the thresholds.
     pub exceedance_probability: f64,
     /// χ² threshold for each parity dimension (index m; entry 0 unused).
@@ -220,6 +232,16 @@ impl FdiConfig {
         for (m, t) in thresholds.iter_mut().enumerate().skip(1) {
             *t = chi2_upper_quantile(m, alpha1)
                 .map_err(|e| ConfigError::new("false_alarm_probability", alpha, e.to_string()))?;
+        }
+        // One mean-shift test per window is an independent try: the configured probability
+        // applies to it as it stands.
+        let mut mean_shift_thresholds = [f64::INFINITY; MAX_PARITY + 1];
+        for (m, t) in mean_shift_thresholds.iter_mut().enumerate().skip(1) {
+            *t = chi2_upper_quantile(m, alpha)
+                .map_err(|e| ConfigError::new("false_alarm_probability", alpha, e.to_string()))?;
+        }
+        if self.mean_shift_window != 0 {
+            at_least("mean_shift_window", self.mean_shift_window, 10)?;
         }
         if !(self.isolation_margin.is_finite() && self.isolation_margin >= 0.0) {
             return Err(ConfigError::new(
@@ -291,6 +313,7 @@ impl FdiConfig {
         Ok(FdiSettings {
             readmit: self.readmit,
             readmit_after_samples: self.readmit_after_samples,
+            readmit_probation_samples: self.readmit_probation_samples,
             motion_noise_fraction: self.motion_noise_fraction,
             timing_skew_samples: 0.0,
             persistence_k: k,
@@ -299,6 +322,8 @@ impl FdiConfig {
             parity_noise: self.parity_noise,
             adaptive_window: self.adaptive_window,
             parity_offset_window: self.parity_offset_window,
+            mean_shift_window: self.mean_shift_window,
+            mean_shift_thresholds,
             learning_samples: if learns { self.learning_samples } else { 0 },
             health: HealthSettings {
                 saturation_samples: self.saturation_samples,

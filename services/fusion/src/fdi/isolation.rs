@@ -92,12 +92,23 @@ pub fn isolate(
     margin: f64,
 ) -> ParityIsolation {
     let (sum, len) = window.sum_last(episode.max(1), space.dimension());
+    isolate_sum(space, &sum, len as f64, margin)
+}
+
+/// Isolates the fault behind `sum`, the whitened parity summed over `len` samples (or a mean
+/// scaled to the sum of its effective length): the same GLT as [`isolate`].
+pub fn isolate_sum(
+    space: &ParitySpace,
+    sum: &[f64; MAX_PARITY],
+    len: f64,
+    margin: f64,
+) -> ParityIsolation {
     let mut scores = [0.0; MAX_CHANNELS];
-    let Some(best) = space.glt_scores(&sum, &mut scores) else {
+    let Some(best) = space.glt_scores(sum, &mut scores) else {
         return ParityIsolation::Unobservable;
     };
     let twins = space.twins(best);
-    let scale = 1.0 / len.max(1) as f64;
+    let scale = 1.0 / len.max(1.0);
     let best_score = scores[best] * scale;
     let contenders = (0..MAX_CHANNELS)
         .filter(|&j| space.twins(j) != 0 && scores[j] * scale > best_score - margin)

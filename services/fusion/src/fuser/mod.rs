@@ -152,8 +152,9 @@ impl ImuFuser {
         }
     }
 
-    /// Returns an excluded channel to service — by explicit command only; exclusions otherwise
-    /// latch (see [`crate::fdi::monitor`]). `Ok(false)` when the channel was not excluded.
+    /// Re-admits an excluded channel — by explicit command only; exclusions otherwise latch (see
+    /// [`crate::fdi::monitor`]). It rejoins the solution after passing its probation
+    /// ([`crate::fdi::probation`]). `Ok(false)` when the channel was not excluded.
     pub fn readmit(&mut self, sensor: SensorType, channel: usize) -> Result<bool, ReadmitError> {
         self.monitor_mut(sensor).readmit(channel)
     }

@@ -201,6 +201,14 @@ impl ErrorStateEkf {
         self.p[(i, i)] = variance;
     }
 
+    /// Adds `variance` to error component `i`'s variance, its correlations kept: an error source
+    /// the propagation does not model (a fault fusion has not isolated yet) widened it.
+    pub fn inflate_component(&mut self, i: usize, variance: f64) {
+        if i < STATES && variance.is_finite() && variance > 0.0 {
+            self.p[(i, i)] += variance;
+        }
+    }
+
     /// Replaces the covariance by the diagonal `variances` (correlations dropped): a filter that
     /// takes over another's solution knows its uncertainties but not their correlations.
     pub fn set_covariance_diagonal(&mut self, variances: &[f64; STATES]) {

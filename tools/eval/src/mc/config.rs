@@ -185,8 +185,8 @@ impl McConfig {
             .filter(|&k| k < ticks);
 
         let mut navigator = self.navigator.clone();
-        navigator.initial_latitude_deg = self.sim.origin_latitude_deg;
-        navigator.initial_longitude_deg = self.sim.origin_longitude_deg;
+        navigator.initial_latitude_deg = Some(self.sim.origin_latitude_deg);
+        navigator.initial_longitude_deg = Some(self.sim.origin_longitude_deg);
         navigator.initial_altitude_m = self.sim.origin_altitude_m;
         navigator.declination_deg = self.sim.earth_field.declination_deg;
         navigator.validate()?;

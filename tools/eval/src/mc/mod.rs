@@ -16,7 +16,7 @@
 
 pub mod config;
 pub mod errors;
-mod pipeline;
+pub(crate) mod pipeline;
 pub mod report;
 pub mod run;
 mod table;

@@ -15,12 +15,20 @@ use super::config::{McError, Prepared, PreparedSystem};
 pub(crate) struct FusedSample {
     pub rate_rps: [f64; 3],
     pub specific_force_mps2: [f64; 3],
+    /// Variance of each rate axis, with fusion's bound on an unisolated fault.
+    pub rate_var: [f64; 3],
+    /// The fused sample's flags (`ipc_types::fused_flags`).
+    pub flags: u32,
     /// Enough healthy channels of both kinds.
     pub usable: bool,
     /// Some channel of the frame did not enter the solution (dead, or excluded by the fuser), or
     /// the fuser flags a channel Suspect or a detected-but-unisolated fault: in a fault-free
     /// flight, a false alarm.
     pub degraded: bool,
+    /// Fusion's per-channel states, reasons and parity verdict of the gyros.
+    pub gyro_status: rins_fusion::SensorStatus,
+    /// The same of the accelerometers.
+    pub accel_status: rins_fusion::SensorStatus,
 }
 
 fn full_mask(n: usize) -> u32 {
@@ -53,11 +61,15 @@ pub(crate) fn fuse_frame(fuser: &mut ImuFuser, imu: &ImuFrame) -> FusedSample {
     FusedSample {
         rate_rps: fused.rate,
         specific_force_mps2: fused.specific_force,
+        rate_var: fused.rate_var,
+        flags: fused.flags(),
         usable: rins_navigator::navigator::fused_sample_usable(fused.flags()),
         degraded: fused.gyro_mask != full_mask(n_gyro)
             || fused.accel_mask != full_mask(n_accel)
             || flagged(&fused.gyro_status)
             || flagged(&fused.accel_status),
+        gyro_status: fused.gyro_status,
+        accel_status: fused.accel_status,
     }
 }
 
@@ -72,6 +84,8 @@ pub(crate) struct Pipeline {
     tick: TickOutput,
     solution: Option<NavOutput>,
     degraded: bool,
+    /// Fusion's output of the last tick (`None` before the first frame).
+    fused: Option<FusedSample>,
 }
 
 impl Pipeline {
@@ -97,7 +111,63 @@ impl Pipeline {
             tick: TickOutput::default(),
             solution: None,
             degraded: false,
+            fused: None,
         })
+    }
+
+    /// The chain as a deployment builds it from its configuration: the simulator with the
+    /// configured block's axes, the fuser with the configured `[fusion]` table (its own rest-bias
+    /// window included) and the simulated converters, the altimeter and the navigator as given.
+    pub fn from_parts(
+        sim: &rins_sim::SimConfig,
+        fusion: &rins_fusion::FusionConfig,
+        altimeter: &rins_altimeter::AltimeterConfig,
+        navigator: &rins_navigator::NavigatorConfig,
+        seed: u64,
+    ) -> Result<Self, McError> {
+        let gyro = fusion
+            .geometry
+            .gyro
+            .build()
+            .map_err(|e| e.within("fusion.geometry.gyro"))?;
+        let accel = fusion
+            .geometry
+            .accel
+            .build()
+            .map_err(|e| e.within("fusion.geometry.accel"))?;
+        let sim_model = Simulator::new(sim, gyro.axes(), accel.axes(), seed)?;
+        let fuser = ImuFuser::new(fusion, sim.gyro_lsb_rps(), sim.accel_lsb_mps2())
+            .map_err(|e| e.within("fusion"))?;
+        let altimeter =
+            AltitudeEstimator::new(altimeter.clone()).map_err(|e| e.within("altimeter"))?;
+        let navigator = Navigator::new(navigator.clone())?;
+        Ok(Self {
+            sim: sim_model,
+            fuser,
+            altimeter,
+            navigator,
+            tick: TickOutput::default(),
+            solution: None,
+            degraded: false,
+            fused: None,
+        })
+    }
+
+    /// Sets a fault on one inertial channel from the next tick on.
+    pub fn inject_fault(
+        &mut self,
+        sensor: InertialSensor,
+        channel: usize,
+        fault: ChannelFault,
+    ) -> Result<(), McError> {
+        self.sim.inject_fault(sensor, channel, fault)?;
+        Ok(())
+    }
+
+    /// Fusion's output of the last tick, `None` before the first frame or when the last tick
+    /// carried no IMU frame.
+    pub fn fused(&self) -> Option<&FusedSample> {
+        self.fused.as_ref()
     }
 
     /// Kills one gyro channel from the next tick on.
@@ -132,10 +202,14 @@ impl Pipeline {
                 .on_mag(time_us, mag.field_nt.map(|nt| f64::from(nt) * 1e-3));
         }
         self.solution = None;
+        self.fused = None;
         if let Payload::Imu(imu) = &self.tick.imu.payload {
             let fused = fuse_frame(&mut self.fuser, imu);
             self.degraded = fused.degraded;
+            self.fused = Some(fused);
             if fused.usable {
+                // As the navigator process does: fusion's fault report first.
+                self.navigator.on_fusion_status(fused.flags, fused.rate_var);
                 self.solution =
                     self.navigator
                         .on_imu(time_us, fused.rate_rps, fused.specific_force_mps2);

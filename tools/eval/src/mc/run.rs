@@ -26,7 +26,7 @@ pub struct KillRun {
 pub const JUMP_WINDOW_S: f64 = 1.0;
 
 /// Angle between two attitudes given as `[w, x, y, z]` unit quaternions, °.
-fn attitude_difference_deg(a: &[f64; 4], b: &[f64; 4]) -> f64 {
+pub(crate) fn attitude_difference_deg(a: &[f64; 4], b: &[f64; 4]) -> f64 {
     let dot = a
         .iter()
         .zip(b)

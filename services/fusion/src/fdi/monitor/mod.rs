@@ -9,9 +9,11 @@
 //!    say it should be well inside its range, otherwise (genuine over-range) it is Suspect;
 //! 2. any exclusion → reconfiguration;
 //! 3. parity test on the offset-corrected parity vector ([`super::offset`]; declarations are
-//!    suspended during the learning phase at start); on a k-of-n declaration: the GLT over the
-//!    alarm episode isolates and excludes the channel when it clearly wins (N_active ≥ 5, no
-//!    twins; see [`super::isolation`]); otherwise, while stationary, the reference may isolate
+//!    suspended during the learning phase at start), per sample with k-of-n persistence and on
+//!    its windowed mean ([`super::mean_shift`]) for biases too small for single samples; on a
+//!    declaration: the GLT over the alarm episode (or over the windowed mean) isolates and
+//!    excludes the channel when it clearly wins (N_active ≥ 5, no twins; see
+//!    [`super::isolation`]); otherwise, while stationary, the reference may isolate
 //!    it among the contenders ([`super::stationary`]); otherwise the candidates are Suspect, the
 //!    fault is reported as detected-not-isolated, and every channel stays in the solution;
 //! 4. weighted least squares over the active set, on the values less the correction of
@@ -32,8 +34,10 @@
 //! status says `block_saturated` and the fused solution is flagged not valid. Nothing is
 //! excluded (an over-range is not a channel fault) and the channels are Suspect (Saturated).
 
+mod fault_bound;
 mod health;
 mod parity_decision;
+mod probation;
 mod solve_correction;
 mod status;
 
@@ -41,10 +45,12 @@ use super::MAX_PARITY;
 use super::channel_health::ChannelHealth;
 use super::config::{FdiSettings, ParityNoise};
 use super::isolation::ParityWindow;
+use super::mean_shift::MeanShift;
 use super::noise_estimate::AdaptiveParityNoise;
 use super::offset::ParityOffset;
 use super::parity::ParitySpace;
 use super::persistence::Persistence;
+use super::probation::ProbationTest;
 use super::recovery::ExclusionRetest;
 use super::report::{ChannelEvents, SensorStatus};
 use super::stationary::ChannelReference;
@@ -125,6 +131,8 @@ pub struct SensorMonitor {
     window: ParityWindow,
     /// Samples since the first exceedance of the current alarm episode (0: no episode).
     episode: usize,
+    /// The windowed mean of the parity, for biases below the per-sample test.
+    mean_shift: MeanShift,
     health: ChannelHealth,
     /// Noise outliers that could not be excluded (3 active), held until the next verdict.
     noisy_suspect: u32,
@@ -145,6 +153,8 @@ pub struct SensorMonitor {
     correction: SolveCorrection,
     /// Re-test of the exclusions while the type has no solution.
     retest: ExclusionRetest,
+    /// Channels re-admitted by command, tested out of the solution (see [`super::probation`]).
+    probation: ProbationTest,
 }
 
 impl SensorMonitor {
@@ -181,6 +191,7 @@ impl SensorMonitor {
             persistence: Persistence::new(settings.persistence_k, settings.persistence_n),
             window: ParityWindow::default(),
             episode: 0,
+            mean_shift: MeanShift::new(settings.mean_shift_window),
             health,
             noisy_suspect: 0,
             adaptive,
@@ -197,6 +208,10 @@ impl SensorMonitor {
             channel_offset: [0.0; MAX_CHANNELS],
             correction: SolveCorrection::new(settings.parity_offset_window),
             retest: ExclusionRetest::default(),
+            probation: ProbationTest::new(
+                settings.readmit_probation_samples,
+                settings.thresholds[1],
+            ),
         };
         monitor.reconfigure();
         monitor
@@ -217,11 +232,14 @@ impl SensorMonitor {
         for ch in bits(self.active_mask() & !input.valid) {
             self.exclude(ch, FaultReason::Missing);
         }
-        let found = self.health.check(input.counts, z, self.active_mask());
+        let found = self
+            .health
+            .check(input.counts, z, self.judged_mask(input.valid));
         let saturated_suspect = self.apply_health(&found, z);
         if self.excluded_mask != before {
             self.reconfigure();
         }
+        self.probation_step(&found, input);
         let active = self.active_mask();
         let health = HealthOutcome {
             saturated_suspect,
@@ -243,11 +261,24 @@ impl SensorMonitor {
 
         let estimate = match &self.solver {
             Some(solver) => {
-                let (x, var) = match before_test {
+                let values = self.correction.apply(z);
+                let (x, mut var) = match before_test {
                     Some((mask, solution)) if mask == solver.mask() => solution,
                     // The test reconfigured: the correction has moved with the set.
-                    _ => solver.solve(&self.correction.apply(z)),
+                    _ => solver.solve(&values),
                 };
+                // A fault declared and not isolated is still in the solution: its variance
+                // carries how far that fault can have moved it (see `fault_bound`).
+                if candidates != 0 {
+                    let bound = fault_bound::solution_error_bound(
+                        solver,
+                        self.geometry.axes(),
+                        &values,
+                        &x,
+                        candidates,
+                    );
+                    var.iter_mut().for_each(|v| *v += bound * bound);
+                }
                 self.last_x = x;
                 SensorEstimate {
                     x,
@@ -302,8 +333,11 @@ impl SensorMonitor {
         self.reference.shift(bias);
     }
 
-    /// Returns an excluded channel to service (explicit command only; see the module docs).
-    /// `Ok(false)` when the channel was not excluded. Rebuilds the solver and parity space.
+    /// Re-admits an excluded channel (explicit command only; see the module docs): it goes on
+    /// probation, tested against the channels in service while it stays out of the solution, and
+    /// rejoins once it passed ([`super::probation`]); when those have no solution to test it
+    /// against, it returns at once (rebuilding the solver and parity space). `Ok(false)` when the
+    /// channel was not excluded.
     pub fn readmit(&mut self, channel: usize) -> Result<bool, ReadmitError> {
         let n = self.geometry.n();
         if channel >= n {
@@ -315,6 +349,9 @@ impl SensorMonitor {
         }
         if self.excluded[channel] == FaultReason::None {
             return Ok(false);
+        }
+        if self.start_probation(channel) {
+            return Ok(true);
         }
         self.excluded[channel] = FaultReason::None;
         self.excluded_mask &= !(1 << channel);
@@ -372,6 +409,7 @@ impl SensorMonitor {
         }
         self.persistence.reset();
         self.window.clear();
+        self.mean_shift.clear();
         self.episode = 0;
         self.reference.clear_recent();
     }

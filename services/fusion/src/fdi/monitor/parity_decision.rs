@@ -1,5 +1,5 @@
 //! The parity side of the monitor: the offset-corrected, motion-scaled parity test with its
-//! persistence, the adaptive noise and offset estimates it feeds, and the isolation of a declared
+//! persistence and its windowed mean, the adaptive noise and offset estimates it feeds, and the isolation of a declared
 //! fault by the GLT or the stationary reference.
 
 use super::SensorMonitor;
@@ -52,14 +52,16 @@ impl SensorMonitor {
         let exceeded = t > self.threshold;
         self.window.push(&pw);
         let persistent = self.persistence.push(exceeded);
+        let shifted = self.mean_shift.push(&pw, dim) > self.settings.mean_shift_thresholds[dim];
         self.episode = if self.persistence.count() > 0 {
             self.episode + 1
         } else {
             0
         };
         // The estimates learn from every sample while learning, afterwards only while no sample
-        // of the window exceeded: a fault must become neither "offset" nor "noise".
-        if learning || self.persistence.count() == 0 {
+        // of the window exceeded and the windowed mean is quiet: a fault must become neither
+        // "offset" nor "noise".
+        if learning || (self.persistence.count() == 0 && !shifted) {
             if let Some(offset) = self.offset.as_mut() {
                 offset.update(&raw, dim, learning_seen);
             }
@@ -71,17 +73,24 @@ impl SensorMonitor {
                 space.set_noise_covariance(estimate.covariance());
             }
         }
-        let declared = persistent && !learning;
+        let declared = (persistent || shifted) && !learning;
         self.reference.push(z, active, t, !declared);
         if !declared {
             return (t, 0, learning);
         }
-        let isolation = isolation::isolate(
-            space,
-            &self.window,
-            self.episode,
-            self.settings.isolation_margin,
-        );
+        let isolation = if persistent {
+            isolation::isolate(
+                space,
+                &self.window,
+                self.episode,
+                self.settings.isolation_margin,
+            )
+        } else {
+            // The windowed mean is the evidence: as a sum over its effective length.
+            let len = self.mean_shift.effective_len();
+            let sum = self.mean_shift.mean().map(|m| m * len);
+            isolation::isolate_sum(space, &sum, len, self.settings.isolation_margin)
+        };
         let candidates = match isolation {
             ParityIsolation::Channel(ch) => {
                 self.exclude(ch, FaultReason::Parity);
@@ -91,7 +100,13 @@ impl SensorMonitor {
             ParityIsolation::Ambiguous(twins) => twins,
             ParityIsolation::Unobservable => active,
         };
+        // The stationary reference judges the last few samples only (the persistence window):
+        // evidence enough for a fault the per-sample test declares, not for one only the
+        // windowed mean sees, where a channel's noise would pass for the fault (a ramp of 1σ on
+        // one gyro had another excluded). Such a fault stays declared and unisolated until it
+        // grows or the per-sample test confirms it.
         if stationary
+            && persistent
             && let Some(ch) = self.reference.isolate(
                 candidates,
                 active,
