@@ -284,7 +284,8 @@ impl IntegrityMonitor {
     /// without horizontal aiding, and a gravity re-levelling in flight takes any acceleration for
     /// tilt. The hold then lasts until the filter starts afresh (a new alignment or a take-over).
     pub fn on_fault_episode_end(&mut self, bound_rad: f64) {
-        if !(bound_rad <= self.config.fault_attitude_sigma_deg.to_radians()) {
+        // A NaN bound is no bound: latched as well.
+        if bound_rad.is_nan() || bound_rad > self.config.fault_attitude_sigma_deg.to_radians() {
             self.fault_latched = true;
         }
     }
