@@ -124,12 +124,19 @@ pub struct ChannelReference {
     recent_capacity: usize,
     recent_len: usize,
     recent_pos: usize,
+    /// Exponentially weighted mean of each channel (weight `smooth_alpha`; 0: none kept): the
+    /// evidence for a fault only the windowed parity mean sees, too small for `recent`.
+    smooth: [f64; MAX_CHANNELS],
+    smooth_alpha: f64,
+    /// Samples in `smooth` since the active set last changed.
+    smooth_len: u32,
 }
 
 impl ChannelReference {
     /// A reference over blocks of `window` samples with evidence over the last `evidence`
-    /// samples (≤ 16). `holds_across_periods`: true for gyros.
-    pub fn new(window: u32, evidence: usize, holds_across_periods: bool) -> Self {
+    /// samples (≤ 16), and over an exponentially weighted mean of about `smoothing` samples (0:
+    /// none). `holds_across_periods`: true for gyros.
+    pub fn new(window: u32, evidence: usize, smoothing: u32, holds_across_periods: bool) -> Self {
         Self {
             holds_across_periods,
             window,
@@ -146,6 +153,13 @@ impl ChannelReference {
             recent_capacity: evidence.clamp(1, MAX_PERSISTENCE_WINDOW),
             recent_len: 0,
             recent_pos: 0,
+            smooth: [0.0; MAX_CHANNELS],
+            smooth_alpha: if smoothing == 0 {
+                0.0
+            } else {
+                2.0 / (f64::from(smoothing) + 1.0)
+            },
+            smooth_len: 0,
         }
     }
 
@@ -168,6 +182,19 @@ impl ChannelReference {
         self.recent[self.recent_pos] = *z;
         self.recent_pos = (self.recent_pos + 1) % self.recent_capacity;
         self.recent_len = (self.recent_len + 1).min(self.recent_capacity);
+        if self.smooth_alpha > 0.0 {
+            let a = if self.smooth_len == 0 {
+                1.0
+            } else {
+                self.smooth_alpha
+            };
+            for (i, m) in self.smooth.iter_mut().enumerate() {
+                if active & (1 << i) != 0 && z[i].is_finite() {
+                    *m += a * (z[i] - *m);
+                }
+            }
+            self.smooth_len = self.smooth_len.saturating_add(1);
+        }
     }
 
     /// Closes the block that the stationary detector just judged; `parity_dimension` of the
@@ -214,12 +241,16 @@ impl ChannelReference {
                 *v -= d;
             }
         }
+        for (m, d) in self.smooth.iter_mut().zip(delta) {
+            *m -= d;
+        }
     }
 
     /// Forgets the recent samples (after the active set changed).
     pub fn clear_recent(&mut self) {
         self.recent_len = 0;
         self.recent_pos = 0;
+        self.smooth_len = 0;
     }
 
     /// A reference is held (it may still be unusable if the vehicle is not stationary now).
@@ -228,7 +259,7 @@ impl ChannelReference {
     }
 
     /// The channel among `candidates` that clearly departs from the reference, judged over the
-    /// active channels `active` with noise σ² `variances`, or `None`.
+    /// active channels `active` with noise σ² `variances` on the last few samples, or `None`.
     pub fn isolate(
         &self,
         candidates: u32,
@@ -236,21 +267,57 @@ impl ChannelReference {
         variances: &[f64; MAX_CHANNELS],
         ratio: f64,
     ) -> Option<usize> {
-        if !self.valid || self.recent_len == 0 {
+        if self.recent_len == 0 {
+            return None;
+        }
+        let ne = self.recent_len as f64;
+        let recent = &self.recent[..self.recent_len];
+        self.pick(candidates, active, variances, ratio, 1.0 / ne, |i| {
+            recent.iter().map(|z| z[i]).sum::<f64>() / ne
+        })
+    }
+
+    /// As [`Self::isolate`], judged on the exponentially weighted mean of each channel: for a
+    /// fault too small for the last few samples. `None` until the mean has seen about its length
+    /// since the active set last changed.
+    pub fn isolate_smoothed(
+        &self,
+        candidates: u32,
+        active: u32,
+        variances: &[f64; MAX_CHANNELS],
+        ratio: f64,
+    ) -> Option<usize> {
+        let a = self.smooth_alpha;
+        if a <= 0.0 || f64::from(self.smooth_len) < 2.0 / a {
+            return None;
+        }
+        // The weighted mean's variance, in units of one sample's.
+        let share = a / (2.0 - a);
+        self.pick(candidates, active, variances, ratio, share, |i| {
+            self.smooth[i]
+        })
+    }
+
+    /// The channel whose `mean` (a variance of `share` of one sample's) departs from the
+    /// reference by `ratio` times more than any other's, if it is a candidate.
+    fn pick(
+        &self,
+        candidates: u32,
+        active: u32,
+        variances: &[f64; MAX_CHANNELS],
+        ratio: f64,
+        share: f64,
+        mean: impl Fn(usize) -> f64,
+    ) -> Option<usize> {
+        if !self.valid {
             return None;
         }
         let judged = active & self.mask;
-        let ne = self.recent_len as f64;
-        let scale = 1.0 / ne + 1.0 / f64::from(self.samples.max(1));
+        let scale = share + 1.0 / f64::from(self.samples.max(1));
         let mut best: Option<(usize, f64)> = None;
         let mut second = 0.0_f64;
         for i in (0..MAX_CHANNELS).filter(|i| judged & (1 << i) != 0) {
-            let mean = self.recent[..self.recent_len]
-                .iter()
-                .map(|z| z[i])
-                .sum::<f64>()
-                / ne;
-            let r = (mean - self.mean[i]).abs() / (variances[i] * scale).sqrt();
+            let r = (mean(i) - self.mean[i]).abs() / (variances[i] * scale).sqrt();
             if !r.is_finite() {
                 return None;
             }
@@ -317,7 +384,7 @@ mod tests {
     #[test]
     fn reference_isolates_the_departing_channel_only_when_it_dominates() {
         let var = [1.0; MAX_CHANNELS];
-        let mut r = ChannelReference::new(100, 5, false);
+        let mut r = ChannelReference::new(100, 5, 0, false);
         let base = {
             let mut z = [0.0; MAX_CHANNELS];
             z[..4].copy_from_slice(&[1.0, 2.0, 3.0, 4.0]);
@@ -346,5 +413,46 @@ mod tests {
         // Accelerometer reference is lost when the vehicle moves.
         r.end_block(false, 1);
         assert!(!r.is_valid());
+    }
+
+    /// A fault of one noise σ: on the last five samples any channel's noise passes for it; on
+    /// the weighted mean over 200 samples only the faulty channel stands out.
+    #[test]
+    fn the_smoothed_evidence_isolates_a_one_sigma_fault_that_five_samples_cannot() {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, StandardNormal};
+        let var = [1.0; MAX_CHANNELS];
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let mut noisy = |offset: [f64; 4]| {
+            let mut z = [0.0; MAX_CHANNELS];
+            for (v, o) in z.iter_mut().zip(offset) {
+                let n: f64 = StandardNormal.sample(&mut rng);
+                *v = o + n;
+            }
+            z
+        };
+        let mut r = ChannelReference::new(1000, 5, 200, true);
+        for _ in 0..1000 {
+            r.push(&noisy([0.0; 4]), 0b1111, 1.0, true);
+        }
+        r.end_block(true, 1);
+        // Too little evidence right after the active set changed.
+        r.clear_recent();
+        assert_eq!(r.isolate_smoothed(0b1111, 0b1111, &var, 3.0), None);
+        let (mut smoothed, mut wrong_recent) = (Vec::new(), 0);
+        for _ in 0..2000 {
+            r.push(&noisy([0.0, 0.0, 1.0, 0.0]), 0b1111, 1.0, true);
+            if let Some(ch) = r.isolate_smoothed(0b1111, 0b1111, &var, 3.0) {
+                smoothed.push(ch);
+            }
+            if r.isolate(0b1111, 0b1111, &var, 3.0).is_some_and(|ch| ch != 2) {
+                wrong_recent += 1;
+            }
+        }
+        assert!(!smoothed.is_empty(), "the smoothed mean found nothing");
+        assert!(smoothed.iter().all(|&ch| ch == 2), "{smoothed:?}");
+        // The five-sample judgement blames a wrong channel now and then: what the smoothed
+        // evidence is for.
+        assert!(wrong_recent > 0);
     }
 }

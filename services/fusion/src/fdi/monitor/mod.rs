@@ -133,6 +133,8 @@ pub struct SensorMonitor {
     episode: usize,
     /// The windowed mean of the parity, for biases below the per-sample test.
     mean_shift: MeanShift,
+    /// Samples since the active set last changed (the offset's re-learning).
+    relearned: u64,
     health: ChannelHealth,
     /// Noise outliers that could not be excluded (3 active), held until the next verdict.
     noisy_suspect: u32,
@@ -192,6 +194,7 @@ impl SensorMonitor {
             window: ParityWindow::default(),
             episode: 0,
             mean_shift: MeanShift::new(settings.mean_shift_window),
+            relearned: 0,
             health,
             noisy_suspect: 0,
             adaptive,
@@ -200,6 +203,7 @@ impl SensorMonitor {
             reference: ChannelReference::new(
                 settings.stationary.window,
                 settings.persistence_n as usize,
+                settings.mean_shift_window,
                 sensor == SensorType::Gyro,
             ),
             status,
@@ -410,6 +414,7 @@ impl SensorMonitor {
         self.persistence.reset();
         self.window.clear();
         self.mean_shift.clear();
+        self.relearned = 0;
         self.episode = 0;
         self.reference.clear_recent();
     }

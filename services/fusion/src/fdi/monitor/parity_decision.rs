@@ -28,6 +28,16 @@ impl SensorMonitor {
             (self.seen < u64::from(self.settings.learning_samples)).then_some(self.seen);
         let learning = learning_seen.is_some();
         self.seen = self.seen.saturating_add(1);
+        // After the active set changed the offset re-learns from scratch, and the windowed mean
+        // waits for it: the offset carried over holds what the channels' biases were before the
+        // change (a channel re-admitted after a fault came back with its own), and the windowed
+        // mean would read that difference as a fault — and, declared, it stops the offset from
+        // learning it, for ever. A re-admitted channel passed its probation against the others
+        // first, and the per-sample test keeps watching meanwhile.
+        let relearn_seen =
+            (self.relearned < u64::from(self.settings.learning_samples)).then_some(self.relearned);
+        self.relearned = self.relearned.saturating_add(1);
+        let offset_seen = learning_seen.or(relearn_seen);
         let mut p = [0.0; MAX_PARITY];
         space.parity(z, &mut p);
         let raw = p;
@@ -52,7 +62,8 @@ impl SensorMonitor {
         let exceeded = t > self.threshold;
         self.window.push(&pw);
         let persistent = self.persistence.push(exceeded);
-        let shifted = self.mean_shift.push(&pw, dim) > self.settings.mean_shift_thresholds[dim];
+        let shifted = self.mean_shift.push(&pw, dim) > self.settings.mean_shift_thresholds[dim]
+            && relearn_seen.is_none();
         self.episode = if self.persistence.count() > 0 {
             self.episode + 1
         } else {
@@ -63,7 +74,7 @@ impl SensorMonitor {
         // "offset" nor "noise".
         if learning || (self.persistence.count() == 0 && !shifted) {
             if let Some(offset) = self.offset.as_mut() {
-                offset.update(&raw, dim, learning_seen);
+                offset.update(&raw, dim, offset_seen);
             }
             self.correction.learn(space, z);
             let truncation = self.settings.truncation[dim];
@@ -100,20 +111,21 @@ impl SensorMonitor {
             ParityIsolation::Ambiguous(twins) => twins,
             ParityIsolation::Unobservable => active,
         };
-        // The stationary reference judges the last few samples only (the persistence window):
-        // evidence enough for a fault the per-sample test declares, not for one only the
-        // windowed mean sees, where a channel's noise would pass for the fault (a ramp of 1σ on
-        // one gyro had another excluded). Such a fault stays declared and unisolated until it
-        // grows or the per-sample test confirms it.
-        if stationary
-            && persistent
-            && let Some(ch) = self.reference.isolate(
-                candidates,
-                active,
-                &self.variances,
-                self.settings.reference_ratio,
-            )
-        {
+        // The stationary reference weighs as much evidence as the declaration did: the last few
+        // samples (the persistence window) for a fault the per-sample test declares; for one only
+        // the windowed mean sees, each channel's mean over the same window — on a few samples a
+        // channel's noise would pass for such a fault (a 1σ ramp on one gyro had another
+        // excluded).
+        let reference = &self.reference;
+        let (variances, ratio) = (&self.variances, self.settings.reference_ratio);
+        let found = stationary.then(|| {
+            if persistent {
+                reference.isolate(candidates, active, variances, ratio)
+            } else {
+                reference.isolate_smoothed(candidates, active, variances, ratio)
+            }
+        });
+        if let Some(Some(ch)) = found {
             self.exclude(ch, FaultReason::StationaryReference);
             self.reconfigure();
             return (t, 0, false);
