@@ -445,7 +445,9 @@ mod tests {
             if let Some(ch) = r.isolate_smoothed(0b1111, 0b1111, &var, 3.0) {
                 smoothed.push(ch);
             }
-            if r.isolate(0b1111, 0b1111, &var, 3.0).is_some_and(|ch| ch != 2) {
+            if r.isolate(0b1111, 0b1111, &var, 3.0)
+                .is_some_and(|ch| ch != 2)
+            {
                 wrong_recent += 1;
             }
         }
