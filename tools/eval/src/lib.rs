@@ -22,6 +22,7 @@ pub mod installation;
 pub mod integrity_tally;
 pub mod leave_one_out;
 pub mod mc;
+pub mod parallel;
 pub mod quadrotor_ahrs;
 pub mod quadrotor_gnss;
 pub mod quadrotor_nav;

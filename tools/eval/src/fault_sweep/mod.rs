@@ -19,9 +19,6 @@ pub mod config;
 pub mod report;
 mod run;
 
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::mpsc;
-
 pub use config::{SweepChannel, SweepConfig, SweepFault, TARGET_ATT_ERR_DEG};
 pub use report::{SweepReport, SweepSummary};
 pub use run::{CleanRun, FaultRun};
@@ -88,54 +85,21 @@ pub fn run_fault_sweep(
         .max()
         .unwrap_or(prepared.window_ticks);
 
-    let next = AtomicUsize::new(0);
-    let stop = AtomicBool::new(false);
-    let mut outcomes: Vec<Option<Outcome>> = (0..total).map(|_| None).collect();
-    let mut first_error = None;
-    std::thread::scope(|scope| {
-        let (tx, rx) = mpsc::channel();
-        for _ in 0..config.threads.min(total) {
-            let tx = tx.clone();
-            let (prepared, bases, jobs, next, stop) = (&prepared, &bases, &jobs, &next, &stop);
-            scope.spawn(move || {
-                while !stop.load(Ordering::Relaxed) {
-                    let k = next.fetch_add(1, Ordering::Relaxed);
-                    let Some(job) = jobs.get(k) else {
-                        break;
-                    };
-                    let result = match *job {
-                        Job::Clean => run::run_clean(prepared, clean_ticks).map(Outcome::Clean),
-                        Job::Fault { at, fault } => {
-                            run::run_fault(prepared, &bases[at], prepared.inject_ticks[at], fault)
-                                .map(Outcome::Fault)
-                        }
-                    };
-                    if tx.send((k, result)).is_err() {
-                        break;
-                    }
-                }
-            });
-        }
-        drop(tx);
-        let mut done = 0;
-        for (k, result) in rx {
-            match result {
-                Ok(outcome) => outcomes[k] = Some(outcome),
-                Err(e) => {
-                    stop.store(true, Ordering::Relaxed);
-                    first_error.get_or_insert(e);
-                }
+    let outcomes = crate::parallel::run_indexed(
+        total,
+        config.threads,
+        |k| match jobs[k] {
+            Job::Clean => run::run_clean(&prepared, clean_ticks).map(Outcome::Clean),
+            Job::Fault { at, fault } => {
+                run::run_fault(&prepared, &bases[at], prepared.inject_ticks[at], fault)
+                    .map(Outcome::Fault)
             }
-            done += 1;
-            progress(done, total);
-        }
-    });
-    if let Some(e) = first_error {
-        return Err(e);
-    }
+        },
+        progress,
+    )?;
     let mut clean = None;
     let mut runs = Vec::with_capacity(total);
-    for outcome in outcomes.into_iter().flatten() {
+    for outcome in outcomes {
         match outcome {
             Outcome::Clean(c) => clean = Some(c),
             Outcome::Fault(r) => runs.push(r),

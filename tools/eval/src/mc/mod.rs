@@ -21,9 +21,6 @@ pub mod report;
 pub mod run;
 mod table;
 
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::mpsc;
-
 pub use config::{McConfig, McError, SystemSpec};
 pub use errors::{NavErrors, RmsErrors, WindowResult};
 pub use report::McReport;
@@ -39,47 +36,12 @@ pub fn run_monte_carlo(
     let prepared = config.prepare()?;
     let total = config.runs;
     let seed = |k: usize| config.first_seed.wrapping_add(k as u64);
-    let next = AtomicUsize::new(0);
-    let stop = AtomicBool::new(false);
-    let mut records: Vec<Option<run::RunRecord>> = vec![None; total];
-    let mut first_error = None;
     progress(0, total);
-
-    std::thread::scope(|scope| {
-        let (tx, rx) = mpsc::channel();
-        for _ in 0..config.threads.min(total) {
-            let tx = tx.clone();
-            let (prepared, next, stop) = (&prepared, &next, &stop);
-            scope.spawn(move || {
-                while !stop.load(Ordering::Relaxed) {
-                    let k = next.fetch_add(1, Ordering::Relaxed);
-                    if k >= total {
-                        break;
-                    }
-                    if tx.send((k, run::run_pair(prepared, seed(k)))).is_err() {
-                        break;
-                    }
-                }
-            });
-        }
-        drop(tx);
-        let mut done = 0;
-        for (k, result) in rx {
-            match result {
-                Ok(record) => records[k] = Some(record),
-                Err(e) => {
-                    stop.store(true, Ordering::Relaxed);
-                    first_error.get_or_insert(e);
-                }
-            }
-            done += 1;
-            progress(done, total);
-        }
-    });
-    if let Some(e) = first_error {
-        return Err(e);
-    }
-    // Every index below `total` was taken by exactly one worker and sent back.
-    let records = records.into_iter().flatten().collect();
+    let records = crate::parallel::run_indexed(
+        total,
+        config.threads,
+        |k| run::run_pair(&prepared, seed(k)),
+        progress,
+    )?;
     Ok(McReport::new(&prepared, config.first_seed, records))
 }
