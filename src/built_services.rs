@@ -50,7 +50,7 @@ impl RinsConfig {
         let navigator = Navigator::new(self.navigator.clone()).map_err(|e| anyhow!("{e}"))?;
         Ok(BuiltServices {
             fuser,
-            fusion_input_deadline: rins_fusion::service::input_deadline(self.fusion.sample_rate_hz),
+            fusion_input_deadline: rins_fusion::service::input_deadline(self.device.imu_rate_hz),
             readmit_probation_samples: self.fusion.fdi.readmit_probation_samples,
             altimeter,
             navigator,

@@ -39,8 +39,7 @@ pub enum Command {
         /// A GNSS receiver is fitted: turns on `[gnss]`, `[navigator.gnss]` and `[sim.gnss]`.
         #[arg(long)]
         gnss: bool,
-        /// IMU sample rate, Hz (overrides sim.imu_rate_hz, fusion.sample_rate_hz and
-        /// fusion.kalman.sample_period_s together).
+        /// IMU sample rate, Hz (overrides device.imu_rate_hz).
         #[arg(long, value_name = "HZ")]
         imu_rate: Option<f64>,
         /// Ask for the `[realtime]` settings (as `realtime.enabled = true`).
@@ -128,6 +127,13 @@ pub enum Command {
         #[command(subcommand)]
         what: EvalCommand,
     },
+    /// The public recordings the evaluations use, as rins recordings: raw IMU counts and truth
+    /// in MCAP, a configuration beside each (`docs/import.md`).
+    Import {
+        /// Which data set.
+        #[command(subcommand)]
+        what: ImportCommand,
+    },
     /// Monte Carlo comparison of the redundant block with an orthogonal triad, with a gyro kill.
     Mc(McArgs),
     /// Fault sweep: one gyro or accelerometer fault per run (bias steps, a ramp, a noise increase)
@@ -175,6 +181,32 @@ pub struct CalibrateMagArgs {
     pub json: bool,
 }
 
+/// The data sets `rins import` converts.
+#[derive(Debug, Subcommand)]
+pub enum ImportCommand {
+    /// The four-IMU quadrotor flights (`<group>/path_<N>/IMU_k.csv`, `GT.csv`): one redundant
+    /// block of every unit's triads, UAV profile, started in the air from the truth.
+    Quadrotor(ImportArgs),
+    /// The pyshoe foot-mounted walks (`*.csv` with the Vicon position), pedestrian profile.
+    Pyshoe(ImportArgs),
+}
+
+/// Options of `rins import`.
+#[derive(Debug, Args)]
+pub struct ImportArgs {
+    /// Directory of the data set.
+    pub dir: PathBuf,
+    /// Output directory: `<run>.mcap`, `<run>.toml` (configuration) and `<run>.json` (clock
+    /// offsets, repairs, scales) per run, a flight's under its group directory.
+    pub out: PathBuf,
+    /// Replace output files that already exist (refused otherwise).
+    #[arg(long)]
+    pub force: bool,
+    /// End with one JSON object instead of the summary.
+    #[arg(long)]
+    pub json: bool,
+}
+
 /// The evaluations on recorded data `rins eval` runs.
 #[derive(Debug, Subcommand)]
 pub enum EvalCommand {
@@ -214,6 +246,11 @@ pub struct EvalQuadrotorArgs {
     /// What to run.
     #[arg(long, value_enum, default_value = "free")]
     pub mode: QuadrotorMode,
+    /// With `--mode ahrs`: run each flight's scored fused solution again through the running
+    /// processes (fusion and the navigator lanes, a private deployment per flight) and report
+    /// their figures beside the in-process ones.
+    #[arg(long)]
+    pub live: bool,
     /// Output format and navigator profile.
     #[command(flatten)]
     pub common: EvalProfileArgs,
@@ -240,6 +277,11 @@ pub struct EvalPyshoeArgs {
     /// Write one PNG per trial into this directory.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
+    /// Run each trial's held-out rins run again through the running processes (fusion and the
+    /// navigator lanes, a private deployment per trial) and report their figures beside the
+    /// in-process ones.
+    #[arg(long)]
+    pub live: bool,
     /// Output format and navigator profile.
     #[command(flatten)]
     pub common: EvalProfileArgs,
@@ -305,7 +347,8 @@ pub struct McArgs {
     /// Number of runs (default: the comparison's default).
     #[arg(long)]
     pub runs: Option<usize>,
-    /// Flight time simulated, s (default: the whole UAV profile).
+    /// Flight time simulated, s (default: the scenario's whole flight; 600 s for the static and
+    /// calibrate scenarios, which never end).
     #[arg(long, allow_negative_numbers = true)]
     pub duration: Option<f64>,
     /// Time of the gyro kill, s (default 300 s, or half the flight when --duration is shorter).
@@ -320,6 +363,9 @@ pub struct McArgs {
     /// Configuration file (its sim, navigator and altimeter settings are used).
     #[arg(long)]
     pub config: Option<PathBuf>,
+    /// Simulator scenario both blocks fly (default: uav, whatever the configuration names).
+    #[arg(long)]
+    pub scenario: Option<ScenarioArg>,
 }
 
 /// Options of `rins sweep`.
@@ -396,6 +442,21 @@ pub enum ScenarioArg {
     /// Turned on the spot through every orientation, the magnetometer distorted by hard and soft
     /// iron (`[sim.calibration]`): data for `rins calibrate mag`.
     Calibrate,
+    /// A quadrotor: take-off, hover, sharp turns, speed changes and a gust, landing; rotor drag
+    /// and rotor vibration (`[sim.multirotor]`).
+    Multirotor,
+}
+
+impl From<ScenarioArg> for rins_sim::Scenario {
+    fn from(scenario: ScenarioArg) -> Self {
+        match scenario {
+            ScenarioArg::Static => Self::Static,
+            ScenarioArg::Uav => Self::Uav,
+            ScenarioArg::Walk => Self::Walk,
+            ScenarioArg::Calibrate => Self::Calibrate,
+            ScenarioArg::Multirotor => Self::Multirotor,
+        }
+    }
 }
 
 /// Options of `rins up`.
@@ -429,8 +490,8 @@ pub struct UpArgs {
     /// `[gnss] port` names one) and turns on the navigator's GNSS updates.
     #[arg(long)]
     pub gnss: bool,
-    /// IMU sample rate of the simulated block and every stage, Hz (overrides sim.imu_rate_hz,
-    /// fusion.sample_rate_hz and fusion.kalman.sample_period_s together).
+    /// IMU sample rate of the simulated block and every stage, Hz (overrides
+    /// device.imu_rate_hz).
     #[arg(long, value_name = "HZ")]
     pub imu_rate: Option<f64>,
     /// Every service asks for its `[realtime]` settings (SCHED_FIFO priority, CPU affinity,
@@ -523,8 +584,7 @@ pub struct SimArgs {
     /// Simulator random seed (overrides sim.seed).
     #[arg(long)]
     pub seed: Option<u64>,
-    /// IMU sample rate, Hz (overrides sim.imu_rate_hz, fusion.sample_rate_hz and
-    /// fusion.kalman.sample_period_s together).
+    /// IMU sample rate, Hz (overrides device.imu_rate_hz).
     #[arg(long, value_name = "HZ")]
     pub imu_rate: Option<f64>,
     /// Configuration file (default: the built-in configuration).
@@ -537,11 +597,12 @@ pub struct SimArgs {
     /// path.
     #[arg(long, value_name = "PATH")]
     pub gnss_link: Option<PathBuf>,
-    /// Stop after this many seconds (the uav scenario then flies its circuits for that long).
+    /// Stop after this many seconds (the uav and multirotor scenarios then fly their circuits or
+    /// pattern for that long).
     #[arg(long, allow_negative_numbers = true)]
     pub duration: Option<f64>,
-    /// Uav scenario: length of the flight, s, its circuits repeated as many times as fit
-    /// (overrides sim.uav_flight_s; default: --duration).
+    /// Uav and multirotor scenarios: length of the flight, s, its circuits (pattern) repeated as
+    /// many times as fit (overrides sim.uav_flight_s; default: --duration).
     #[arg(long, allow_negative_numbers = true, value_name = "SECONDS")]
     pub flight_s: Option<f64>,
     /// Faults for the simulator to apply.
@@ -615,6 +676,23 @@ mod tests {
         }
         Cli::command().debug_assert();
         check(&Cli::command(), "rins");
+    }
+
+    #[test]
+    fn every_scenario_parses_from_the_command_line() {
+        use clap::Parser;
+        let parsed = Cli::try_parse_from(["rins", "up", "--scenario", "multirotor"]).unwrap();
+        let super::Command::Up(up) = parsed.command else {
+            panic!("not `up`: {parsed:?}");
+        };
+        let scenario = up.scenario.expect("--scenario given");
+        assert_eq!(
+            rins_sim::Scenario::from(scenario),
+            rins_sim::Scenario::Multirotor
+        );
+        let mc = Cli::try_parse_from(["rins", "mc", "--scenario", "multirotor"]).unwrap();
+        assert!(matches!(mc.command, super::Command::Mc(_)));
+        assert!(Cli::try_parse_from(["rins", "up", "--scenario", "quadcopter"]).is_err());
     }
 }
 
@@ -699,6 +777,10 @@ pub enum BenchCommand {
     /// Every IPC hop of the pipeline against the bare iceoryx2 hop with the same payload, the
     /// same service settings and the same wait strategy, measured in one invocation.
     Ipc(BenchIpcArgs),
+    /// The pipeline at each IMU rate: a fault-free run (false alarms, drops, CPU, end-to-end
+    /// latency) and runs with injected faults (detected, isolated, how fast); one JSON row per
+    /// rate with --json.
+    Rates(BenchRatesArgs),
     /// The receiving process of the bare hops (started by `rins bench ipc`).
     #[command(hide = true)]
     IpcReceiver {
@@ -706,6 +788,27 @@ pub enum BenchCommand {
         #[arg(long, default_value_t = 60.0)]
         phase_limit: f64,
     },
+}
+
+/// `rins bench rates`.
+#[derive(Debug, Args)]
+pub struct BenchRatesArgs {
+    /// IMU rates, Hz, comma-separated.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_values_t = [100.0, 250.0, 500.0, 1000.0, 2000.0, 4000.0, 8000.0]
+    )]
+    pub rates: Vec<f64>,
+    /// Length of each `rins up` run (device time), s.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 25.0)]
+    pub duration: f64,
+    /// Configuration file (default: the built-in configuration).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// One JSON object per rate, one per line, instead of the table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// `rins bench ipc`.

@@ -17,7 +17,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::cli::ScenarioArg;
 
-/// The IMU rates `--imu-rate` accepts, Hz: from a slow block to what the pipeline carries.
+mod retired;
+
+/// The IMU rates `device.imu_rate_hz` (and `--imu-rate`) accepts, Hz: from a slow block to what
+/// the pipeline carries.
 pub const MIN_IMU_RATE_HZ: f64 = 50.0;
 /// See [`MIN_IMU_RATE_HZ`].
 pub const MAX_IMU_RATE_HZ: f64 = 16_000.0;
@@ -30,14 +33,20 @@ pub const PEDESTRIAN: &str = include_str!("../config/pedestrian.toml");
 /// navigator settings only.
 pub const UAV: &str = include_str!("../config/uav.toml");
 
-/// What the sensor block's datasheet says about its converters.
+/// What the sensor block's datasheet says about its converters and its output rate: the one place
+/// the IMU rate is stated (fusion, the simulator and the timing of every stage follow it).
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct DeviceConfig {
-    /// Gyro full scale: ±this many °/s over the 12-bit range.
+    /// Gyro full scale: ±this many °/s over the converter's range.
     pub gyro_full_scale_dps: f64,
-    /// Accelerometer full scale: ±this many g over the 12-bit range.
+    /// Accelerometer full scale: ±this many g over the converter's range.
     pub accel_full_scale_g: f64,
+    /// The converter's resolution, bits (8..=16): full scale is 2^(bits−1) counts. The serial
+    /// protocol carries 12-bit counts; other values are for recordings replayed without it.
+    pub converter_bits: u8,
+    /// The block's output rate, Hz.
+    pub imu_rate_hz: f64,
 }
 
 impl Default for DeviceConfig {
@@ -45,16 +54,23 @@ impl Default for DeviceConfig {
         Self {
             gyro_full_scale_dps: 300.0,
             accel_full_scale_g: 8.0,
+            converter_bits: SERIAL_CONVERTER_BITS,
+            imu_rate_hz: 1000.0,
         }
     }
 }
 
 use rins_earth::STANDARD_GRAVITY;
-use rins_protocol::layout::COUNTS_PER_FULL_SCALE;
+
+/// The converter resolution the serial protocol carries, bits.
+pub const SERIAL_CONVERTER_BITS: u8 = 12;
+/// Converter resolutions `device.converter_bits` accepts.
+pub const CONVERTER_BITS: std::ops::RangeInclusive<u8> =
+    rins_fusion::fdi::channel_health::CONVERTER_BITS;
 
 impl DeviceConfig {
-    /// Checks both full scales (finite, positive, within what a MEMS converter offers); the error
-    /// names the field and its value.
+    /// Checks both full scales (finite, positive, within what a MEMS converter offers), the
+    /// converter's bits and the IMU rate; the error names the field and its value.
     pub fn validate(&self) -> Result<(), String> {
         for (field, value, max) in [
             (
@@ -72,17 +88,56 @@ impl DeviceConfig {
                 return Err(format!("{field} = {value}: must be > 0 and <= {max}"));
             }
         }
+        if !CONVERTER_BITS.contains(&self.converter_bits) {
+            return Err(format!(
+                "device.converter_bits = {}: must be {}..={}",
+                self.converter_bits,
+                CONVERTER_BITS.start(),
+                CONVERTER_BITS.end()
+            ));
+        }
+        let hz = self.imu_rate_hz;
+        if !(hz.is_finite() && (MIN_IMU_RATE_HZ..=MAX_IMU_RATE_HZ).contains(&hz)) {
+            return Err(format!(
+                "device.imu_rate_hz = {hz}: must be {MIN_IMU_RATE_HZ}..={MAX_IMU_RATE_HZ} Hz"
+            ));
+        }
         Ok(())
+    }
+
+    /// Counts per full scale: 2^(bits−1).
+    pub fn counts_per_full_scale(&self) -> f64 {
+        f64::from(
+            1u32 << (self
+                .converter_bits
+                .clamp(*CONVERTER_BITS.start(), *CONVERTER_BITS.end())
+                - 1),
+        )
     }
 
     /// One gyro count, rad/s: the full scale spread over the converter's counts.
     pub fn gyro_lsb_rps(&self) -> f64 {
-        self.gyro_full_scale_dps.to_radians() / COUNTS_PER_FULL_SCALE
+        self.gyro_full_scale_dps.to_radians() / self.counts_per_full_scale()
     }
 
     /// One accelerometer count, m/s².
     pub fn accel_lsb_mps2(&self) -> f64 {
-        self.accel_full_scale_g * STANDARD_GRAVITY / COUNTS_PER_FULL_SCALE
+        self.accel_full_scale_g * STANDARD_GRAVITY / self.counts_per_full_scale()
+    }
+
+    /// Refuses a converter other than the serial protocol's 12 bits for a deployment that reads
+    /// the serial line.
+    pub fn check_serial_link(&self) -> Result<()> {
+        if self.converter_bits != SERIAL_CONVERTER_BITS {
+            bail!(
+                "device.converter_bits = {}: the serial line carries {SERIAL_CONVERTER_BITS}-bit \
+                 counts, so a deployment reading it needs converter_bits = {SERIAL_CONVERTER_BITS} \
+                 (a recording of a {}-bit block is replayed without the serial link)",
+                self.converter_bits,
+                self.converter_bits
+            );
+        }
+        Ok(())
     }
 }
 
@@ -156,13 +211,35 @@ impl RinsConfig {
     /// Parses and validates a configuration text; errors start with `origin` (the file's path or
     /// the built-in profile's name) and name the offending field and value.
     pub fn parse(text: &str, origin: &str) -> Result<Self> {
-        let mut cfg: RinsConfig =
-            toml::from_str(text).map_err(|e| anyhow!("{origin}: {}", e.to_string().trim_end()))?;
+        let syntax = |e: toml::de::Error| anyhow!("{origin}: {}", e.to_string().trim_end());
+        let table: toml::Table = toml::from_str(text).map_err(syntax)?;
+        if let Some(message) = retired::retired_keys(&table) {
+            bail!("{origin}: {message}");
+        }
+        let mut cfg: RinsConfig = toml::from_str(text).map_err(syntax)?;
+        cfg.device
+            .validate()
+            .map_err(|e| anyhow!("{origin}: {e}"))?;
+        cfg.apply_device();
         cfg.validate().map_err(|e| anyhow!("{origin}: {e}"))?;
-        // The simulated block has the configured device's converters.
-        cfg.sim.sensors.gyro_full_scale_dps = cfg.device.gyro_full_scale_dps;
-        cfg.sim.sensors.accel_full_scale_g = cfg.device.accel_full_scale_g;
         Ok(cfg)
+    }
+
+    /// Hands `[device]` to every table that depends on the block: fusion's rate and converter,
+    /// the simulator's rate (its slower sensors capped at it) and converters.
+    fn apply_device(&mut self) {
+        let hz = self.device.imu_rate_hz;
+        self.fusion.block = rins_fusion::config::ImuBlock {
+            imu_rate_hz: hz,
+            converter_bits: self.device.converter_bits,
+        };
+        self.sim.imu_rate_hz = hz;
+        self.sim.baro_rate_hz = self.sim.baro_rate_hz.min(hz);
+        self.sim.mag_rate_hz = self.sim.mag_rate_hz.min(hz);
+        self.sim.aux_rate_hz = self.sim.aux_rate_hz.min(hz);
+        // The simulated block has the configured device's converters.
+        self.sim.sensors.gyro_full_scale_dps = self.device.gyro_full_scale_dps;
+        self.sim.sensors.accel_full_scale_g = self.device.accel_full_scale_g;
     }
 
     /// Checks every table; the error names the first bad field with its table and its value.
@@ -204,22 +281,19 @@ impl RinsConfig {
             rins_sim::Scenario::Uav => "uav",
             rins_sim::Scenario::Walk => "walk",
             rins_sim::Scenario::Calibrate => "calibrate",
+            rins_sim::Scenario::Multirotor => "multirotor",
         }
     }
 
-    /// The block's IMU sample rate, `hz`, everywhere the configuration states it: the
-    /// simulator's rate, fusion's nominal rate and its Kalman filter's period. The other
-    /// simulated sensors keep their rates (capped at the IMU's).
+    /// Sets the block's IMU sample rate, `device.imu_rate_hz`, and hands it on (fusion's noise,
+    /// windows and Kalman period, the simulator's tick). The other simulated sensors keep their
+    /// rates (capped at the IMU's).
     pub fn set_imu_rate(&mut self, hz: f64) -> Result<()> {
         if !(hz.is_finite() && (MIN_IMU_RATE_HZ..=MAX_IMU_RATE_HZ).contains(&hz)) {
             bail!("--imu-rate {hz}: must be {MIN_IMU_RATE_HZ}..={MAX_IMU_RATE_HZ} Hz");
         }
-        self.sim.imu_rate_hz = hz;
-        self.sim.baro_rate_hz = self.sim.baro_rate_hz.min(hz);
-        self.sim.mag_rate_hz = self.sim.mag_rate_hz.min(hz);
-        self.sim.aux_rate_hz = self.sim.aux_rate_hz.min(hz);
-        self.fusion.sample_rate_hz = hz;
-        self.fusion.kalman.sample_period_s = 1.0 / hz;
+        self.device.imu_rate_hz = hz;
+        self.apply_device();
         self.validate().map_err(|e| anyhow!("--imu-rate {hz}: {e}"))
     }
 
@@ -230,6 +304,7 @@ impl RinsConfig {
             ScenarioArg::Uav => rins_sim::Scenario::Uav,
             ScenarioArg::Walk => rins_sim::Scenario::Walk,
             ScenarioArg::Calibrate => rins_sim::Scenario::Calibrate,
+            ScenarioArg::Multirotor => rins_sim::Scenario::Multirotor,
         };
     }
 }
@@ -334,6 +409,56 @@ mod tests {
         let err = RinsConfig::parse("[deployment]\nnavigator_lanes = 3\n", "t").unwrap_err();
         assert!(
             format!("{err}").contains("deployment.navigator_lanes = 3: must be 1 or 2"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn the_converter_bits_set_the_lsb_and_the_serial_link_needs_12() {
+        let cfg = RinsConfig::parse("[device]\nconverter_bits = 16\n", "t").unwrap();
+        let lsb = cfg.device.gyro_lsb_rps();
+        assert!((lsb - 300f64.to_radians() / 32768.0).abs() < 1e-18, "{lsb}");
+        assert_eq!(cfg.fusion.block.converter_bits, 16);
+        let err = cfg.device.check_serial_link().unwrap_err().to_string();
+        assert!(
+            err.contains("device.converter_bits = 16") && err.contains("12-bit"),
+            "{err}"
+        );
+        let twelve = load(None).unwrap();
+        twelve.device.check_serial_link().unwrap();
+        assert!((twelve.device.accel_lsb_mps2() - 8.0 * STANDARD_GRAVITY / 2048.0).abs() < 1e-15);
+        let err = RinsConfig::parse("[device]\nconverter_bits = 17\n", "t").unwrap_err();
+        assert!(
+            format!("{err}").contains("device.converter_bits = 17: must be 8..=16"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn the_imu_rate_is_one_key_handed_to_every_table() {
+        let cfg = RinsConfig::parse("[device]\nimu_rate_hz = 250\n", "t").unwrap();
+        assert_eq!(cfg.fusion.block.imu_rate_hz, 250.0);
+        assert_eq!(cfg.sim.imu_rate_hz, 250.0);
+        let mut cfg = load(None).unwrap();
+        cfg.set_imu_rate(4000.0).unwrap();
+        assert_eq!(
+            (
+                cfg.device.imu_rate_hz,
+                cfg.fusion.block.imu_rate_hz,
+                cfg.sim.imu_rate_hz
+            ),
+            (4000.0, 4000.0, 4000.0)
+        );
+        let err = RinsConfig::parse("[fusion]\nsample_rate_hz = 500\n", "f.toml").unwrap_err();
+        assert!(
+            format!("{err}").contains(
+                "f.toml: fusion.sample_rate_hz is no longer read: the IMU rate is one key, device.imu_rate_hz"
+            ),
+            "{err}"
+        );
+        let err = RinsConfig::parse("[device]\nimu_rate_hz = 20000\n", "t").unwrap_err();
+        assert!(
+            format!("{err}").contains("device.imu_rate_hz = 20000"),
             "{err}"
         );
     }

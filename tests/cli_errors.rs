@@ -24,10 +24,22 @@ fn unknown_config_key_is_rejected_by_name() {
 
 #[test]
 fn out_of_range_value_names_field_and_value() {
-    let f = config_file("[sim]\nimu_rate_hz = 0\n");
+    let f = config_file("[device]\nimu_rate_hz = 0\n");
     fails_with(
         &["up", "--duration", "1", "--config", f.path()],
-        &["sim.imu_rate_hz = 0"],
+        &["device.imu_rate_hz = 0"],
+    );
+    // A key from before the rate was one key is refused with what to write instead.
+    let f = config_file("[sim]\nimu_rate_hz = 500\n");
+    fails_with(
+        &["up", "--duration", "1", "--config", f.path()],
+        &["sim.imu_rate_hz is no longer read", "device.imu_rate_hz"],
+    );
+    // The serial line carries 12-bit counts: a 16-bit block is for replayed recordings.
+    let f = config_file("[device]\nconverter_bits = 16\n");
+    fails_with(
+        &["up", "--duration", "1", "--config", f.path()],
+        &["device.converter_bits = 16", "12-bit"],
     );
     let f = config_file(
         "[fusion.geometry.gyro]\nkind = \"pyramid\"\nn = 2\nalpha_deg = 30\nbeta0_deg = 0\n",
@@ -144,4 +156,16 @@ fn a_root_and_prefix_too_long_for_socket_names_are_refused_naming_both() {
         assert!(!ipc.root.exists(), "{args:?} created the root");
         assert_eq!(ipc.shm_entries(), Vec::<String>::new());
     }
+}
+
+#[test]
+fn a_fault_for_a_source_that_is_not_fitted_is_refused_at_start() {
+    fails_with(
+        &["up", "--duration", "1", "--inject", "gnss:jump=50@5s"],
+        &["gnss:jump=50@5s", "no GNSS receiver is fitted", "--gnss"],
+    );
+    fails_with(
+        &["up", "--duration", "1", "--inject", "gyro4:dead@1s"],
+        &["gyro4", "4 gyro channels"],
+    );
 }

@@ -103,6 +103,35 @@ fn a_still_foot_scores_zero_on_both_metrics_and_a_broken_file_is_listed_not_fata
     assert!(num(&reference, "mean_armse_m").abs() < 1e-3, "{reference}");
 }
 
+/// The held-out run of each walk repeated by the running processes (a private deployment per
+/// walk, fed the walk as 16-bit counts) lands on the in-process one: a still foot under constant
+/// zero-velocity updates moves by far less than a millimetre whatever the last count's rounding,
+/// and the processes compute exactly what the same library code does in this process.
+#[test]
+fn a_still_foot_through_the_running_processes_matches_the_in_process_run() {
+    let dir = std::env::temp_dir().join(format!("rins-eval-foot-live-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("a.csv"), still_trial()).unwrap();
+    std::fs::write(dir.join("b.csv"), still_trial()).unwrap();
+    let r = run_json(&["eval", "pyshoe", dir.to_str().unwrap(), "--json", "--live"]);
+    let _ = std::fs::remove_dir_all(&dir);
+
+    let trials = r["trials"].as_array().expect("trials");
+    assert_eq!(trials.len(), 2, "{r}");
+    for t in trials {
+        assert!(num(t, "live_vs_offline_max_diff_m") < 1e-3, "{t}");
+        assert!(num(t, "live_vs_same_input_max_diff_m") < 1e-9, "{t}");
+        assert!(
+            (num(t, "live_armse_m") - num(t, "offline_armse_m")).abs() < 1e-3,
+            "{t}"
+        );
+        assert_eq!(t["live_samples_missing"].as_u64(), Some(0), "{t}");
+        assert_eq!(t["live_alignment_offset_samples"].as_i64(), Some(0), "{t}");
+    }
+    assert!(num(&r, "live_vs_offline_max_diff_m") < 1e-3, "{r}");
+}
+
 #[test]
 fn real_walks_carry_both_metrics_the_peer_and_the_reference_method() {
     let Some(dir) = rins_eval::datasets::recording_set("pyshoe-vicon") else {

@@ -1,7 +1,7 @@
 //! `rins eval fdi|pyshoe|xio|quadrotor`: loads the configuration, runs the evaluation from
 //! `rins-eval` with a progress bar and prints the report.
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use rins_eval::fdi::{FdiRequest, draw_roc, evaluate, to_table};
 
 use rins_eval::foot::FootMethod;
@@ -68,16 +68,37 @@ fn plotted(what: &str, dir: Option<&std::path::Path>) {
 }
 
 pub fn run_pyshoe(args: &EvalPyshoeArgs) -> Result<()> {
-    let aided = pedestrian(&args.common)?;
+    let profile = config::load_pedestrian(args.common.profile.as_deref())?;
+    let aided = profile.navigator.aided_config();
     let mut bar = super::progress::Progress::new("eval pyshoe");
-    let report = rins_eval::foot::evaluate_pyshoe(
-        &args.dir,
-        &aided,
-        foot_method(args.method),
-        args.plot.as_deref(),
-        &mut |d, t| bar.set(d, t),
-    )?;
+    let mut progress = |d, t| bar.set(d, t);
+    let (mut report, walks) = if args.live {
+        rins_eval::foot::evaluate_pyshoe_with_runs(
+            &args.dir,
+            &aided,
+            foot_method(args.method),
+            args.plot.as_deref(),
+            &mut progress,
+        )?
+    } else {
+        let report = rins_eval::foot::evaluate_pyshoe(
+            &args.dir,
+            &aided,
+            foot_method(args.method),
+            args.plot.as_deref(),
+            &mut progress,
+        )?;
+        (report, Vec::new())
+    };
     bar.finish();
+    if args.live {
+        let text = match &args.common.profile {
+            Some(path) => std::fs::read_to_string(path)
+                .with_context(|| format!("cannot read {}", path.display()))?,
+            None => config::PEDESTRIAN.to_string(),
+        };
+        super::eval_live::pyshoe(&profile, &text, &walks, &mut report)?;
+    }
     plotted("pyshoe", args.plot.as_deref());
     print(
         args.common.json,
@@ -110,6 +131,22 @@ pub fn run_quadrotor(args: &EvalQuadrotorArgs) -> Result<()> {
         .navigator
         .aided_config();
     let mut bar = super::progress::Progress::new("eval quadrotor");
+    if args.live && args.mode != QuadrotorMode::Ahrs {
+        anyhow::bail!("eval quadrotor: --live runs --mode ahrs only");
+    }
+    if args.live {
+        let (mut report, runs) =
+            rins_eval::quadrotor_ahrs::evaluate_with_runs(&args.dir, &aided, &mut |d, t| {
+                bar.set(d, t)
+            })?;
+        bar.finish();
+        super::eval_live::quadrotor_ahrs(&args.dir, &runs, &mut report)?;
+        return print(
+            args.common.json,
+            &report,
+            rins_eval::quadrotor_ahrs::report::to_table,
+        );
+    }
     if args.mode == QuadrotorMode::Ahrs {
         let report =
             rins_eval::quadrotor_ahrs::evaluate(&args.dir, &aided, &mut |d, t| bar.set(d, t))?;

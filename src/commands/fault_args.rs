@@ -4,20 +4,26 @@
 use anyhow::{Result, anyhow};
 use rins_sim::FaultParseError;
 use rins_sim::fault_schedule::{FaultFile, ScheduledFault};
+use rins_sim::sim_command::FittedSources;
 
 use crate::cli::FaultArgs;
 use crate::config::RinsConfig;
 
-/// Number of gyro and accelerometer channels of the configured sensor block.
-pub fn channel_counts(cfg: &RinsConfig) -> Result<(usize, usize)> {
+/// What the configured deployment fits: the sensor block's gyro and accelerometer channels, and
+/// whether a (simulated) GNSS receiver runs.
+pub fn fitted_sources(cfg: &RinsConfig) -> Result<FittedSources> {
     let (gyro, accel) = cfg.geometries()?;
-    Ok((gyro.n(), accel.n()))
+    Ok(FittedSources {
+        n_gyro: gyro.n(),
+        n_accel: accel.n(),
+        gnss_receiver: cfg.gnss.enabled || cfg.sim.gnss.enabled,
+    })
 }
 
-/// Every scheduled fault of `args`, each checked against a block of `n_gyro` gyros and
-/// `n_accel` accelerometers; errors name the option or file and the offending token.
-pub fn schedule(args: &FaultArgs, n_gyro: usize, n_accel: usize) -> Result<Vec<ScheduledFault>> {
-    let fitted = |f: &ScheduledFault| f.command.check_fitted(n_gyro, n_accel);
+/// Every scheduled fault of `args`, each checked against what `sources` fits; errors name the
+/// option or file and the offending token.
+pub fn schedule(args: &FaultArgs, sources: &FittedSources) -> Result<Vec<ScheduledFault>> {
+    let fitted = |f: &ScheduledFault| f.command.check_fitted(sources);
     let mut faults = Vec::new();
     for spec in &args.inject {
         let fault = ScheduledFault::parse(spec)

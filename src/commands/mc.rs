@@ -23,6 +23,9 @@ fn mc_config(args: &McArgs) -> Result<McConfig> {
         mc.navigator = cfg.navigator;
         mc.altimeter = cfg.altimeter;
     }
+    if let Some(scenario) = args.scenario {
+        mc.sim.scenario = scenario.into();
+    }
     if let Some(runs) = args.runs {
         mc.runs = runs;
     }

@@ -6,8 +6,10 @@ mod control;
 mod echo;
 mod echo_readable;
 mod eval;
+mod eval_live;
 mod fault_args;
 mod geometry;
+mod import;
 mod inject;
 mod latency;
 mod mc;
@@ -28,7 +30,7 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 
-use crate::cli::{BenchCommand, CalibrateCommand, Cli, Command, EvalCommand};
+use crate::cli::{BenchCommand, CalibrateCommand, Cli, Command, EvalCommand, ImportCommand};
 
 pub fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
@@ -77,6 +79,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Latency(args) => latency::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Bench { what } => match what {
             BenchCommand::Ipc(args) => bench::run_ipc(&args).map(|()| ExitCode::SUCCESS),
+            BenchCommand::Rates(args) => bench::run_rates(&args).map(|()| ExitCode::SUCCESS),
             BenchCommand::IpcReceiver { phase_limit } => {
                 bench::run_receiver(phase_limit).map(|()| ExitCode::SUCCESS)
             }
@@ -89,6 +92,10 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             EvalCommand::Pyshoe(args) => eval::run_pyshoe(&args).map(|()| ExitCode::SUCCESS),
             EvalCommand::Xio(args) => eval::run_xio(&args).map(|()| ExitCode::SUCCESS),
             EvalCommand::Quadrotor(args) => eval::run_quadrotor(&args).map(|()| ExitCode::SUCCESS),
+        },
+        Command::Import { what } => match what {
+            ImportCommand::Quadrotor(args) => import::run_quadrotor(&args),
+            ImportCommand::Pyshoe(args) => import::run_pyshoe(&args),
         },
         Command::Mc(args) => mc::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Sweep(args) => sweep::run(&args).map(|()| ExitCode::SUCCESS),

@@ -3,34 +3,22 @@
 //! navigation output compared with the recorded one, sample for sample. `--offline` runs the same
 //! library code in this process instead.
 
-use std::collections::HashSet;
-use std::process::{Child, Command, ExitCode, Stdio};
-use std::time::{Duration, Instant};
+use std::process::ExitCode;
+use std::time::Instant;
 
-use anyhow::{Context, Result, anyhow, bail};
-use std::collections::VecDeque;
+use anyhow::{Result, bail};
 
-use ipc_types::{Altitude, Health, NavState, RawAux, RawBaro, RawImu, RawMag, ServiceKind, names};
+use ipc_types::NavState;
 use rins::replay::compare::{NavComparison, compare};
 use rins::replay::input::{RawSample, ReplayInput};
+use rins::replay::live::{self, LiveOptions};
 use rins::replay::offline::OfflinePipeline;
-use rins_navigator::aiding_queue::HOLD_US;
-use rins_runtime::ipc::{SUBSCRIBER_BUFFER, TopicPublisher, TopicSubscriber};
 use rins_runtime::shutdown::Shutdown;
-use rins_runtime::tool_node::ToolNode;
 use serde::Serialize;
 
 use crate::cli::ReplayArgs;
 use crate::commands::progress::Progress;
 use crate::config;
-
-/// Raw frames the replay may run ahead of the slower navigator lane: well inside a subscriber's
-/// buffer, so that no sample is ever overwritten before it is taken.
-const AHEAD: u64 = (SUBSCRIBER_BUFFER / 4) as u64;
-/// How long the fresh deployment may take to start every service.
-const START_TIMEOUT: Duration = Duration::from_secs(30);
-/// How long the pipeline may make no progress before the replay gives up.
-const STALL_TIMEOUT: Duration = Duration::from_secs(10);
 
 /// What `rins replay --json` prints last.
 #[derive(Debug, Serialize)]
@@ -159,76 +147,6 @@ fn recorded_span_s(input: &ReplayInput) -> f64 {
     hi.saturating_sub(lo) as f64 * 1e-9
 }
 
-/// The deployment the replay feeds: `rins up` without acquisition and simulator.
-struct Deployment {
-    child: Child,
-}
-
-impl Deployment {
-    fn start(args: &ReplayArgs) -> Result<Self> {
-        let exe = std::env::current_exe().context("cannot locate the rins executable")?;
-        let mut cmd = Command::new(exe);
-        cmd.args(["up", "--external-source", "--json"]);
-        if let Some(config) = &args.config {
-            cmd.arg("--config").arg(config);
-        }
-        let child = cmd
-            .stdout(Stdio::null())
-            .spawn()
-            .context("cannot start the replaying deployment")?;
-        Ok(Self { child })
-    }
-
-    /// Stops the deployment (SIGINT: a clean stop) and waits for it.
-    fn stop(mut self) -> Result<()> {
-        if let Ok(pid) = i32::try_from(self.child.id()) {
-            // SAFETY: kill(2) on our own, not yet reaped, child.
-            unsafe { libc::kill(pid, libc::SIGINT) };
-        }
-        let status = self.child.wait()?;
-        if !status.success() {
-            bail!("the replaying deployment ended with {status}");
-        }
-        Ok(())
-    }
-}
-
-/// The replaying deployment's navigation output, per lane, as it arrives, and how far the
-/// altimeter got.
-struct NavTap {
-    lanes: [TopicSubscriber<NavState>; 2],
-    out: [Vec<NavState>; 2],
-    altitude: TopicSubscriber<Altitude>,
-    /// Device time of the newest altitude, µs.
-    altitude_t_us: Option<u64>,
-}
-
-impl NavTap {
-    fn drain(&mut self) -> Result<bool> {
-        let mut any = false;
-        while let Some(a) = self.altitude.receive()? {
-            self.altitude_t_us = Some(a.header.origin_device_time_us);
-            any = true;
-        }
-        for (sub, out) in self.lanes.iter().zip(&mut self.out) {
-            while let Some(n) = sub.receive()? {
-                out.push(n);
-                any = true;
-            }
-        }
-        Ok(any)
-    }
-
-    /// The sequence number every running lane has delivered up to.
-    fn delivered(&self, lanes: u8) -> u64 {
-        self.out[..usize::from(lanes.clamp(1, 2))]
-            .iter()
-            .map(|o| o.last().map_or(0, |n| n.header.origin_seq))
-            .min()
-            .unwrap_or(0)
-    }
-}
-
 fn replay_live(
     args: &ReplayArgs,
     input: &ReplayInput,
@@ -236,164 +154,18 @@ fn replay_live(
     lanes: u8,
 ) -> Result<[Vec<NavState>; 2]> {
     let shutdown = Shutdown::install()?;
-    // A replay into a running deployment would mix its samples with the live ones: refused, as
-    // `rins up` refuses a second deployment on one prefix.
-    let settings = rins_runtime::ipc::IpcSettings::from_env();
-    rins_watchdog::deployment_checks::ensure_no_live_deployment(&settings)
-        .context("rins replay starts a deployment of its own")?;
-    let deployment = Deployment::start(args)?;
-    let result = feed(input, speed, lanes, &shutdown);
-    let stopped = deployment.stop();
-    let out = result?;
-    stopped?;
-    Ok(out)
-}
-
-/// Waits for every service of the deployment to beat, then publishes the raw samples, paced, and
-/// collects the navigation output.
-fn feed(
-    input: &ReplayInput,
-    speed: Option<f64>,
-    lanes: u8,
-    shutdown: &Shutdown,
-) -> Result<[Vec<NavState>; 2]> {
-    let tool = ToolNode::join("replay")?;
-    let node = tool.node();
-    let heartbeats = TopicSubscriber::<Health>::new(node, names::HEARTBEAT)?;
-    let mut expected: HashSet<u8> = [ServiceKind::Fusion, ServiceKind::Altimeter]
-        .iter()
-        .chain(&ServiceKind::NAVIGATOR_LANES[..usize::from(lanes.clamp(1, 2))])
-        .map(|k| *k as u8)
-        .collect();
-    let deadline = Instant::now() + START_TIMEOUT;
-    while !expected.is_empty() {
-        if shutdown.requested() {
-            bail!("stopped");
-        }
-        if Instant::now() > deadline {
-            bail!(
-                "the replaying deployment did not start within {} s (services missing: {:?})",
-                START_TIMEOUT.as_secs(),
-                expected
-            );
-        }
-        heartbeats.wait(Duration::from_millis(50))?;
-        while let Some(h) = heartbeats.receive()? {
-            expected.remove(&h.service);
-        }
-    }
-    let imu = TopicPublisher::<RawImu>::new(node, names::RAW_IMU)?;
-    let baro = TopicPublisher::<RawBaro>::new(node, names::RAW_BARO)?;
-    let mag = TopicPublisher::<RawMag>::new(node, names::RAW_MAG)?;
-    let aux = TopicPublisher::<RawAux>::new(node, names::RAW_AUX)?;
-    let mut tap = NavTap {
-        lanes: [
-            TopicSubscriber::new(node, names::NAV_LANES[0])?,
-            TopicSubscriber::new(node, names::NAV_LANES[1])?,
-        ],
-        out: [Vec::new(), Vec::new()],
-        altitude: TopicSubscriber::new(node, names::ALTITUDE)?,
-        altitude_t_us: None,
+    let options = LiveOptions {
+        exe: None,
+        config: args.config.clone(),
+        lanes,
+        speed,
+        private: None,
+        log: None,
     };
-    // Barometer samples published whose altitude the navigator may not have yet.
-    let mut baro_in_flight: VecDeque<u64> = VecDeque::new();
-    let t0 = input.raw.first().map_or(0, RawSample::rx_ns);
-    let started = Instant::now();
     let mut progress = Progress::new("replaying");
-    let mut last_imu_seq = 0;
-    for (i, sample) in input.raw.iter().enumerate() {
-        if shutdown.requested() {
-            bail!("stopped");
-        }
-        if let Some(speed) = speed {
-            let due =
-                Duration::from_secs_f64(sample.rx_ns().saturating_sub(t0) as f64 * 1e-9 / speed);
-            if let Some(wait) = due.checked_sub(started.elapsed()) {
-                std::thread::sleep(wait);
-            }
-        }
-        if let RawSample::Imu(raw) = sample {
-            // Never further ahead of the navigator than its buffers hold.
-            wait_until(
-                &mut tap,
-                lanes,
-                raw.header.origin_seq.saturating_sub(AHEAD),
-                last_imu_seq,
-            )?;
-            last_imu_seq = raw.header.origin_seq;
-            // The navigator applies an altitude where the IMU stream passes its time: the
-            // altimeter must have delivered it before an IMU frame that far on is published, as
-            // it had, with time to spare, when the recording was made. (Magnetometer samples go
-            // straight to the navigator, published before the later IMU frames.)
-            let t = raw.header.origin_device_time_us;
-            while let Some(&b) = baro_in_flight.front() {
-                if b.saturating_add(HOLD_US) > t {
-                    break;
-                }
-                wait_for_altitude(&mut tap, b)?;
-                baro_in_flight.pop_front();
-            }
-        }
-        if let RawSample::Baro(raw) = sample {
-            baro_in_flight.push_back(raw.header.origin_device_time_us);
-        }
-        match sample {
-            RawSample::Imu(s) => imu.publish(*s)?,
-            RawSample::Baro(s) => baro.publish(*s)?,
-            RawSample::Mag(s) => mag.publish(*s)?,
-            RawSample::Aux(s) => aux.publish(*s)?,
-        }
-        tap.drain()?;
-        if i % 1000 == 0 {
-            progress.set(i, input.raw.len());
-        }
-    }
+    let out = live::run(&input.raw, &options, &shutdown, &mut |done, total| {
+        progress.set(done, total)
+    })?;
     progress.finish();
-    wait_until(&mut tap, lanes, last_imu_seq, last_imu_seq)?;
-    let out = std::mem::take(&mut tap.out);
-    drop(tap);
-    drop((imu, baro, mag, aux, heartbeats));
-    drop(tool);
-    Ok(out)
-}
-
-/// Drains the topics until the altimeter delivered the altitude of device time `t_us`.
-fn wait_for_altitude(tap: &mut NavTap, t_us: u64) -> Result<()> {
-    let started = Instant::now();
-    while tap.altitude_t_us.is_none_or(|a| a < t_us) {
-        if !tap.drain()? {
-            if started.elapsed() > STALL_TIMEOUT {
-                bail!(
-                    "the replaying altimeter delivered nothing for {} s (waiting for device time {t_us} µs)",
-                    STALL_TIMEOUT.as_secs()
-                );
-            }
-            tap.altitude.wait(Duration::from_millis(1))?;
-        }
-    }
-    Ok(())
-}
-
-/// Drains the navigation output until every lane delivered `seq` (none before the first frame);
-/// an error when nothing comes for [`STALL_TIMEOUT`].
-fn wait_until(tap: &mut NavTap, lanes: u8, seq: u64, published_up_to: u64) -> Result<()> {
-    if published_up_to == 0 {
-        return Ok(());
-    }
-    let mut last_progress = Instant::now();
-    while tap.delivered(lanes) < seq {
-        if tap.drain()? {
-            last_progress = Instant::now();
-        } else if last_progress.elapsed() > STALL_TIMEOUT {
-            return Err(anyhow!(
-                "the replaying pipeline delivered nothing for {} s (navigation up to sequence {}, \
-                 waiting for {seq})",
-                STALL_TIMEOUT.as_secs(),
-                tap.delivered(lanes)
-            ));
-        } else {
-            tap.lanes[0].wait(Duration::from_millis(1))?;
-        }
-    }
-    Ok(())
+    Ok(out.nav)
 }

@@ -46,6 +46,10 @@ pub fn run(
         cfg.validate()
             .map_err(|e| anyhow::anyhow!("--mavlink: {e}"))?;
     }
+    if name == ServiceName::Acquisition {
+        // The serial protocol carries 12-bit counts.
+        cfg.device.check_serial_link()?;
+    }
     let built = cfg.build_services()?;
     let shutdown = Shutdown::install()?;
     let settings = IpcSettings::from_env();

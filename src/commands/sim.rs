@@ -34,7 +34,9 @@ pub fn run(args: &SimArgs) -> Result<()> {
     }
     // The simulated block carries the sensors the fusion geometry describes.
     let (gyro, accel) = cfg.geometries()?;
-    let faults = fault_args::schedule(&args.faults, gyro.n(), accel.n())?;
+    let mut fitted = fault_args::fitted_sources(&cfg)?;
+    fitted.gnss_receiver = cfg.sim.gnss.enabled || args.gnss_link.is_some();
+    let faults = fault_args::schedule(&args.faults, &fitted)?;
     let sim = Simulator::new(&cfg.sim, gyro.axes(), accel.axes(), cfg.sim.seed)?;
     let shutdown = Shutdown::install()?;
     let gnss = (cfg.sim.gnss.enabled || args.gnss_link.is_some()).then(|| GnssOptions {

@@ -47,6 +47,11 @@ fn apply_overrides(cfg: &mut RinsConfig, args: &UpArgs) -> Result<()> {
     {
         bail!("--duration {duration}: must be a positive number of seconds");
     }
+    // A deployment reads the serial line (the simulator's or a device's), unless an external
+    // source (a replay) publishes the raw samples.
+    if !args.external_source {
+        cfg.device.check_serial_link()?;
+    }
     if let Some(port) = &args.port {
         if !port.exists() {
             bail!(
@@ -75,8 +80,7 @@ fn apply_overrides(cfg: &mut RinsConfig, args: &UpArgs) -> Result<()> {
             bail!("--inject and --faults need the simulator: they cannot be used with --port");
         }
         // Checked here so that a bad fault stops the start-up before any child runs.
-        let (n_gyro, n_accel) = fault_args::channel_counts(cfg)?;
-        fault_args::schedule(&args.faults, n_gyro, n_accel)?;
+        fault_args::schedule(&args.faults, &fault_args::fitted_sources(cfg)?)?;
     }
     Ok(())
 }

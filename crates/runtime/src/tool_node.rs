@@ -40,7 +40,15 @@ impl ToolNode {
     /// Joins the deployment as the node `TOOL-PID` (e.g. `echo-1234`) once it is found to be the
     /// expected user's.
     pub fn join(tool: &str) -> Result<Self> {
-        let settings = join_check::settings_to_join()?;
+        Self::join_settings(tool, join_check::settings_to_join()?)
+    }
+
+    /// [`ToolNode::join`] on the deployment of `settings` instead of the environment's (a
+    /// deployment a tool started itself on a private root), once it is found to be the expected
+    /// user's.
+    pub fn join_settings(tool: &str, settings: IpcSettings) -> Result<Self> {
+        settings.check_name_lengths()?;
+        join_check::check_joinable(&settings)?;
         let root = private_dir::without_trailing_slash(Path::new(&settings.root)).to_path_buf();
         let root_existed = std::fs::symlink_metadata(&root).is_ok();
         // A deployment starting now does not clean the prefix while the node is being made (see

@@ -63,8 +63,6 @@ use serde::{Deserialize, Serialize};
 pub const DEFAULT_GYRO_PROCESS_NOISE: f64 = 10.0;
 /// Default white-jerk PSD of the accelerometer side, (m/s³)²/Hz: f_n ≈ 25 Hz with the default noise.
 pub const DEFAULT_ACCEL_PROCESS_NOISE: f64 = 1000.0;
-/// Default nominal IMU sample period, s (1 kHz).
-pub const DEFAULT_SAMPLE_PERIOD_S: f64 = 0.001;
 /// Accepted sample periods, s.
 pub const SAMPLE_PERIOD_RANGE_S: std::ops::RangeInclusive<f64> = 1e-5..=1.0;
 
@@ -99,26 +97,15 @@ impl Default for KalmanProcessNoise {
 }
 
 /// Settings of the Kalman fusion method.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct KalmanConfig {
-    /// White-jerk PSD per sensor type.
+    /// White-jerk PSD per sensor type. (The filter's period is the IMU's, `device.imu_rate_hz`.)
     pub process_noise: KalmanProcessNoise,
-    /// Nominal IMU sample period, s.
-    pub sample_period_s: f64,
-}
-
-impl Default for KalmanConfig {
-    fn default() -> Self {
-        Self {
-            process_noise: KalmanProcessNoise::default(),
-            sample_period_s: DEFAULT_SAMPLE_PERIOD_S,
-        }
-    }
 }
 
 impl KalmanConfig {
-    /// Checks every field; errors name it (`process_noise.gyro`, `sample_period_s`, …) and its value.
+    /// Checks every field; errors name it (`process_noise.gyro`, …) and its value.
     pub fn validate(&self) -> Result<(), ConfigError> {
         for (field, q) in [
             ("process_noise.gyro", self.process_noise.gyro),
@@ -127,18 +114,6 @@ impl KalmanConfig {
             if !(q.is_finite() && q > 0.0) {
                 return Err(ConfigError::new(field, q, "must be finite and > 0"));
             }
-        }
-        let dt = self.sample_period_s;
-        if !SAMPLE_PERIOD_RANGE_S.contains(&dt) {
-            return Err(ConfigError::new(
-                "sample_period_s",
-                dt,
-                format!(
-                    "must be in {:e}..={} s",
-                    SAMPLE_PERIOD_RANGE_S.start(),
-                    SAMPLE_PERIOD_RANGE_S.end()
-                ),
-            ));
         }
         Ok(())
     }

@@ -210,8 +210,8 @@ fn config_parses_from_toml_and_errors_name_fields() {
         kind = "axes"
         axes = [[1, 0, 0], [0, 1, 0], [0, 0, 1], [0.57735, 0.57735, 0.57735], [0.57735, -0.57735, 0.57735]]
         [noise]
-        gyro_sigma_rps = [0.005, 0.005, 0.005, 0.006, 0.007]
-        accel_sigma_mps2 = 0.05
+        gyro_noise_density_dps_rthz = [0.01, 0.01, 0.01, 0.012, 0.014]
+        accel_noise_density_ug_rthz = 160
         [calibration.accel]
         scale = [1.0, 1.01, 0.99, 1.0]
         [fdi]
@@ -223,7 +223,23 @@ fn config_parses_from_toml_and_errors_name_fields() {
     "#;
     let cfg: FusionConfig = toml::from_str(text).unwrap();
     cfg.validate().unwrap();
-    assert_eq!(cfg.noise.accel_sigma_mps2, ChannelNoise::Uniform(0.05));
+    assert_eq!(
+        cfg.noise.accel_noise_density_ug_rthz,
+        ChannelNoise::Uniform(160.0)
+    );
+    // The per-sample σ is the density times √rate, at the block's rate.
+    let sigmas = cfg.channel_sigmas(ipc_types::SensorType::Gyro).unwrap();
+    assert!(
+        (sigmas[4] - 0.014f64.to_radians() * 1000f64.sqrt()).abs() < 1e-15,
+        "{sigmas:?}"
+    );
+    let mut fast = cfg.clone();
+    fast.block.imu_rate_hz = 4000.0;
+    let fast_sigmas = fast.channel_sigmas(ipc_types::SensorType::Gyro).unwrap();
+    assert!(
+        (fast_sigmas[4] / sigmas[4] - 2.0).abs() < 1e-12,
+        "{fast_sigmas:?}"
+    );
     assert_eq!(
         (
             cfg.fdi.persistence_k,
@@ -250,21 +266,26 @@ fn config_parses_from_toml_and_errors_name_fields() {
             .to_string()
     };
     assert_eq!(
-        err("[noise]\ngyro_sigma_rps = [0.1, 0.1, 0.1]"),
-        "noise.gyro_sigma_rps = 3 entries: must be one number or have 4 entries (one per channel)"
+        err("[noise]\ngyro_noise_density_dps_rthz = [0.1, 0.1, 0.1]"),
+        "noise.gyro_noise_density_dps_rthz = 3 entries: must be one number or have 4 entries (one per channel)"
     );
     assert_eq!(
-        err("[noise]\naccel_sigma_mps2 = [0.1, -0.1, 0.1, 0.1]"),
-        "noise.accel_sigma_mps2[1] = -0.1: must be in [1e-9, 1e3]"
+        err("[noise]\naccel_noise_density_ug_rthz = [100, -100, 100, 100]"),
+        "noise.accel_noise_density_ug_rthz[1] = -100: must be in [1e-9, 1e6]"
     );
     assert_eq!(
-        err("[noise]\ngyro_sigma_rps = 0"),
-        "noise.gyro_sigma_rps = 0: must be in [1e-9, 1e3]"
+        err("[noise]\ngyro_noise_density_dps_rthz = 0"),
+        "noise.gyro_noise_density_dps_rthz = 0: must be in [1e-9, 1e6]"
     );
     // So large that σ² overflows and the least squares loses its solution.
     assert_eq!(
-        err("[noise]\ngyro_sigma_rps = 1e308"),
-        "noise.gyro_sigma_rps = 1e308: must be in [1e-9, 1e3]"
+        err("[noise]\ngyro_noise_density_dps_rthz = 1e308"),
+        "noise.gyro_noise_density_dps_rthz = 1e308: must be in [1e-9, 1e6]"
+    );
+    // Within the density's range, but a per-sample σ no least squares can weigh.
+    assert_eq!(
+        err("[noise]\ngyro_noise_density_dps_rthz = 1e5"),
+        "noise.gyro_noise_density_dps_rthz = 100000: gives a per-sample σ of 5.519e4 at the IMU rate: must be in [1e-9, 1e3]"
     );
     assert_eq!(
         err("[calibration.accel]\nscale = [1, 0, 1, 1]"),
@@ -332,16 +353,15 @@ fn method_kalman_and_rest_bias_keys_parse_and_errors_name_fields() {
     let text = r#"
         method = "kalman"
         rest_bias_s = 2.5
-        sample_rate_hz = 500
-        [kalman]
-        sample_period_s = 0.002
         [kalman.process_noise]
         gyro = 20.0
         accel = 500.0
     "#;
-    let cfg: FusionConfig = toml::from_str(text).unwrap();
+    let mut cfg: FusionConfig = toml::from_str(text).unwrap();
+    cfg.block.imu_rate_hz = 500.0;
     cfg.validate().unwrap();
     assert_eq!(cfg.method, FusionMethod::Kalman);
+    assert_eq!(cfg.sample_period_s(), 0.002);
     assert_eq!(
         (
             cfg.kalman.process_noise.gyro,
@@ -356,7 +376,7 @@ fn method_kalman_and_rest_bias_keys_parse_and_errors_name_fields() {
 
     let d = FusionConfig::default();
     assert_eq!(d.method, FusionMethod::Wls);
-    assert_eq!((d.rest_bias_s, d.sample_rate_hz), (1.0, 1000.0));
+    assert_eq!((d.rest_bias_s, d.block.imu_rate_hz), (1.0, 1000.0));
     assert_eq!(d.rest_bias_samples().unwrap(), 1000);
     let off: FusionConfig = toml::from_str("rest_bias_s = 0").unwrap();
     assert_eq!(off.rest_bias_samples().unwrap(), 0);
@@ -374,25 +394,34 @@ fn method_kalman_and_rest_bias_keys_parse_and_errors_name_fields() {
         err("[kalman.process_noise]\ngyro = -1"),
         "kalman.process_noise.gyro = -1: must be finite and > 0"
     );
-    assert!(
-        err("[kalman]\nsample_period_s = 0").starts_with("kalman.sample_period_s = 0: must be in")
-    );
-    assert_eq!(
-        err("method = \"kalman\"\nsample_rate_hz = 500"),
-        "kalman.sample_period_s = 0.001: must be 1 / sample_rate_hz = 0.002 s with method = \"kalman\""
-    );
+    // The rate is the device's, not a [fusion] key.
+    for old in ["sample_rate_hz = 500", "[kalman]\nsample_period_s = 0.002"] {
+        assert!(toml::from_str::<FusionConfig>(old).is_err(), "{old}");
+    }
     assert_eq!(
         err("rest_bias_s = -1"),
         "rest_bias_s = -1: must be in 0..=600 s (0 disables it)"
     );
     assert_eq!(
         err("rest_bias_s = 0.005"),
-        "rest_bias_s = 0.005: must span at least 10 samples at sample_rate_hz = 1000 (or be 0)"
+        "rest_bias_s = 0.005: must span at least 10 samples at device.imu_rate_hz = 1000 (or be 0)"
     );
+    let mut zero = FusionConfig::default();
+    zero.block.imu_rate_hz = 0.0;
     assert_eq!(
-        err("sample_rate_hz = 0"),
-        "sample_rate_hz = 0: must be in 1..=100000 Hz"
+        zero.validate().unwrap_err().to_string(),
+        "device.imu_rate_hz = 0: must be in 1..=100000 Hz"
     );
+    // The stationary block is in seconds: 0.2 s is 8 samples at 40 Hz, too few for a spread.
+    let mut slow = FusionConfig::default();
+    slow.block.imu_rate_hz = 40.0;
+    slow.rest_bias_s = 0.0;
+    assert_eq!(
+        slow.validate().unwrap_err().to_string(),
+        "fdi.stationary_window_s = 0.2: must span at least 10 samples at device.imu_rate_hz = 40"
+    );
+    slow.block.imu_rate_hz = 100.0;
+    slow.validate().unwrap();
     let e = toml::from_str::<FusionConfig>("method = \"median\"").unwrap_err();
     assert!(e.to_string().contains("unknown variant"), "{e}");
     let e = ImuFuser::new(

@@ -12,6 +12,7 @@ use crate::mag_calibration::MagCalibration;
 use crate::mag_heading::MagAidingConfig;
 use crate::mechanisation::StrapdownConfig;
 use crate::stance::StanceConfig;
+use crate::start::InFlightStart;
 use crate::tilt_aiding::TiltAidingConfig;
 use rins_earth::normal_gravity;
 
@@ -69,6 +70,10 @@ pub struct NavigatorConfig {
     pub mag_calibration: MagCalibration,
     /// Integrity monitor and recovery policies (`[navigator.integrity]`).
     pub integrity: IntegrityConfig,
+    /// An in-flight start (`[navigator.start]`): the state taken over at the first IMU sample at
+    /// or after its time instead of a static alignment (absent: static alignment).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub start: Option<InFlightStart>,
 }
 
 impl Default for NavigatorConfig {
@@ -98,6 +103,7 @@ impl Default for NavigatorConfig {
             gnss: GnssAidingConfig::default(),
             mag_calibration: MagCalibration::default(),
             integrity: IntegrityConfig::default(),
+            start: None,
         }
     }
 }
@@ -266,6 +272,17 @@ impl NavigatorConfig {
                 "out of range (nis_window 1..=64, time_stall_samples >= 1, limits >= 0, others finite and > 0)",
             )
             .within("navigator.integrity"));
+        }
+        if let Some(start) = &self.start {
+            start.validate()?;
+            if self.initial_latitude_deg.is_none() {
+                return Err(ConfigError::new(
+                    "start",
+                    "a state",
+                    "needs the position: give initial_latitude_deg and initial_longitude_deg",
+                )
+                .within("navigator"));
+            }
         }
         let calibration = &self.mag_calibration;
         let entries = calibration

@@ -28,6 +28,7 @@ pub mod mechanisation;
 pub mod navigator;
 pub mod service;
 pub mod stance;
+pub mod start;
 pub mod state_history;
 pub mod takeover;
 pub mod tilt_aiding;

@@ -28,6 +28,7 @@ use crate::ekf::{AidingCounts, AidingSource, ErrorStateEkf};
 use crate::gnss_updates::{GnssMeasurement, GnssOutcome};
 use crate::inertial_core::AidedNavigator;
 use crate::mechanisation::{NominalState, StepOutcome};
+use crate::start::InFlightStart;
 use crate::takeover::{TakeOverError, peer_solution};
 use crate::unisolated_fault::FusionFault;
 
@@ -116,6 +117,8 @@ pub struct Navigator {
     rejected_imu_samples: u64,
     /// The integrity of the last sample, evaluated once per sample.
     integrity: (Integrity, u32),
+    /// The in-flight start not yet taken over (`[navigator.start]`).
+    pending_start: Option<InFlightStart>,
 }
 
 impl Navigator {
@@ -128,6 +131,7 @@ impl Navigator {
             state_time_us: 0,
             rejected_imu_samples: 0,
             integrity: (Integrity::Invalid, 0),
+            pending_start: config.start,
             config,
         })
     }
@@ -136,6 +140,7 @@ impl Navigator {
     /// the next IMU sample propagates from the peer's device time.
     pub fn take_over(&mut self, peer: &NavState) -> Result<(), TakeOverError> {
         let sol = peer_solution(peer)?;
+        self.pending_start = None;
         self.core.take_over(
             sol.device_time_us,
             sol.state,
@@ -149,12 +154,50 @@ impl Navigator {
         Ok(())
     }
 
-    /// Drops the solution and starts a new alignment window.
+    /// Drops the solution and starts a new alignment window (a configured in-flight start is
+    /// in the past by now: never taken again).
     pub fn restart_alignment(&mut self) {
         let config = self.config.clone();
-        if let Ok(fresh) = Self::new(config) {
+        if let Ok(mut fresh) = Self::new(config) {
+            fresh.pending_start = None;
             *self = fresh;
         }
+    }
+
+    /// With an in-flight start pending: takes its state over when the IMU stream reaches its time
+    /// (`device_time_us` at or after it). Returns whether the sample is to be left out: it comes
+    /// before the start, or is the start's own instant (the state is already there). A stream
+    /// that is already more than `max_dt_s` past the start (a lane restarted in flight) has left
+    /// the start behind: it is dropped, and the lane aligns or takes the other lane's solution
+    /// over as without one.
+    fn start_in_flight(&mut self, device_time_us: u64) -> bool {
+        let Some(start) = self.pending_start else {
+            return false;
+        };
+        let start_us = start.device_time_us();
+        if device_time_us < start_us {
+            self.state_time_us = device_time_us;
+            return true;
+        }
+        let max_dt_us = (self.config.max_dt_s * 1e6).round() as u64;
+        if device_time_us - start_us > max_dt_us {
+            self.pending_start = None;
+            return false;
+        }
+        let s = start.state(self.core.config());
+        self.core
+            .take_over(s.device_time_us, s.state, s.bias, &s.variances);
+        self.core
+            .set_position_known(self.config.initial_latitude_deg.is_some());
+        self.state_time_us = s.device_time_us;
+        self.pending_start = None;
+        device_time_us == start_us
+    }
+
+    /// Whether an in-flight start waits for the IMU stream to reach its time: the lane then
+    /// takes its own start, not the other lane's solution.
+    pub fn start_pending(&self) -> bool {
+        self.pending_start.is_some()
     }
 
     /// The configuration in use.
@@ -213,6 +256,10 @@ impl Navigator {
         rate_rps: [f64; 3],
         specific_force: [f64; 3],
     ) -> Option<NavOutput> {
+        if self.start_in_flight(device_time_us) {
+            self.integrity = self.core.evaluate_integrity();
+            return self.core.is_navigating().then(|| self.output());
+        }
         let step = self
             .core
             .on_imu(device_time_us, rate_rps, specific_force, None);
@@ -239,6 +286,10 @@ impl Navigator {
     /// integrated; once aligned, the solution is published as it stands with the integrity that
     /// says so. While aligning the window is not disturbed (`None`).
     pub fn on_unusable_imu(&mut self, device_time_us: u64) -> Option<NavOutput> {
+        if self.start_in_flight(device_time_us) {
+            self.integrity = self.core.evaluate_integrity();
+            return self.core.is_navigating().then(|| self.output());
+        }
         self.core.on_unusable_imu(device_time_us);
         self.integrity = self.core.evaluate_integrity();
         self.core.is_navigating().then(|| self.output())

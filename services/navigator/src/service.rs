@@ -190,7 +190,9 @@ impl PipelineStage for NavigatorStage {
     }
 
     fn before_input(&mut self, _counters: &mut Health) -> Result<(), IpcError> {
-        self.listening = self.peer_in.is_some() && self.nav.mode() == NavMode::Aligning;
+        self.listening = self.peer_in.is_some()
+            && self.nav.mode() == NavMode::Aligning
+            && !self.nav.start_pending();
         if let Some(peer_in) = self.peer_in.as_ref().filter(|_| self.listening) {
             while let Some(peer) = peer_in.receive()? {
                 self.handover.push_peer(peer);

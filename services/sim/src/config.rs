@@ -6,6 +6,7 @@ use crate::calibration_config::CalibrationConfig;
 use crate::error::{SimError, check_positive, check_range};
 use crate::sensor_model::mag::EarthField;
 use crate::sensor_model::{Environment, SensorModelConfig};
+use crate::trajectory::multirotor_config::MultirotorConfig;
 use crate::trajectory::{Scenario, TrajectoryStart};
 
 /// Highest accepted IMU rate, Hz.
@@ -54,7 +55,9 @@ pub struct SimConfig {
     pub scenario: Scenario,
     /// Seed of every random draw: the same seed gives the same frames.
     pub seed: u64,
-    /// IMU frame rate (the simulator's base tick), Hz.
+    /// IMU frame rate (the simulator's base tick), Hz: the block's, `device.imu_rate_hz`, set
+    /// by the deployment (not a `[sim]` key).
+    #[serde(skip)]
     pub imu_rate_hz: f64,
     /// Barometer frame rate, Hz (at most the IMU rate).
     pub baro_rate_hz: f64,
@@ -75,6 +78,7 @@ pub struct SimConfig {
     pub static_s: f64,
     /// UAV scenario: length of the whole flight, s (parking, take-off, circuits, landing); the
     /// pair of circuits repeats as many times as fit. Unset: one pair (about 615 s), then parked.
+    /// The multirotor scenario repeats its pattern the same way (unset: one, about 125 s).
     pub uav_flight_s: Option<f64>,
     /// Sea-level pressure of the ISA model, Pa.
     pub qnh_pa: f64,
@@ -84,6 +88,9 @@ pub struct SimConfig {
     pub sensors: SensorModelConfig,
     /// Calibrate scenario: the turns and the magnetometer's hard and soft iron.
     pub calibration: CalibrationConfig,
+    /// Multirotor scenario: the airframe's rotor drag, the gust and the rotor vibration
+    /// (`[sim.multirotor]`).
+    pub multirotor: MultirotorConfig,
     /// The simulated GNSS receiver (`[sim.gnss]`).
     pub gnss: crate::gnss_config::GnssReceiverConfig,
 }
@@ -107,6 +114,7 @@ impl Default for SimConfig {
             earth_field: EarthFieldConfig::default(),
             sensors: SensorModelConfig::default(),
             calibration: CalibrationConfig::default(),
+            multirotor: MultirotorConfig::default(),
             gnss: crate::gnss_config::GnssReceiverConfig::default(),
         }
     }
@@ -116,7 +124,7 @@ impl SimConfig {
     /// Checks every field; the error names the field (`sim.…`) and its value.
     pub fn validate(&self) -> Result<(), SimError> {
         check_positive(
-            "sim.imu_rate_hz",
+            "device.imu_rate_hz",
             self.imu_rate_hz,
             MAX_IMU_RATE_HZ,
             "must be > 0 and <= 100000",
@@ -130,7 +138,7 @@ impl SimConfig {
                 field,
                 rate,
                 self.imu_rate_hz,
-                "must be > 0 and <= sim.imu_rate_hz",
+                "must be > 0 and <= device.imu_rate_hz",
             )?;
         }
         check_range(
@@ -206,6 +214,7 @@ impl SimConfig {
             "must be within -180..=180",
         )?;
         self.calibration.validate()?;
+        self.multirotor.validate()?;
         self.gnss
             .validate(self.imu_rate_hz)
             .map_err(SimError::GnssReceiver)?;
@@ -241,6 +250,7 @@ impl SimConfig {
             static_s: self.static_s,
             uav_flight_s: self.uav_flight_s,
             calibration_sweep_s: self.calibration.sweep_s,
+            multirotor: self.multirotor,
         }
     }
 

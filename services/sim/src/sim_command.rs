@@ -30,6 +30,17 @@ pub enum SimCommand {
 /// The target name of the GNSS receiver in `rins inject gnss …` and `gnss:KIND=PARAM@TIME`.
 pub const GNSS_TARGET: &str = "gnss";
 
+/// What a deployment has fitted, against which a fault is checked before it is scheduled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FittedSources {
+    /// Gyro channels of the sensor block.
+    pub n_gyro: usize,
+    /// Accelerometer channels of the sensor block.
+    pub n_accel: usize,
+    /// A (simulated) GNSS receiver runs.
+    pub gnss_receiver: bool,
+}
+
 impl SimCommand {
     /// A GNSS receiver fault from its short name (`outage`, `jump`, `freeze`, `drift`, `clear`)
     /// and parameter; errors name the piece that is wrong.
@@ -194,11 +205,19 @@ impl SimCommand {
             .map_or_else(|| "device".to_string(), |c| c.to_string())
     }
 
-    /// Checks a channel against the block's channels; a device fault fits any block.
-    pub fn check_fitted(&self, n_gyro: usize, n_accel: usize) -> Result<(), FaultParseError> {
+    /// Checks the command against what is fitted: a channel against the block's channels, a GNSS
+    /// fault against the receiver; a disconnect fits any block.
+    pub fn check_fitted(&self, fitted: &FittedSources) -> Result<(), FaultParseError> {
         match self {
-            Self::Channel(c) => c.channel.check_fitted(n_gyro, n_accel),
-            Self::Disconnect(_) | Self::Gnss { .. } => Ok(()),
+            Self::Channel(c) => c.channel.check_fitted(fitted.n_gyro, fitted.n_accel),
+            Self::Disconnect(_) => Ok(()),
+            // Accepted without a receiver, the fault would change nothing and the run would look
+            // like a receiver that survived it.
+            Self::Gnss { fault, .. } if !fitted.gnss_receiver => Err(FaultParseError::new(
+                fault.name(),
+                "no GNSS receiver is fitted: run with --gnss (or [gnss] enabled = true)",
+            )),
+            Self::Gnss { .. } => Ok(()),
         }
     }
 
@@ -308,11 +327,38 @@ mod tests {
         );
         assert_eq!(d.target(), "device");
         assert_eq!(d.to_string(), "disconnect 2 s");
-        assert!(d.check_fitted(0, 0).is_ok());
+        let none = FittedSources {
+            n_gyro: 0,
+            n_accel: 0,
+            gnss_receiver: false,
+        };
+        assert!(d.check_fitted(&none).is_ok());
         let c = inject("gyro2", Some("bias"), Some("0.5"), None).unwrap();
         assert_eq!((c.fault(), c.param()), (SimFault::BiasStep, 0.5));
         assert_eq!(c.target(), "gyro2");
-        assert!(c.check_fitted(2, 4).is_err());
+        let two_gyros = FittedSources {
+            n_gyro: 2,
+            n_accel: 4,
+            gnss_receiver: false,
+        };
+        assert!(c.check_fitted(&two_gyros).is_err());
+    }
+
+    #[test]
+    fn a_gnss_fault_without_a_receiver_is_refused_naming_it() {
+        let jump = inject("gnss", Some("jump"), Some("50"), None).unwrap();
+        let mut fitted = FittedSources {
+            n_gyro: 4,
+            n_accel: 4,
+            gnss_receiver: false,
+        };
+        let err = jump.check_fitted(&fitted).unwrap_err().to_string();
+        assert!(
+            err.contains("gnss-jump") && err.contains("no GNSS receiver"),
+            "{err}"
+        );
+        fitted.gnss_receiver = true;
+        assert!(jump.check_fitted(&fitted).is_ok());
     }
 
     #[test]

@@ -43,3 +43,19 @@ fn step_does_not_allocate() {
     assert_eq!(allocations, 0);
     assert_eq!(out.truth.imu_seq, 19_999);
 }
+
+/// The multirotor scenario too: its attitude solve, blade-phase table and vibration, through the
+/// take-off and into the pattern.
+#[test]
+fn multirotor_step_does_not_allocate() {
+    let config = common::config(Scenario::Multirotor);
+    let axes = rins_test_support::pyramid::optimal_pyramid_axes();
+    let mut sim = Simulator::new(&config, &axes, &axes, 1).unwrap();
+    let mut out = TickOutput::default();
+    let allocations = allocations_during(|| {
+        for _ in 0..40_000 {
+            sim.step(&mut out);
+        }
+    });
+    assert_eq!(allocations, 0);
+}

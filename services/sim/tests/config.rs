@@ -34,17 +34,22 @@ fn converter_range_is_the_device_s_not_a_simulator_key() {
 fn toml_section_parses_with_defaults_for_missing_fields() {
     let text = r#"
         scenario = "uav"
-        imu_rate_hz = 8000.0
         origin_latitude_deg = 51.5
         [earth_field]
         declination_deg = -1.5
         [sensors]
         mag_soft_iron = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.1]]
     "#;
-    let c: SimConfig = toml::from_str(text).unwrap();
+    let mut c: SimConfig = toml::from_str(text).unwrap();
+    assert_eq!(
+        c.imu_rate_hz, 1000.0,
+        "the rate is the device's, set by the deployment"
+    );
+    c.imu_rate_hz = 8000.0;
     c.validate().unwrap();
     assert_eq!(c.scenario, Scenario::Uav);
-    assert_eq!(c.imu_rate_hz, 8000.0);
+    // Not a [sim] key.
+    assert!(toml::from_str::<SimConfig>("imu_rate_hz = 8000.0").is_err());
     assert_eq!(c.baro_rate_hz, 50.0);
     assert_eq!(c.earth_field.declination_deg, -1.5);
     assert_eq!(c.earth_field.intensity_ut, 50.0);
@@ -74,10 +79,10 @@ fn error_of(mutate: impl FnOnce(&mut SimConfig)) -> String {
 
 #[test]
 fn validation_errors_name_field_and_value() {
-    assert!(error_of(|c| c.imu_rate_hz = 0.0).starts_with("sim.imu_rate_hz = 0: must be > 0"));
-    assert!(error_of(|c| c.imu_rate_hz = f64::NAN).starts_with("sim.imu_rate_hz = NaN"));
+    assert!(error_of(|c| c.imu_rate_hz = 0.0).starts_with("device.imu_rate_hz = 0: must be > 0"));
+    assert!(error_of(|c| c.imu_rate_hz = f64::NAN).starts_with("device.imu_rate_hz = NaN"));
     assert!(error_of(|c| c.baro_rate_hz = -5.0).starts_with("sim.baro_rate_hz = -5: must be > 0"));
-    assert!(error_of(|c| c.mag_rate_hz = 2000.0).contains("<= sim.imu_rate_hz"));
+    assert!(error_of(|c| c.mag_rate_hz = 2000.0).contains("<= device.imu_rate_hz"));
     assert!(error_of(|c| c.aux_rate_hz = 0.0).starts_with("sim.aux_rate_hz = 0"));
     assert!(error_of(|c| c.origin_latitude_deg = 89.0).starts_with("sim.origin_latitude_deg = 89"));
     assert!(
@@ -128,7 +133,7 @@ fn simulator_rejects_bad_config_and_axes() {
     assert!(matches!(
         Simulator::new(&bad, &axes, &axes, 0),
         Err(SimError::Config {
-            field: "sim.imu_rate_hz",
+            field: "device.imu_rate_hz",
             ..
         })
     ));

@@ -25,6 +25,7 @@ fn truth(rate: Vector3<f64>, force: Vector3<f64>) -> TruthState {
         altitude_m: 0.0,
         foot_load: 0.0,
         stance: false,
+        rotor: Default::default(),
     }
 }
 

@@ -1,4 +1,4 @@
-//! `rins bench ipc`: every IPC hop of the pipeline beside the bare transport hop that carries the
+//! `rins bench rates` (see [`rates`]) and `rins bench ipc`: every IPC hop of the pipeline beside the bare transport hop that carries the
 //! same payload, measured in one invocation on the same machine, so each hop is reported as a
 //! ratio to the bare hop measured a minute before it.
 //!
@@ -9,6 +9,9 @@
 //! shared memory removed, whatever happens.
 
 mod bare_hop;
+mod rates;
+
+pub use rates::run_rates;
 
 use std::io::BufReader;
 use std::path::PathBuf;

@@ -9,6 +9,7 @@
 //!   faults injected into the data).
 //! - [`datasets`]: loaders of recorded data sets (the four-IMU quadrotor flights).
 //! - [`integrity_tally`]: the share of a recording the navigator judged ok, degraded, invalid.
+//! - [`import`]: the public recordings as rins's own (raw IMU counts, truth, configuration).
 //! - [`installation`]: relative rotation between IMUs from paired rate vectors (Wahba's problem).
 //! - [`quadrotor_nav`]: free-inertial roll, pitch and height on the quadrotor recordings, each unit
 //!   alone and the units fused.
@@ -18,6 +19,7 @@ pub mod datasets;
 pub mod fault_sweep;
 pub mod fdi;
 pub mod foot;
+pub mod import;
 pub mod installation;
 pub mod integrity_tally;
 pub mod leave_one_out;

@@ -1,7 +1,7 @@
 //! Channel-health checks on the raw counts and calibrated values of one sensor type: the fast
 //! isolation path that works for any N, including N = 4 where parity cannot isolate.
 //!
-//! - **Saturation**: counts at [`COUNT_MIN`] or [`COUNT_MAX`] for `saturation_samples` consecutive
+//! - **Saturation**: counts at the converter's rails ([`count_rails`]) for `saturation_samples` consecutive
 //!   samples. Whether that is a fault or a genuine over-range is decided by the caller from what
 //!   the other channels say (see `monitor`).
 //! - **Stuck**: the same count `stuck_samples` times in a row (not at a rail, which is the
@@ -33,19 +33,90 @@
 //! signal, where the others change almost every sample). A channel frozen at sample t0 repeats
 //! the last good count, so the run reaches 20 at the 19th frozen sample: isolated in ≤ 20 samples.
 //! The figures are checked numerically by the test `stuck_false_alarm_arithmetic`.
+//!
+//! The table is for 1 kHz. The per-sample σ in counts falls with the rate (√rate): at 100 Hz the
+//! accelerometers' is 0.38 counts, and a healthy channel repeats its count in runs far longer than
+//! 20. The configured `stuck_samples` is therefore a floor: the fuser raises it to
+//! [`stuck_run_needed`] for the quietest channel of the type at the configured rate.
 
+use super::chi2::regularized_gamma_p;
 use crate::geometry::MAX_CHANNELS;
 
-/// Lowest count of the signed 12-bit converter.
+/// Lowest count of the signed 12-bit converter (the serial protocol's).
 pub const COUNT_MIN: i16 = -2048;
-/// Highest count of the signed 12-bit converter.
+/// Highest count of the signed 12-bit converter (the serial protocol's).
 pub const COUNT_MAX: i16 = 2047;
+/// Resolutions a converter may have, bits.
+pub const CONVERTER_BITS: std::ops::RangeInclusive<u8> = 8..=16;
+
+/// The rails of a signed converter of `bits` (8..=16): −2^(bits−1) and 2^(bits−1) − 1.
+pub fn count_rails(bits: u8) -> [i16; 2] {
+    let half = 1i32 << (bits.clamp(*CONVERTER_BITS.start(), *CONVERTER_BITS.end()) - 1);
+    // Within i16 for bits <= 16.
+    [(-half) as i16, (half - 1) as i16]
+}
+
+/// Expected fault-free stuck declarations per hour, over all channels of one sensor type, that
+/// the stuck run length is made to stay below (the configured `stuck_samples` is a floor).
+pub const STUCK_FALSE_ALARMS_PER_HOUR: f64 = 0.01;
+/// Longest stuck run the derivation asks for: a channel quieter than this allows cannot be told
+/// from a frozen one by its counts.
+pub const MAX_STUCK_RUN: u32 = 100_000;
+
+/// P(|ε| < x) for ε ~ N(0, σ²) with σ = 1 and x ≥ 0: erf(x/√2).
+fn within(x: f64) -> f64 {
+    regularized_gamma_p(0.5, x * x / 2.0)
+}
+
+/// The probability that a fault-free channel with white noise σ (`sigma_counts`, in counts,
+/// before rounding) whose true value sits on a count repeats one count `run` times in a row:
+/// Σ_k p_k^run with p_k = P(k − ½ < ε < k + ½). A true value on a count is the worst case.
+pub fn repeat_run_probability(sigma_counts: f64, run: u32) -> f64 {
+    if sigma_counts <= 0.0 {
+        return 1.0;
+    }
+    let mut total = within(0.5 / sigma_counts).powf(f64::from(run));
+    // The terms fall off as exp(−k²/2σ²): 8σ + 1 counts either side is far past double precision.
+    let reach = (8.0 * sigma_counts).ceil() as i32 + 1;
+    for k in 1..=reach {
+        let p = 0.5
+            * (within((f64::from(k) + 0.5) / sigma_counts)
+                - within((f64::from(k) - 0.5) / sigma_counts));
+        total += 2.0 * p.max(0.0).powf(f64::from(run));
+    }
+    total
+}
+
+/// The shortest run of identical counts that a fault-free channel of white noise `sigma_counts`
+/// (counts) shows less often than [`STUCK_FALSE_ALARMS_PER_HOUR`] over `channel_samples_per_hour`
+/// (channels × rate × 3600), at most [`MAX_STUCK_RUN`]. At 1 kHz the default block needs 19 (its
+/// accelerometers' σ is 1.2 counts); at 100 Hz, where their σ is 0.38 counts, 88.
+pub fn stuck_run_needed(sigma_counts: f64, channel_samples_per_hour: f64) -> u32 {
+    let budget = STUCK_FALSE_ALARMS_PER_HOUR / channel_samples_per_hour.max(1.0);
+    // The probability falls geometrically with the run: double, then bisect.
+    let ok = |run: u32| repeat_run_probability(sigma_counts, run) <= budget;
+    let mut hi = 2u32;
+    while !ok(hi) {
+        if hi >= MAX_STUCK_RUN {
+            return MAX_STUCK_RUN;
+        }
+        hi = (hi * 2).min(MAX_STUCK_RUN);
+    }
+    let mut lo = hi / 2;
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if ok(mid) { hi = mid } else { lo = mid }
+    }
+    hi
+}
 
 /// Thresholds of the channel-health checks (validated by the configuration).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HealthSettings {
     /// Samples in a row at a converter rail before a channel counts as saturated.
     pub saturation_samples: u32,
+    /// The converter's lowest and highest counts (see [`count_rails`]).
+    pub rails: [i16; 2],
     /// Identical counts in a row that make a channel stuck.
     pub stuck_samples: u32,
     /// Block length of the noise-outlier check, samples.
@@ -161,7 +232,7 @@ impl ChannelHealth {
                 1
             };
             self.last_counts[i] = c;
-            if c == COUNT_MIN || c == COUNT_MAX {
+            if c == s.rails[0] || c == s.rails[1] {
                 self.rail_run[i] = self.rail_run[i].saturating_add(1);
                 found.at_rail |= bit;
                 if self.rail_run[i] >= s.saturation_samples {
@@ -276,8 +347,32 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
     use rand_distr::{Distribution, StandardNormal};
 
+    #[test]
+    fn stuck_run_follows_the_noise_in_counts() {
+        // The table above: accelerometer σ = 1.2 counts, L = 20 → Σ p_k^L = 1.5e-10.
+        let p = repeat_run_probability(1.2, 20);
+        assert!((1.2e-10..1.9e-10).contains(&p), "{p}");
+        // 1 h at 1 kHz on 4 channels: 19 is the first run below 0.01 per hour (0.0069).
+        assert_eq!(stuck_run_needed(1.214, 4.0 * 1000.0 * 3600.0), 19);
+        // At 100 Hz the same block's accelerometers have σ = 0.38 counts.
+        let slow = stuck_run_needed(0.384, 4.0 * 100.0 * 3600.0);
+        assert!((80..100).contains(&slow), "{slow}");
+        assert!(repeat_run_probability(0.384, slow) * 1.44e6 <= STUCK_FALSE_ALARMS_PER_HOUR);
+        assert!(repeat_run_probability(0.384, slow - 1) * 1.44e6 > STUCK_FALSE_ALARMS_PER_HOUR);
+        // A noiseless channel cannot be judged by its counts.
+        assert_eq!(stuck_run_needed(0.0, 1e7), MAX_STUCK_RUN);
+    }
+
+    #[test]
+    fn rails_follow_the_bits() {
+        assert_eq!(count_rails(12), [COUNT_MIN, COUNT_MAX]);
+        assert_eq!(count_rails(16), [i16::MIN, i16::MAX]);
+        assert_eq!(count_rails(8), [-128, 127]);
+    }
+
     const SETTINGS: HealthSettings = HealthSettings {
         saturation_samples: 5,
+        rails: [COUNT_MIN, COUNT_MAX],
         stuck_samples: 20,
         noise_window: 200,
         noise_ratio: 25.0,

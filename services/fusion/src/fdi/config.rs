@@ -71,8 +71,9 @@ pub struct FdiConfig {
     /// A channel is noisy when its first-difference variance exceeds this multiple of the median
     /// of the other channels'.
     pub noise_ratio: f64,
-    /// Block length of the stationary detector, samples.
-    pub stationary_window: u32,
+    /// Block length of the stationary detector, s (turned into samples at the IMU rate: the
+    /// blocks that make the zero-rate/gravity reference span the same time at every rate).
+    pub stationary_window_s: f64,
     /// Largest per-axis standard deviation of the fused rate while stationary, rad/s.
     pub stationary_rate_spread_rps: f64,
     /// Largest per-axis standard deviation of the fused specific force while stationary, m/s².
@@ -119,7 +120,7 @@ impl Default for FdiConfig {
             stuck_samples: 20,
             noise_window: 200,
             noise_ratio: 25.0,
-            stationary_window: 200,
+            stationary_window_s: 0.2,
             stationary_rate_spread_rps: 0.02,
             stationary_force_spread_mps2: 0.2,
             stationary_max_rate_rps: 0.05,
@@ -183,6 +184,9 @@ pub struct FdiSettings {
     pub truncation: [f64; MAX_PARITY + 1],
 }
 
+/// Longest stationary block, s.
+pub const MAX_STATIONARY_WINDOW_S: f64 = 60.0;
+
 fn positive(field: &str, v: f64) -> Result<(), ConfigError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
@@ -200,9 +204,14 @@ fn at_least(field: &str, v: u32, min: u32) -> Result<(), ConfigError> {
 }
 
 impl FdiConfig {
-    /// Checks every field and derives the thresholds. Errors name the field relative to this
-    /// table (e.g. `persistence_k = 9: must be <= persistence_n (5)`).
+    /// [`Self::settings_at`] at 1 kHz.
     pub fn settings(&self) -> Result<FdiSettings, ConfigError> {
+        self.settings_at(1000.0)
+    }
+
+    /// Checks every field and derives the thresholds for an IMU rate of `rate_hz`. Errors name
+    /// the field relative to this table (e.g. `persistence_k = 9: must be <= persistence_n (5)`).
+    pub fn settings_at(&self, rate_hz: f64) -> Result<FdiSettings, ConfigError> {
         let (k, n) = (self.persistence_k, self.persistence_n);
         if !(1..=MAX_PERSISTENCE_WINDOW as u32).contains(&n) {
             return Err(ConfigError::new(
@@ -271,7 +280,23 @@ impl FdiConfig {
                 "must be finite and > 1",
             ));
         }
-        at_least("stationary_window", self.stationary_window, 10)?;
+        let w = self.stationary_window_s;
+        if !(w.is_finite() && w > 0.0 && w <= MAX_STATIONARY_WINDOW_S) {
+            return Err(ConfigError::new(
+                "stationary_window_s",
+                w,
+                format!("must be in (0, {MAX_STATIONARY_WINDOW_S}] s"),
+            ));
+        }
+        // Bounded by 60 s × 100 kHz, well inside u32.
+        let stationary_window = (w * rate_hz).round() as u32;
+        if stationary_window < 10 {
+            return Err(ConfigError::new(
+                "stationary_window_s",
+                w,
+                format!("must span at least 10 samples at device.imu_rate_hz = {rate_hz}"),
+            ));
+        }
         positive(
             "stationary_rate_spread_rps",
             self.stationary_rate_spread_rps,
@@ -327,12 +352,16 @@ impl FdiConfig {
             learning_samples: if learns { self.learning_samples } else { 0 },
             health: HealthSettings {
                 saturation_samples: self.saturation_samples,
+                rails: [
+                    super::channel_health::COUNT_MIN,
+                    super::channel_health::COUNT_MAX,
+                ],
                 stuck_samples: self.stuck_samples,
                 noise_window: self.noise_window,
                 noise_ratio: self.noise_ratio,
             },
             stationary: StationarySettings {
-                window: self.stationary_window,
+                window: stationary_window,
                 rate_spread: self.stationary_rate_spread_rps,
                 force_spread: self.stationary_force_spread_mps2,
                 max_rate: self.stationary_max_rate_rps,

@@ -67,11 +67,20 @@ impl ImuFuser {
         let rest_window = config.rest_bias_samples()?;
         let gyro = RedundantSensor::new(config, SensorType::Gyro, gyro_lsb, settings, &kalman)?;
         let accel = RedundantSensor::new(config, SensorType::Accel, accel_lsb, settings, &kalman)?;
-        let rest_bias = RestBias::new(rest_window, gyro.geometry.n(), settings.stationary);
+        // The configured spreads are the motion allowed; the fused values also spread by the
+        // sensors' own noise, which grows with √rate: allow it on top.
+        let mut stationary = settings.stationary;
+        stationary.rate_spread = stationary
+            .rate_spread
+            .hypot(gyro.fused_noise_variance().sqrt());
+        stationary.force_spread = stationary
+            .force_spread
+            .hypot(accel.fused_noise_variance().sqrt());
+        let rest_bias = RestBias::new(rest_window, gyro.geometry.n(), stationary);
         Ok(Self {
             gyro,
             accel,
-            stationary: StationaryDetector::new(settings.stationary),
+            stationary: StationaryDetector::new(stationary),
             rest_bias,
         })
     }

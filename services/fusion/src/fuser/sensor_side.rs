@@ -5,7 +5,7 @@
 use crate::calibration::{Calibration, MAX_TEMPERATURE_C, MIN_TEMPERATURE_C};
 use crate::config::FusionConfig;
 use crate::error::ConfigError;
-use crate::fdi::channel_health::{COUNT_MAX, COUNT_MIN};
+use crate::fdi::channel_health::stuck_run_needed;
 use crate::fdi::{
     ChannelEvents, FdiSettings, MonitorInput, SensorEstimate, SensorMonitor, SensorStatus,
 };
@@ -47,7 +47,7 @@ impl RedundantSensor {
         config: &FusionConfig,
         sensor: SensorType,
         lsb: f64,
-        settings: FdiSettings,
+        mut settings: FdiSettings,
         kalman: &KalmanConfig,
     ) -> Result<Self, ConfigError> {
         let lsb_field = match sensor {
@@ -61,18 +61,29 @@ impl RedundantSensor {
         let n = geometry.n();
         let calibration = Calibration::new(calibration, n, lsb)
             .map_err(|e| e.within(sensor.name()).within("calibration"))?;
+        // A healthy channel repeats its count in runs whose length depends on its noise in
+        // counts (long at low rates, where the white noise is below one count): the stuck run
+        // must be long enough for the quietest channel.
+        let quietest = (0..n)
+            .map(|i| {
+                let step = (calibration.apply(i, 1) - calibration.apply(i, 0)).abs();
+                variances[i].sqrt() / step
+            })
+            .fold(f64::INFINITY, f64::min);
+        let channel_samples_per_hour = n as f64 * config.block.imu_rate_hz * 3600.0;
+        settings.health.stuck_samples = settings
+            .health
+            .stuck_samples
+            .max(stuck_run_needed(quietest, channel_samples_per_hour));
         // The converter adds its quantisation noise, (step)²/12 with the step in SI units, to the
         // sensor's own: significant at 1–2 lsb of noise, where it raises the variance by 2–6 %.
         for (i, v) in variances.iter_mut().enumerate().take(n) {
             let step = calibration.apply(i, 1) - calibration.apply(i, 0);
             *v += step * step / 12.0;
         }
-        let rail_values = std::array::from_fn(|i| {
-            [
-                calibration.apply(i, COUNT_MIN),
-                calibration.apply(i, COUNT_MAX),
-            ]
-        });
+        let [rail_lo, rail_hi] = settings.health.rails;
+        let rail_values =
+            std::array::from_fn(|i| [calibration.apply(i, rail_lo), calibration.apply(i, rail_hi)]);
         let monitor = SensorMonitor::new(sensor, geometry, variances, rail_values, settings);
         // The full geometry passed the conditioning check, so this only fails on a logic error.
         if monitor.solver().is_none() {
@@ -93,7 +104,7 @@ impl RedundantSensor {
                     &geometry,
                     geometry.full_mask(),
                     &variances[..n],
-                    kalman.sample_period_s,
+                    config.sample_period_s(),
                     q,
                 )
                 .map_err(|e| ConfigError::new(format!("kalman.{field}"), q, e.to_string()))?;
@@ -107,6 +118,19 @@ impl RedundantSensor {
             variances,
             kalman,
         })
+    }
+
+    /// The largest per-axis variance of the least-squares estimate from the channel noise alone
+    /// (full channel set), SI²: what the stationary detector's spreads must allow beyond motion.
+    pub fn fused_noise_variance(&self) -> f64 {
+        let n = self.geometry.n();
+        let worst = self.variances[..n].iter().copied().fold(0.0, f64::max);
+        let factor = self
+            .geometry
+            .variance_factors()
+            .into_iter()
+            .fold(0.0, f64::max);
+        worst * factor
     }
 
     /// One side of one frame. `rest_bias`: the start-up bias estimate of this side, if any

@@ -1,5 +1,6 @@
 //! Error models of the simulated sensor block: redundant single-axis gyros and accelerometers with a
-//! 12-bit ADC, module temperatures, barometer, magnetometer and foot-pressure sensor.
+//! 12-bit ADC, module temperatures, barometer, magnetometer and foot-pressure sensor, and the rotor
+//! vibration a multirotor shakes the block with ([`vibration`]).
 //!
 //! Everything random comes from ChaCha8 generators seeded with one `u64`; each sensor type draws from
 //! its own stream so that, for instance, changing the barometer rate leaves the IMU noise unchanged,
@@ -13,6 +14,7 @@ mod foot_pressure;
 pub mod inertial;
 pub mod mag;
 mod temperature;
+pub mod vibration;
 
 use ipc_types::MAX_CHANNELS;
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
@@ -206,8 +208,9 @@ impl SensorModel {
     /// Samples every gyro and accelerometer channel and the module temperatures for `truth`.
     pub fn imu(&mut self, truth: &TruthState, out: &mut ImuFrame) {
         let delta_c = self.temperature.delta_c(truth.time_s);
+        let (vibration_rate_b, vibration_force_b) = vibration::body_vibration(&truth.rotor);
         let g = self.gyro.sample(
-            &truth.angular_rate_b,
+            &(truth.angular_rate_b + vibration_rate_b),
             truth.time_s,
             &delta_c,
             &mut self.rng.imu,
@@ -215,7 +218,7 @@ impl SensorModel {
             &mut out.gyro_counts,
         );
         let a = self.accel.sample(
-            &truth.specific_force_b,
+            &(truth.specific_force_b + vibration_force_b),
             truth.time_s,
             &delta_c,
             &mut self.rng.imu,

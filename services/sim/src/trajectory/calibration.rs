@@ -13,6 +13,7 @@
 //! twice the mean. The block rotates about its own centre and does not move: the specific force is
 //! gravity alone.
 
+use crate::sensor_model::vibration::RotorState;
 use std::f64::consts::{PI, TAU};
 
 use nalgebra::Vector3;
@@ -135,6 +136,7 @@ impl CalibrationPath {
             altitude_m: self.start.altitude_m,
             foot_load: 0.0,
             stance: t <= t0,
+            rotor: RotorState::default(),
         }
     }
 }
@@ -152,6 +154,7 @@ mod tests {
             static_s: 3.0,
             uav_flight_s: None,
             calibration_sweep_s: 6.0,
+            multirotor: Default::default(),
         }
     }
 

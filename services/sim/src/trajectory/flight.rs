@@ -9,6 +9,7 @@
 //!
 //! Latitude and longitude integrate the velocity over the WGS84 ellipsoid (see [`super::geodesy`]).
 
+use crate::sensor_model::vibration::RotorState;
 use nalgebra::Vector3;
 
 use super::geodesy::{GeodeticTable, Kinematics};
@@ -150,6 +151,7 @@ impl FlightPath {
             altitude_m: self.start.altitude_m + cr.integral,
             foot_load: 0.0,
             stance: t <= self.rest_until_s || t >= self.rest_from_s,
+            rotor: RotorState::default(),
         }
     }
 }

@@ -2,7 +2,8 @@
 //!
 //! Three motion generators share the conventions below: a vehicle moved by smooth schedules (the
 //! static and UAV scenarios, [`flight`]), a foot-mounted sensor on a walking person ([`walk`]) and
-//! the block turned on the spot through every orientation ([`calibration`]).
+//! the block turned on the spot through every orientation ([`calibration`]); and a quadrotor whose
+//! attitude follows from its rotor-drag dynamics ([`multirotor`]).
 //! Each gives Euler angles and their rates, velocity and acceleration in closed form; then
 //! - attitude q = R_z(ψ) R_y(θ) R_x(φ) (body FRD → NED);
 //! - body rate from the exact Euler-rate relation, so it is the true derivative of q;
@@ -16,6 +17,10 @@ pub mod calibration;
 pub mod flight;
 pub mod gait;
 pub mod geodesy;
+pub mod multirotor;
+pub mod multirotor_config;
+pub mod multirotor_profile;
+pub mod rotor;
 pub mod schedule;
 pub mod uav_profile;
 pub mod walk;
@@ -25,8 +30,12 @@ use serde::{Deserialize, Serialize};
 
 use calibration::CalibrationPath;
 use flight::FlightPath;
+use multirotor::MultirotorPath;
+use multirotor_config::MultirotorConfig;
 use rins_earth::STANDARD_GRAVITY;
 use walk::WalkPath;
+
+use crate::sensor_model::vibration::RotorState;
 
 /// Which motion the simulator produces.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
@@ -43,6 +52,10 @@ pub enum Scenario {
     /// Turned on the spot through every orientation, over and over, with the magnetometer's hard
     /// and soft iron of `[sim.calibration]`: what `rins calibrate mag` needs (see [`calibration`]).
     Calibrate,
+    /// A quadrotor: take-off, hover, a repeated pattern of sharp turns, speed changes and a wind
+    /// gust, landing; its attitude follows from the rotor-drag dynamics of `[sim.multirotor]`
+    /// and its rotors shake the block (see [`multirotor`]).
+    Multirotor,
 }
 
 /// Where and how the trajectory starts, and how long the UAV flies.
@@ -58,11 +71,14 @@ pub struct TrajectoryStart {
     pub heading_rad: f64,
     /// Time at rest, level, before the UAV profile or the walk starts moving, s.
     pub static_s: f64,
-    /// UAV scenario: the flight (parking included) lasts up to this long, its circuits repeated
-    /// as many times as fit; `None`: one pair of circuits. Ignored by the other scenarios.
+    /// UAV and multirotor scenarios: the flight (parking included) lasts up to this long, its
+    /// circuits (patterns) repeated as many times as fit; `None`: one pair of circuits (one
+    /// pattern). Ignored by the other scenarios.
     pub uav_flight_s: Option<f64>,
     /// Calibrate scenario: time of one full yaw turn, s (> 0). Ignored by the other scenarios.
     pub calibration_sweep_s: f64,
+    /// Multirotor scenario: the airframe, its gust and its vibration. Ignored by the others.
+    pub multirotor: MultirotorConfig,
 }
 
 /// The true state at one instant.
@@ -94,6 +110,8 @@ pub struct TruthState {
     /// between steps in the walk, parked before and after the motion in the other scenarios. This
     /// is what a zero-velocity detector should find.
     pub stance: bool,
+    /// The rotors' vibration of the block (zero amplitude unless a multirotor's rotors turn).
+    pub rotor: RotorState,
 }
 
 /// Landmark times of a motion, s.
@@ -113,6 +131,7 @@ enum Motion {
     Flight(FlightPath),
     Walk(WalkPath),
     Calibration(CalibrationPath),
+    Multirotor(Box<MultirotorPath>),
 }
 
 /// A deterministic trajectory; sampling is allocation-free.
@@ -146,6 +165,10 @@ impl Trajectory {
                 let (path, landmarks) = CalibrationPath::new(start, start.calibration_sweep_s);
                 (Motion::Calibration(path), landmarks)
             }
+            Scenario::Multirotor => {
+                let (path, landmarks) = MultirotorPath::new(start);
+                (Motion::Multirotor(Box::new(path)), landmarks)
+            }
         };
         Self {
             start,
@@ -177,6 +200,22 @@ impl Trajectory {
         &self.start
     }
 
+    /// Wind NED at `t`, m/s: the multirotor's gust, calm in the other scenarios.
+    pub fn wind_n(&self, t: f64) -> Vector3<f64> {
+        match &self.motion {
+            Motion::Multirotor(path) => path.wind_n(t.max(0.0)),
+            _ => Vector3::zeros(),
+        }
+    }
+
+    /// Blade-pass frequency of the rotors at `t`, Hz: 0 unless a multirotor's rotors turn.
+    pub fn blade_pass_hz(&self, t: f64) -> f64 {
+        match &self.motion {
+            Motion::Multirotor(path) => path.blade_pass_hz(t.max(0.0)),
+            _ => 0.0,
+        }
+    }
+
     /// The true state at time `t` seconds (clamped to t ≥ 0).
     pub fn sample(&self, t: f64) -> TruthState {
         let t = t.max(0.0);
@@ -184,6 +223,7 @@ impl Trajectory {
             Motion::Flight(path) => path.sample(t),
             Motion::Walk(path) => path.sample(t),
             Motion::Calibration(path) => path.sample(t),
+            Motion::Multirotor(path) => path.sample(t),
         }
     }
 }

@@ -21,6 +21,7 @@
 //! origin (a flat map): over 50 m the curvilinear mechanisation `φ̇ = v_N/(R_M(φ)+h)`,
 //! `λ̇ = v_E/((R_N(φ)+h) cos φ)` differs from it by under 0.3 mm.
 
+use crate::sensor_model::vibration::RotorState;
 use std::f64::consts::FRAC_PI_4;
 
 use nalgebra::Vector3;
@@ -200,6 +201,7 @@ impl WalkPath {
             altitude_m: self.start.altitude_m - f.position_n.z,
             foot_load: f.foot_load,
             stance: f.stance,
+            rotor: RotorState::default(),
         }
     }
 

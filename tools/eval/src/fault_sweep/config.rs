@@ -302,23 +302,17 @@ impl SweepConfig {
             .build()
             .map_err(|e| e.within("fusion.geometry.accel"))?;
         let counts = [gyro.n(), accel.n()];
-        let sigmas = |noise: &rins_fusion::ChannelNoise, n: usize, field: &str| {
-            noise
-                .variances(n)
-                .map(|v| v[..n].iter().map(|v| v.sqrt()).collect::<Vec<_>>())
-                .map_err(|e| e.within(field).within("fusion.noise"))
+        // The parity test's per-sample σ at the simulated rate.
+        let mut fusion = self.fusion.clone();
+        fusion.block.imu_rate_hz = rate;
+        let sigmas = |sensor| {
+            fusion
+                .channel_sigmas(sensor)
+                .map_err(|e| e.within("fusion"))
         };
         let fdi_sigma = [
-            sigmas(
-                &self.fusion.noise.gyro_sigma_rps,
-                counts[0],
-                "gyro_sigma_rps",
-            )?,
-            sigmas(
-                &self.fusion.noise.accel_sigma_mps2,
-                counts[1],
-                "accel_sigma_mps2",
-            )?,
+            sigmas(ipc_types::SensorType::Gyro)?,
+            sigmas(ipc_types::SensorType::Accel)?,
         ];
         let channels = if self.channels.is_empty() {
             let all = |sensor, n| (0..n).map(move |index| SweepChannel { sensor, index });

@@ -8,7 +8,8 @@
 //! threshold). No setting is ever chosen on the flight it is scored on
 //! (see [`super::cross_validation`]).
 
-use rins_fusion::{ChannelNoise, FdiConfig, FusionConfig, NoiseConfig, ParityNoise, PerSensor};
+use rins_fusion::config::ImuBlock;
+use rins_fusion::{FdiConfig, FusionConfig, NoiseConfig, ParityNoise, PerSensor};
 use serde::Serialize;
 
 use super::layout::Layout;
@@ -95,16 +96,20 @@ pub(crate) fn fusion_config(
             gyro: layout.geometry(),
             accel: layout.geometry(),
         },
-        noise: NoiseConfig {
-            gyro_sigma_rps: ChannelNoise::Uniform(noise.gyro_sigma_rps * setting.noise_scale),
-            accel_sigma_mps2: ChannelNoise::Uniform(noise.accel_sigma_mps2 * setting.noise_scale),
-        },
+        noise: NoiseConfig::from_per_sample_sigma(
+            noise.gyro_sigma_rps * setting.noise_scale,
+            noise.accel_sigma_mps2 * setting.noise_scale,
+            IMU_RATE_HZ,
+        ),
         calibration: PerSensor::default(),
         fdi,
         // The flights start in motion: no estimate of channel biases at rest (the relative
         // biases are removed in the pre-processing instead).
         rest_bias_s: 0.0,
-        sample_rate_hz: IMU_RATE_HZ,
+        block: ImuBlock {
+            imu_rate_hz: IMU_RATE_HZ,
+            ..ImuBlock::default()
+        },
         ..FusionConfig::default()
     }
 }

@@ -7,6 +7,7 @@
 //! is made leave-one-trial-out: every trial is scored with the threshold that did best on the
 //! other trials, and that held-out figure is the one reported.
 
+pub mod live;
 pub mod metrics;
 pub mod plot;
 pub mod pyshoe_eval;
@@ -22,7 +23,7 @@ use serde::Serialize;
 
 use crate::datasets::foot::FootTrial;
 
-pub use pyshoe_eval::{PyshoeReport, PyshoeTrial, evaluate_pyshoe};
+pub use pyshoe_eval::{PyshoeReport, PyshoeTrial, evaluate_pyshoe, evaluate_pyshoe_with_runs};
 pub use xio_eval::{XioReport, XioWalk, evaluate_xio};
 
 /// Which estimator the per-trial figures, the means and the plots are of.

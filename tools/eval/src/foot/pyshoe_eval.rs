@@ -7,6 +7,7 @@ use anyhow::{Context, Result, anyhow};
 use rins_navigator::inertial_core::AidedConfig;
 use serde::Serialize;
 
+use super::live::{LiveWalk, LiveWalkSummary, ScoredWalk, score_positions};
 use super::metrics::{aligned_rmse_2d, peer_armse_2d, round_mm};
 use super::plot::{TrialPlot, draw_trial};
 use super::reference::{ReferenceConfig, run_with_statistic, shoe_statistic};
@@ -61,6 +62,9 @@ pub struct PyshoeTrial {
     pub zupt_rejected: u64,
     /// How much of the walk the navigator judged usable (rins only).
     pub integrity: Option<IntegritySummary>,
+    /// The held-out rins run repeated through the running processes (`--live`).
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub live: Option<LiveWalk>,
 }
 
 /// The pyshoe evaluation of a whole directory.
@@ -98,6 +102,9 @@ pub struct PyshoeReport {
     pub reference_threshold_all: f64,
     /// Mean over the trials of Σ estimated / Σ true stride length.
     pub mean_stride_length_ratio: f64,
+    /// Every held-out rins run repeated through the running processes (`--live`).
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub live: Option<LiveWalkSummary>,
 }
 
 /// What one estimator produced on one trial with one setting.
@@ -115,26 +122,15 @@ fn horizontal(points: &[[f64; 3]]) -> Vec<[f64; 2]> {
     points.iter().map(|p| [p[0], p[1]]).collect()
 }
 
-// The estimate's first two axes (north, east for rins; the level x, y of the peer's method, also
-// z down) against the export's Vicon x, y. With the Vicon z up, that pair is mirrored, so the
-// export's horizontal axes do not form the right-handed frame their z suggests; matched this way
-// every trial fits within centimetres (the peer's own evaluation pairs them the same way). Only a
-// rotation is ever fitted, never a reflection.
+// The estimate's first two axes (north, east) against the export's Vicon x, y: see
+// [`score_positions`].
 fn score_rins(trial: &FootTrial, truth: &[[f64; 3]], config: &AidedConfig) -> Scored {
     let run = run_trial(trial, config);
-    let truth_xy = horizontal(truth);
-    let estimate = horizontal(&run.ned_m);
-    let peer = peer_armse_2d(&estimate, &truth_xy);
-    let start = run.aligned_at.unwrap_or(run.ned_m.len());
-    let rmse = if start < estimate.len() {
-        aligned_rmse_2d(&estimate[start..], &truth_xy[start..]).0
-    } else {
-        f64::NAN
-    };
+    let score = score_positions(&run.ned_m, run.aligned_at, truth);
     Scored {
-        armse_m: peer.armse_m,
-        rmse_2d_m: rmse,
-        rotation_rad: peer.rotation_rad,
+        armse_m: score.armse_m,
+        rmse_2d_m: score.rmse_2d_m,
+        rotation_rad: score.rotation_rad,
         zupt_rejected: run.zupt_rejected,
         integrity: Some(run.integrity.summary()),
         ned_m: run.ned_m,
@@ -206,6 +202,29 @@ pub fn evaluate_pyshoe(
     plot_dir: Option<&Path>,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<PyshoeReport> {
+    Ok(evaluate(dir, config, method, plot_dir, false, progress)?.0)
+}
+
+/// As [`evaluate_pyshoe`], with each trial's held-out rins run kept (in the report's trial
+/// order) for the running service to repeat.
+pub fn evaluate_pyshoe_with_runs(
+    dir: &Path,
+    config: &AidedConfig,
+    method: FootMethod,
+    plot_dir: Option<&Path>,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<(PyshoeReport, Vec<ScoredWalk>)> {
+    evaluate(dir, config, method, plot_dir, true, progress)
+}
+
+fn evaluate(
+    dir: &Path,
+    config: &AidedConfig,
+    method: FootMethod,
+    plot_dir: Option<&Path>,
+    keep_runs: bool,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<(PyshoeReport, Vec<ScoredWalk>)> {
     let files = pyshoe::list_trials(dir)
         .with_context(|| format!("eval pyshoe: cannot list {}", dir.display()))?;
     if files.is_empty() {
@@ -267,8 +286,16 @@ pub fn evaluate_pyshoe(
     let rins_choice = choose_without_each(&rins_logs);
     let reference_choice = choose_without_each(&reference_logs);
     let mut trials = Vec::with_capacity(loaded.len());
+    let mut runs = Vec::new();
     for (i, l) in loaded.iter().enumerate() {
         let rins_config = &rins[rins_choice[i]];
+        if keep_runs {
+            runs.push(ScoredWalk::new(
+                l.trial.clone(),
+                l.truth.clone(),
+                *rins_config,
+            ));
+        }
         let reference_threshold = thresholds[reference_choice[i]];
         let scored = match method {
             FootMethod::Rins => score_rins(&l.trial, &l.truth, rins_config),
@@ -315,6 +342,7 @@ pub fn evaluate_pyshoe(
                 / scored.stance.len().max(1) as f64,
             zupt_rejected: scored.zupt_rejected,
             integrity: scored.integrity,
+            live: None,
         });
         done += 1;
         progress(done, total);
@@ -324,7 +352,7 @@ pub fn evaluate_pyshoe(
         (v.len() == trials.len()).then(|| mean(v.into_iter()))
     };
     progress(total, total);
-    Ok(PyshoeReport {
+    let report = PyshoeReport {
         method,
         mean_rmse_m: mean(trials.iter().map(|t| t.rmse_2d_m)),
         mean_armse_m: mean(trials.iter().map(|t| t.armse_m)),
@@ -349,5 +377,7 @@ pub fn evaluate_pyshoe(
         ),
         trials,
         skipped,
-    })
+        live: None,
+    };
+    Ok((report, runs))
 }

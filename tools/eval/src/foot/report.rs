@@ -2,6 +2,7 @@
 
 use std::fmt::Write;
 
+use super::live::LiveWalkSummary;
 use super::{FootMethod, PyshoeReport, Skipped, XioReport};
 use crate::integrity_tally::IntegritySummary;
 
@@ -106,7 +107,64 @@ pub fn pyshoe_table(r: &PyshoeReport) -> String {
         "strides: estimated / true length {:.3} on average (stride = foot-down to foot-down)",
         r.mean_stride_length_ratio
     );
+    if let Some(live) = &r.live {
+        live_table(&mut s, r, live);
+    }
     s
+}
+
+/// The held-out rins runs through the running processes, beside the in-process figures.
+fn live_table(s: &mut String, r: &PyshoeReport, live: &LiveWalkSummary) {
+    let _ = writeln!(
+        s,
+        "
+through the running processes ({}), rins held-out setting:",
+        live.live_input
+    );
+    let _ = writeln!(
+        s,
+        "{:<20} {:>8} {:>8} {:>8} {:>8} {:>10} {:>10} {:>10} {:>6} {:>5}",
+        "trial",
+        "rmse2d",
+        "live",
+        "ARMSE",
+        "live",
+        "vs off mm",
+        "vs same mm",
+        "quant mm",
+        "align",
+        "miss"
+    );
+    for t in &r.trials {
+        let Some(l) = &t.live else { continue };
+        let _ = writeln!(
+            s,
+            "{:<20} {:>8.4} {:>8.4} {:>8.4} {:>8.4} {:>10.4} {:>10.4} {:>10.4} {:>6} {:>5}",
+            t.trial,
+            l.offline_rmse_m,
+            l.live_rmse_m,
+            l.offline_armse_m,
+            l.live_armse_m,
+            1e3 * l.live_vs_offline_max_diff_m,
+            1e3 * l.live_vs_same_input_max_diff_m,
+            1e3 * l.quantisation_max_diff_m,
+            l.live_alignment_offset_samples,
+            l.live_samples_missing
+        );
+    }
+    let _ = writeln!(
+        s,
+        "live: RMSE {:.4} m, ARMSE {:.4} m on average; largest difference to the in-process runs \
+         {:.4} mm (to the same pipeline in process on the same frames {:.4} mm; the counts and \
+         fusion in process {:.4} mm); {} samples missing; {} walks with a channel excluded",
+        live.live_mean_rmse_m,
+        live.live_mean_armse_m,
+        1e3 * live.live_vs_offline_max_diff_m,
+        1e3 * live.live_vs_same_input_max_diff_m,
+        1e3 * live.quantisation_max_diff_m,
+        live.live_samples_missing,
+        live.walks_with_live_exclusions
+    );
 }
 
 /// The x-io evaluation as a text table: one line per walk with its end-point error.

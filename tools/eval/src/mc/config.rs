@@ -1,9 +1,8 @@
 //! Settings of the Monte Carlo comparison and their validation.
 
 use rins_altimeter::AltimeterConfig;
-use rins_fusion::{
-    ChannelNoise, ConfigError, FusionConfig, Geometry, GeometryConfig, NoiseConfig, PerSensor,
-};
+use rins_fusion::config::ImuBlock;
+use rins_fusion::{ConfigError, FusionConfig, Geometry, GeometryConfig, NoiseConfig, PerSensor};
 use rins_navigator::NavigatorConfig;
 use rins_sim::{Scenario, SimConfig, SimError, Trajectory};
 use thiserror::Error;
@@ -162,7 +161,7 @@ impl McConfig {
         }
         self.sim.validate()?;
         let full_flight_s = match self.sim.scenario {
-            Scenario::Uav | Scenario::Walk => {
+            Scenario::Uav | Scenario::Walk | Scenario::Multirotor => {
                 Trajectory::new(self.sim.scenario, self.sim.trajectory_start()).end_s()
             }
             // Neither ever stops: ten minutes, as long as one uav flight.
@@ -199,7 +198,9 @@ impl McConfig {
 
         let gyro_channel_bias_ticks = if self.calibrate_gyro_channels_at_rest {
             let parked_s = match self.sim.scenario {
-                Scenario::Uav | Scenario::Walk | Scenario::Calibrate => self.sim.static_s,
+                Scenario::Uav | Scenario::Walk | Scenario::Calibrate | Scenario::Multirotor => {
+                    self.sim.static_s
+                }
                 Scenario::Static => f64::INFINITY,
             };
             if parked_s < navigator.align_s {
@@ -259,9 +260,14 @@ impl McConfig {
                 gyro: spec.geometry.clone(),
                 accel: spec.geometry.clone(),
             },
-            noise: NoiseConfig {
-                gyro_sigma_rps: ChannelNoise::Uniform(positive(gyro_sigma)),
-                accel_sigma_mps2: ChannelNoise::Uniform(positive(accel_sigma)),
+            noise: NoiseConfig::from_per_sample_sigma(
+                positive(gyro_sigma),
+                positive(accel_sigma),
+                self.sim.imu_rate_hz,
+            ),
+            block: ImuBlock {
+                imu_rate_hz: self.sim.imu_rate_hz,
+                ..ImuBlock::default()
             },
             ..FusionConfig::default()
         };

@@ -156,6 +156,8 @@ pub struct McReport {
     pub first_seed: u64,
     /// Simulated flight time, s.
     pub duration_s: f64,
+    /// The simulator scenario flown.
+    pub scenario: rins_sim::Scenario,
     /// Simulated IMU rate, Hz.
     pub imu_rate_hz: f64,
     /// Kill time, s, when the fault experiment ran.
@@ -293,6 +295,7 @@ impl McReport {
             runs: records.len(),
             first_seed,
             duration_s: prepared.duration_s,
+            scenario: prepared.sim.scenario,
             imu_rate_hz: prepared.sim.imu_rate_hz,
             kill_at_s,
             gyro_channels_calibrated_at_rest: prepared.gyro_channel_bias_ticks.is_some(),

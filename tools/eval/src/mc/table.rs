@@ -14,13 +14,14 @@ impl McReport {
         let (r, o) = (&self.redundant, &self.orthogonal);
         let _ = writeln!(
             s,
-            "Monte Carlo, {} runs (seeds {}..={}), {} s of the UAV profile at {} Hz; same per-channel \
+            "Monte Carlo, {} runs (seeds {}..={}), {} s of the {} scenario at {} Hz; same per-channel \
              error model and seeds for both blocks.\n",
             self.runs,
             self.first_seed,
             self.first_seed
                 .wrapping_add(self.runs.saturating_sub(1) as u64),
             num(self.duration_s),
+            scenario_name(self.scenario),
             num(self.imu_rate_hz),
         );
         let _ = writeln!(
@@ -249,6 +250,17 @@ fn pm(s: &Stat) -> String {
 /// Three numbers as `x/y/z`.
 fn triple(x: [f64; 3]) -> String {
     format!("{}/{}/{}", num(x[0]), num(x[1]), num(x[2]))
+}
+
+/// The scenario as the command line names it.
+fn scenario_name(scenario: rins_sim::Scenario) -> &'static str {
+    match scenario {
+        rins_sim::Scenario::Static => "static",
+        rins_sim::Scenario::Uav => "uav",
+        rins_sim::Scenario::Walk => "walk",
+        rins_sim::Scenario::Calibrate => "calibrate",
+        rins_sim::Scenario::Multirotor => "multirotor",
+    }
 }
 
 #[cfg(test)]

@@ -5,8 +5,9 @@ use nalgebra::UnitQuaternion;
 use rins_navigator::inertial_core::AidedConfig;
 
 use super::candidates::Candidate;
+use super::live::ScoredRun;
 use super::mounting::{Paired, fit_mounting, mounting_rotation, roll_pitch_rmse_deg};
-use super::run::{GyroPrior, navigate_ahrs};
+use super::run::{AttitudeTrace, GyroPrior, navigate_ahrs};
 use super::{CandidateFigure, Flight, FlightResult, SETTLE_S, pair, with_candidate};
 use crate::datasets::quadrotor::MAX_IMUS;
 use crate::quadrotor_nav::frames::Motion;
@@ -18,6 +19,8 @@ pub struct Outcome {
     pub flights: Vec<FlightResult>,
     /// Every candidate's in-sample figure and how often it was chosen.
     pub candidates: Vec<CandidateFigure>,
+    /// Per flight, the fused run that scored it, to be repeated by the running service.
+    pub runs: Vec<ScoredRun>,
 }
 
 /// Mean score of `runs` after [`SETTLE_S`] with the mounting fitted on all of them.
@@ -221,7 +224,7 @@ pub(crate) fn run(
             progress(n * MAX_IMUS);
         }
     }
-    let results = flights
+    let (results, runs): (Vec<FlightResult>, Vec<ScoredRun>) = flights
         .iter()
         .enumerate()
         .map(|(f, flight)| {
@@ -230,14 +233,20 @@ pub(crate) fn run(
             let scale = choose_prior_scale(flights, &first[c], config, f);
             let others = same_units(flights, &first[c], f, None);
             let tilt = fit_mounting(&paired(&others), SETTLE_S);
-            let fused = run_paired(
-                flight,
-                &flight.fused,
-                config,
-                &mounting_rotation(tilt),
-                prior_from(&others, scale).as_ref(),
-            )
-            .paired;
+            let scored = ScoredRun {
+                flight: flight.name.clone(),
+                motion: flight.fused.clone(),
+                start: flight.start,
+                config: *config,
+                mounting: mounting_rotation(tilt),
+                prior: prior_from(&others, scale),
+                tilt_rad: tilt,
+                rows: flight.rows.clone(),
+                trace: AttitudeTrace::default(),
+            };
+            let trace = scored.rerun(&flight.fused);
+            let scored = ScoredRun { trace, ..scored };
+            let fused = scored.paired(&scored.trace);
             let mut single = [None; MAX_IMUS];
             let mut peer = [None; MAX_IMUS];
             for (k, &imu) in flight.imus.iter().enumerate() {
@@ -267,7 +276,7 @@ pub(crate) fn run(
                 peer[imu - 1] = Some(roll_pitch_rmse_deg(&flight.peers[k], tilt, 0.0));
             }
             progress(MAX_IMUS + 1);
-            FlightResult {
+            let result = FlightResult {
                 name: flight.name.clone(),
                 imus: flight.imus.clone(),
                 rows: flight.rows.len(),
@@ -279,9 +288,11 @@ pub(crate) fn run(
                 file_offsets_s: flight.file_offsets_s.clone(),
                 repairs: flight.repairs,
                 notes: flight.notes.clone(),
-            }
+                live: None,
+            };
+            (result, scored)
         })
-        .collect();
+        .unzip();
     let candidates = grid
         .iter()
         .enumerate()
@@ -296,5 +307,6 @@ pub(crate) fn run(
     Outcome {
         flights: results,
         candidates,
+        runs,
     }
 }

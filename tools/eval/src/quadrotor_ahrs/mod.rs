@@ -24,6 +24,7 @@
 
 pub mod candidates;
 pub mod cross_validation;
+pub mod live;
 pub mod mounting;
 pub mod report;
 pub mod run;
@@ -44,6 +45,7 @@ use crate::quadrotor_nav::frames::{self, Motion};
 use crate::quadrotor_nav::run::{Start, start_from_truth};
 use crate::quadrotor_nav::{require_data_dir, vehicle_from_reference};
 use candidates::Candidate;
+use live::ScoredRun;
 use mounting::Paired;
 use run::AttitudeTrace;
 
@@ -100,6 +102,9 @@ pub struct FlightResult {
     pub repairs: Repairs,
     /// What the loader repaired or noticed.
     pub notes: Vec<String>,
+    /// The same run through the running processes (`--live`).
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub live: Option<live::LiveFlight>,
 }
 
 /// One candidate's in-sample figure (first pass, gyro bias learnt from zero, every flight after
@@ -145,6 +150,9 @@ pub struct AhrsReport {
     pub candidates: Vec<CandidateFigure>,
     /// Per flight.
     pub flights: Vec<FlightResult>,
+    /// The fused runs through the running processes (`--live`).
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub live: Option<live::LiveSummary>,
 }
 
 /// The reference's attitude pairs for `trace` at the flight's rows.
@@ -227,6 +235,15 @@ pub fn evaluate(
     base: &AidedConfig,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<AhrsReport> {
+    evaluate_with_runs(dir, base, progress).map(|(report, _)| report)
+}
+
+/// [`evaluate`], with the fused run that scored each flight (in the report's flight order).
+pub fn evaluate_with_runs(
+    dir: &Path,
+    base: &AidedConfig,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<(AhrsReport, Vec<ScoredRun>)> {
     require_data_dir(dir)?;
     let loaded = load_each(dir, |_, _| ()).map_err(|e| {
         anyhow!(
@@ -270,12 +287,13 @@ pub fn evaluate(
         progress(done.min(total), total);
     });
     progress(total, total);
-    Ok(report::summarise(
+    let report = report::summarise(
         dir,
         flights_total,
         repairs,
         failures,
         outcome.flights,
         outcome.candidates,
-    ))
+    );
+    Ok((report, outcome.runs))
 }

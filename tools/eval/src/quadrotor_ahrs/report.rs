@@ -54,6 +54,7 @@ pub fn summarise(
         roll_pitch_target_met: fused <= ROLL_PITCH_TARGET_DEG,
         candidates,
         flights,
+        live: None,
     }
 }
 
@@ -156,6 +157,50 @@ pub fn to_table(r: &AhrsReport) -> String {
         p.imu_files_skipped,
         p.trials_failed
     );
+    if let Some(live) = &r.live {
+        live_lines(&mut s, r, live);
+    }
     s.push_str(&skipped_lines(&r.failures));
     s
+}
+
+/// The fused runs through the running processes, per flight and over all.
+fn live_lines(s: &mut String, r: &AhrsReport, live: &super::live::LiveSummary) {
+    let _ = writeln!(
+        s,
+        "through the running processes ({}): roll/pitch RMSE, largest attitude difference to the \
+         in-process run, to the pipeline's code in process on the same frames, and what fusion \
+         made of the input in process, degrees",
+        live.live_input
+    );
+    for f in &r.flights {
+        if let Some(l) = &f.live {
+            let _ = writeln!(
+                s,
+                "{:22} {:6.2} | {:9.2e} {:9.2e} {:9.2e} | fusion events {:5}, excluded: {}",
+                f.name,
+                l.live_roll_pitch_rmse_deg,
+                l.live_vs_offline_max_diff_deg,
+                l.live_vs_same_input_max_diff_deg,
+                l.quantisation_max_diff_deg,
+                l.live_fdi_events,
+                if l.live_excluded_channels.is_empty() {
+                    "none".to_string()
+                } else {
+                    l.live_excluded_channels.join(", ")
+                }
+            );
+        }
+    }
+    let _ = writeln!(
+        s,
+        "{:22} {:6.2} | {:9.2e} {:9.2e} {:9.2e} | flights with a channel excluded: {}; rows missing: {}",
+        "live",
+        live.live_roll_pitch_rmse_deg,
+        live.live_vs_offline_max_diff_deg,
+        live.live_vs_same_input_max_diff_deg,
+        live.quantisation_max_diff_deg,
+        live.flights_with_live_exclusions,
+        live.live_rows_missing
+    );
 }

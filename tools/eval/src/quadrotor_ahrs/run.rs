@@ -2,15 +2,15 @@
 //! from the truth at t0 and never told the truth again.
 //!
 //! The live navigator's own code path: [`AidedNavigator::take_over`] starts it from the state at
-//! t0 (the flights start in the air, so static alignment cannot run), then every sample goes
+//! t0 built by the navigator's in-flight start ([`InFlightStart`]; the flights start in the air,
+//! so static alignment cannot run), then every sample goes
 //! through [`AidedNavigator::on_imu`], which predicts the filter and makes the tilt updates of
 //! `[navigator.tilt]`. There is no baro, magnetometer or position in these recordings.
 
-use nalgebra::{UnitQuaternion, Vector3};
-use rins_navigator::attitude::quaternion_from_euler;
-use rins_navigator::ekf::BG;
+use nalgebra::UnitQuaternion;
+use rins_navigator::attitude::{euler_from_quaternion, quaternion_from_euler};
 use rins_navigator::inertial_core::{AidedConfig, AidedNavigator};
-use rins_navigator::{ImuBias, NominalState};
+use rins_navigator::start::InFlightStart;
 
 use crate::quadrotor_nav::frames::Motion;
 use crate::quadrotor_nav::run::Start;
@@ -67,16 +67,57 @@ pub struct AhrsRun {
     pub final_gyro_bias_rps: [f64; 3],
 }
 
-/// Device time of trial time `t_s`, µs: the trial's times start near 0 and may be slightly
+/// Device time of trial time `t_s`, s: the trial's times start near 0 and may be slightly
 /// negative after alignment, so they are moved by a fixed second.
-fn device_us(t_s: f64) -> u64 {
-    ((t_s + 1.0).max(0.0) * 1e6).round() as u64
+pub fn device_time_s(t_s: f64) -> f64 {
+    t_s + 1.0
+}
+
+/// Device time of trial time `t_s`, µs (as [`InFlightStart::device_time_us`] rounds it).
+pub fn device_us(t_s: f64) -> u64 {
+    (device_time_s(t_s).max(0.0) * 1e6).round() as u64
+}
+
+/// The navigator's in-flight start of a run (`[navigator.start]`) and the settings it runs with:
+/// the airframe's attitude at t0 turned by the inverse of the unit's `mounting`
+/// (`C_nav←vehicle = C_nav←unit · mounting`), the velocity and height at t0, and the gyro bias
+/// from `prior` when given (its σ then replaces `initial_gyro_bias_sigma`), else zero with the
+/// configured σ. The running navigator takes the same table over.
+pub fn in_flight_start(
+    start: &Start,
+    config: &AidedConfig,
+    mounting: &UnitQuaternion<f64>,
+    prior: Option<&GyroPrior>,
+) -> (InFlightStart, AidedConfig) {
+    let [roll, pitch, heading] = start.euler_rad;
+    let attitude = quaternion_from_euler(roll, pitch, heading) * mounting.inverse();
+    let [roll, pitch, heading] = euler_from_quaternion(&attitude);
+    let mut config = *config;
+    // A start states the position: the running navigator then counts it known.
+    config.origin_known = true;
+    if let Some(p) = prior {
+        config.noise.initial_gyro_bias_sigma = p.sigma_rps;
+    }
+    let table = InFlightStart {
+        time_s: device_time_s(start.t_s),
+        roll_deg: roll.to_degrees(),
+        pitch_deg: pitch.to_degrees(),
+        heading_deg: heading.to_degrees(),
+        velocity_ned_mps: start.velocity_ned,
+        altitude_m: config.origin[2] + start.height_m,
+        gyro_bias_dps: prior.map(|p| p.bias_rps.map(f64::to_degrees)),
+    };
+    (table, config)
+}
+
+/// Index of the first sample of `motion` after the start time `t_s`: sample j is the mean over
+/// the interval ending at its time.
+pub fn first_sample_after(motion: &Motion, t_s: f64) -> usize {
+    (((t_s - motion.t0_s) / motion.dt_s).floor().max(-1.0) + 1.0) as usize
 }
 
 /// Runs `motion` from `start` through the navigator's inertial core with `config` (its tilt
-/// updates included when enabled). The unit's attitude at t0 is the airframe's turned by the
-/// inverse of the unit's `mounting` (`C_nav←vehicle = C_nav←unit · mounting`); the gyro bias
-/// starts from `prior` when given, else from zero with the configured σ.
+/// updates included when enabled), started as [`in_flight_start`] says.
 pub fn navigate_ahrs(
     motion: &Motion,
     start: &Start,
@@ -84,26 +125,15 @@ pub fn navigate_ahrs(
     mounting: &UnitQuaternion<f64>,
     prior: Option<&GyroPrior>,
 ) -> AhrsRun {
-    let [lat, lon, altitude_zero_m] = config.origin;
-    let mut state = NominalState::at_rest(lat, lon, altitude_zero_m + start.height_m);
-    let [roll, pitch, heading] = start.euler_rad;
-    state.attitude = quaternion_from_euler(roll, pitch, heading) * mounting.inverse();
-    state.velocity_ned = Vector3::from(start.velocity_ned);
-    let mut bias = ImuBias::default();
-    let mut variances = config.noise.initial_variances();
-    if let Some(p) = prior {
-        bias.gyro_rps = Vector3::from(p.bias_rps);
-        variances[BG..BG + 3].fill(p.sigma_rps * p.sigma_rps);
-    }
-    let mut navigator = AidedNavigator::new(*config);
-    navigator.take_over(device_us(start.t_s), state, bias, &variances);
+    let (table, config) = in_flight_start(start, config, mounting, prior);
+    let s = table.state(&config);
+    let mut navigator = AidedNavigator::new(config);
+    navigator.take_over(s.device_time_us, s.state, s.bias, &s.variances);
     let mut trace = AttitudeTrace::default();
     trace.t_s.push(start.t_s);
-    trace.attitude.push(state.attitude);
-    // Sample j is the mean over the interval ending at its time: the first one used is the first
-    // after t0.
-    let first = ((start.t_s - motion.t0_s) / motion.dt_s).floor().max(-1.0) + 1.0;
-    for (j, sample) in motion.samples.iter().enumerate().skip(first as usize) {
+    trace.attitude.push(s.state.attitude);
+    let first = first_sample_after(motion, start.t_s);
+    for (j, sample) in motion.samples.iter().enumerate().skip(first) {
         let t_s = motion.time(j);
         let step = navigator.on_imu(device_us(t_s), sample.gyro_rps, sample.accel_mps2, None);
         if !step.propagated.is_some_and(|p| p.is_applied()) {

@@ -3,7 +3,7 @@
 //! type has lost its solution (see [`crate::fdi::recovery`]).
 
 use super::{MonitorInput, SensorMonitor, bits};
-use crate::fdi::channel_health::{COUNT_MAX, COUNT_MIN, HealthFindings};
+use crate::fdi::channel_health::HealthFindings;
 use crate::fdi::config::ReadmitPolicy;
 use crate::fdi::recovery::RetestInput;
 use crate::geometry::MAX_CHANNELS;
@@ -82,7 +82,7 @@ impl SensorMonitor {
                 input
                     .counts
                     .get(i)
-                    .is_some_and(|&c| c != COUNT_MIN && c != COUNT_MAX)
+                    .is_some_and(|&c| !self.settings.health.rails.contains(&c))
             })
             .fold(0u32, |m, i| m | 1 << i);
         let candidates = self.active_mask() | (self.excluded_mask & input.valid & off_rail);
