@@ -30,6 +30,11 @@ struct ReplayReport {
     seconds: f64,
     /// Recorded time over replay time.
     speed_achieved: f64,
+    /// Navigation samples the replay produced, both lanes.
+    nav_samples_replayed: u64,
+    /// The file carries navigation output to compare with (a recording imported from another
+    /// system's data, `rins import`, does not).
+    recorded_navigation: bool,
     #[serde(flatten)]
     comparison: NavComparison,
     /// Aiding readings the recorded navigator lanes applied after their place in the IMU stream
@@ -90,6 +95,8 @@ pub fn run(args: &ReplayArgs) -> Result<ExitCode> {
         imu_frames: input.imu_frames() as u64,
         seconds,
         speed_achieved: if seconds > 0.0 { span_s / seconds } else { 0.0 },
+        nav_samples_replayed: replayed.iter().map(|lane| lane.len() as u64).sum(),
+        recorded_navigation: input.nav.iter().any(|lane| !lane.is_empty()),
         comparison: compare(&input.nav, &replayed),
         recorded_late_aiding: input.recorded_late_aiding.iter().sum(),
         file_messages_skipped: input.skipped + input.undecodable,
@@ -112,6 +119,13 @@ pub fn run(args: &ReplayArgs) -> Result<ExitCode> {
             c.nav_samples_different,
             c.nav_samples_missing
         );
+        if !report.recorded_navigation {
+            println!(
+                "{}: no recorded navigation output to compare with; the replay produced {} \
+                 navigation samples",
+                report.file, report.nav_samples_replayed
+            );
+        }
         if report.file_chunks_damaged > 0 || report.file_messages_skipped > 0 {
             println!(
                 "{}: {} damaged chunks and {} damaged messages skipped",
@@ -130,14 +144,18 @@ pub fn run(args: &ReplayArgs) -> Result<ExitCode> {
             );
         }
     }
-    // Not identical is a finding a script must see.
-    Ok(
-        if c.nav_samples_different == 0 && c.nav_samples_compared > 0 {
-            ExitCode::SUCCESS
-        } else {
-            ExitCode::FAILURE
-        },
-    )
+    // Not identical is a finding a script must see; so is a file with nothing to compare that
+    // produced no navigation.
+    let passed = if report.recorded_navigation {
+        c.nav_samples_different == 0 && c.nav_samples_compared > 0
+    } else {
+        report.nav_samples_replayed > 0
+    };
+    Ok(if passed {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
 }
 
 /// Recorded time from the first raw sample to the last, s.

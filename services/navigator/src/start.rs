@@ -9,7 +9,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use crate::attitude::quaternion_from_euler;
-use crate::config::ConfigError;
+use crate::config::{ConfigError, check_in};
 use crate::ekf::STATES;
 use crate::inertial_core::AidedConfig;
 use crate::mechanisation::{ImuBias, NominalState};
@@ -63,11 +63,7 @@ fn check(
     ok: impl Fn(f64) -> bool,
     reason: &'static str,
 ) -> Result<(), ConfigError> {
-    if value.is_finite() && ok(value) {
-        Ok(())
-    } else {
-        Err(ConfigError::new(field, value, reason).within("navigator.start"))
-    }
+    check_in("navigator.start", field, value, ok, reason)
 }
 
 impl InFlightStart {

@@ -13,10 +13,10 @@ use anyhow::{Result, anyhow};
 use ipc_types::{Header, RawImu, Truth};
 use rins_earth::LocalOrigin;
 
-use super::counts::{Quantiser, Scales, largest_abs};
+use super::counts::{BlockQuantiser, Scales, largest_abs};
 use super::fragment::{Axes, Fragment, NoiseDensity, render};
 use super::quadrotor::Profile;
-use super::{ImportedRun, Quantisation, RepairCount, central_difference, rx_ns};
+use super::{ImportedRun, RepairCount, central_difference};
 use crate::datasets::FootTrial;
 use crate::quadrotor_ahrs::run::device_us;
 
@@ -54,41 +54,13 @@ pub fn import_trial(trial: &FootTrial, profile: &Profile<'_>) -> Result<Imported
         largest_abs(trial.samples.iter().flat_map(|s| s.accel_mps2)),
     )
     .ok_or_else(|| anyhow!("{name}: no finite IMU value to scale the converter to"))?;
-    let mut gyro = Quantiser::new(scales.gyro_lsb_rps);
-    let mut accel = Quantiser::new(scales.accel_lsb_mps2);
-    let mut invalid = 0;
-    let mut imu = Vec::with_capacity(trial.samples.len());
-    for (j, s) in trial.samples.iter().enumerate() {
-        let device = device_us(s.t_s - t0);
-        let mut frame = RawImu {
-            n_gyro: 3,
-            n_accel: 3,
-            header: Header {
-                origin_seq: j as u64,
-                origin_device_time_us: device,
-                origin_rx_ns: rx_ns(device),
-                ..Header::default()
-            },
-            ..RawImu::default()
-        };
-        for i in 0..3 {
-            match gyro.count(i, s.gyro_rps[i]) {
-                Some(c) => {
-                    frame.gyro_counts[i] = c;
-                    frame.valid_mask |= 1 << i;
-                }
-                None => invalid += 1,
-            }
-            match accel.count(i, s.accel_mps2[i]) {
-                Some(c) => {
-                    frame.accel_counts[i] = c;
-                    frame.valid_mask |= 1 << (16 + i);
-                }
-                None => invalid += 1,
-            }
-        }
-        imu.push(frame);
-    }
+    let mut block = BlockQuantiser::new(&scales);
+    let imu: Vec<RawImu> = trial
+        .samples
+        .iter()
+        .enumerate()
+        .map(|(j, s)| block.frame(j as u64, device_us(s.t_s - t0), &s.gyro_rps, &s.accel_mps2))
+        .collect();
 
     let mut notes = Vec::new();
     let truth = match &trial.truth_m {
@@ -166,12 +138,7 @@ pub fn import_trial(trial: &FootTrial, profile: &Profile<'_>) -> Result<Imported
         config_fragment,
         scales,
         rate_hz,
-        quantisation: Quantisation {
-            gyro_max_error_rps: gyro.largest_error,
-            accel_max_error_mps2: accel.largest_error,
-            clamped: gyro.clamped + accel.clamped,
-            invalid_readings: invalid,
-        },
+        quantisation: block.quantisation(),
         clock_offsets: Vec::new(),
         repairs,
         notes,

@@ -18,9 +18,9 @@ use rins_earth::LocalOrigin;
 use rins_fusion::{Geometry, WlsSolver};
 use rins_navigator::attitude::quaternion_from_euler;
 
-use super::counts::{Quantiser, Scales, largest_abs};
+use super::counts::{BlockQuantiser, Scales, largest_abs};
 use super::fragment::{Axes, Fragment, NoiseDensity, StartTable, render};
-use super::{ClockOffset, ImportedRun, Quantisation, RepairCount, central_difference, rx_ns, wxyz};
+use super::{ClockOffset, ImportedRun, Quantisation, RepairCount, central_difference, wxyz};
 use crate::datasets::quadrotor::projection::{Installation, MAX_CHANNELS, estimate_installation};
 use crate::datasets::quadrotor::{IMU_RATE_HZ, Repairs, Trial};
 use crate::quadrotor_ahrs::run::device_us;
@@ -153,55 +153,23 @@ fn truth_samples(trial: &Trial, motion: &Motion, origin: &LocalOrigin) -> (Vec<T
     (out, outside)
 }
 
-/// Quantises every unit's triads into frames of `3 · units` channels.
+/// Quantises every unit's triads into frames of `3 · units` channels (channel 3k+i: axis i of
+/// unit k).
 fn frames_of(trial: &Trial, motion: &Motion, scales: &Scales) -> (Vec<RawImu>, Quantisation) {
-    let n = 3 * trial.imus.len();
-    let mut gyro = Quantiser::new(scales.gyro_lsb_rps);
-    let mut accel = Quantiser::new(scales.accel_lsb_mps2);
-    let mut invalid = 0;
+    let n = (3 * trial.imus.len()).min(MAX_CHANNELS);
+    let mut block = BlockQuantiser::new(scales);
     let mut frames = Vec::with_capacity(trial.len());
+    let (mut gyro, mut accel) = ([0.0; MAX_CHANNELS], [0.0; MAX_CHANNELS]);
     for j in 0..trial.len() {
-        let device = device_us(motion.time(j));
-        let mut frame = RawImu {
-            n_gyro: n as u8,
-            n_accel: n as u8,
-            header: Header {
-                origin_seq: j as u64,
-                origin_device_time_us: device,
-                origin_rx_ns: rx_ns(device),
-                ..Header::default()
-            },
-            ..RawImu::default()
-        };
-        for (k, series) in trial.imus.iter().enumerate() {
+        for (k, series) in trial.imus.iter().enumerate().take(n / 3) {
             let s = &series.samples[j];
-            for i in 0..3 {
-                let ch = 3 * k + i;
-                match gyro.count(ch, s.gyro_rps[i]) {
-                    Some(c) => {
-                        frame.gyro_counts[ch] = c;
-                        frame.valid_mask |= 1 << ch;
-                    }
-                    None => invalid += 1,
-                }
-                match accel.count(ch, s.accel_mps2[i]) {
-                    Some(c) => {
-                        frame.accel_counts[ch] = c;
-                        frame.valid_mask |= 1 << (16 + ch);
-                    }
-                    None => invalid += 1,
-                }
-            }
+            gyro[3 * k..3 * k + 3].copy_from_slice(&s.gyro_rps);
+            accel[3 * k..3 * k + 3].copy_from_slice(&s.accel_mps2);
         }
-        frames.push(frame);
+        let device = device_us(motion.time(j));
+        frames.push(block.frame(j as u64, device, &gyro[..n], &accel[..n]));
     }
-    let quantisation = Quantisation {
-        gyro_max_error_rps: gyro.largest_error,
-        accel_max_error_mps2: accel.largest_error,
-        clamped: gyro.clamped + accel.clamped,
-        invalid_readings: invalid,
-    };
-    (frames, quantisation)
+    (frames, block.quantisation())
 }
 
 /// Largest difference, over the frames whose channels are all valid, between the equal-weight
