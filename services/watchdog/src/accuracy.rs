@@ -79,6 +79,9 @@ pub struct ScoredSample {
     pub nav: Position,
     /// The navigator's integrity of this sample was ok.
     pub integrity_ok: bool,
+    /// The navigator claims a horizontal position (without an initial position, none until the
+    /// first absolute fix: its latitude and longitude are placeholders, not an error to score).
+    pub position_known: bool,
 }
 
 impl Accuracy {
@@ -87,10 +90,14 @@ impl Accuracy {
         let attitude = attitude_error_deg(s.truth_q, s.nav_q);
         self.attitude_deg.push(attitude);
         self.altitude_m.push(s.nav.height_m - s.truth.height_m);
-        self.horizontal.push(s.truth, s.nav);
+        if s.position_known {
+            self.horizontal.push(s.truth, s.nav);
+        }
         if s.integrity_ok {
             self.attitude_deg_while_ok.push(attitude);
-            self.horizontal_m_while_ok.push(s.truth.distance_to(&s.nav));
+            if s.position_known {
+                self.horizontal_m_while_ok.push(s.truth.distance_to(&s.nav));
+            }
         }
     }
 }
@@ -129,6 +136,7 @@ mod tests {
             truth: at(0.0),
             nav: at(1e-5),
             integrity_ok: false,
+            position_known: true,
         });
         let small = UnitQuaternion::from_euler_angles(0.0, 0.5f64.to_radians(), 0.0);
         acc.push(&ScoredSample {
@@ -137,12 +145,38 @@ mod tests {
             truth: at(0.0),
             nav: at(0.0),
             integrity_ok: true,
+            position_known: true,
         });
         assert!((acc.attitude_deg.max().unwrap() - 2.0).abs() < 1e-9);
         assert!((acc.attitude_deg_while_ok.max().unwrap() - 0.5).abs() < 1e-9);
         assert!(acc.horizontal.errors().max().unwrap() > 60.0);
         assert_eq!(acc.horizontal_m_while_ok.max(), Some(0.0));
         assert_eq!(acc.attitude_deg_while_ok.count(), 1);
+    }
+
+    #[test]
+    fn a_position_the_navigator_does_not_claim_is_not_scored() {
+        let level = [1.0, 0.0, 0.0, 0.0];
+        let at = |lat_rad| Position {
+            lat_rad,
+            lon_rad: 0.0,
+            height_m: 0.0,
+        };
+        let mut acc = Accuracy::default();
+        // A placeholder position 5000 km away before the first fix, then 1 m off.
+        for (nav, position_known) in [(at(0.8), false), (at(1.0 / 6.4e6), true)] {
+            acc.push(&ScoredSample {
+                truth_q: level,
+                nav_q: level,
+                truth: at(0.0),
+                nav,
+                integrity_ok: true,
+                position_known,
+            });
+        }
+        assert!(acc.horizontal.errors().max().unwrap() < 1.1);
+        assert!(acc.horizontal_m_while_ok.max().unwrap() < 1.1);
+        assert_eq!(acc.attitude_deg.count(), 2);
     }
 
     #[test]

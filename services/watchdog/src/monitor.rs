@@ -305,6 +305,9 @@ impl Monitor {
                         height_m: nav.altitude_m,
                     },
                     integrity_ok: integrity == Integrity::Ok,
+                    position_known: nav.integrity_reasons
+                        & ipc_types::integrity_reason::POSITION_UNKNOWN
+                        == 0,
                 });
             }
         }
