@@ -429,6 +429,11 @@ AIDING_STALE = {
     0x400: "gnss",
 }
 
+#: Bits of NavState.aiding (rejected sources), with their names.
+AIDING_REJECTED = {
+    0x800: "gnss",
+}
+
 #: Bits of FusedImu.flags, with their names.
 FUSED_FLAGS = {
     0x1: "gyro-fault-not-isolated",

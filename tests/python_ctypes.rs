@@ -104,7 +104,7 @@ fn wire_enums() -> Vec<WireEnum> {
 type BitNames = &'static [(u32, &'static str)];
 
 /// Flag words: the Python name of the table, the field it describes, and its bit names.
-fn flag_tables() -> [(&'static str, &'static str, BitNames); 5] {
+fn flag_tables() -> [(&'static str, &'static str, BitNames); 6] {
     [
         (
             "INTEGRITY_REASONS",
@@ -120,6 +120,11 @@ fn flag_tables() -> [(&'static str, &'static str, BitNames); 5] {
             "AIDING_STALE",
             "NavState.aiding (stale sources)",
             &ipc_types::aiding::STALE_NAMES,
+        ),
+        (
+            "AIDING_REJECTED",
+            "NavState.aiding (rejected sources)",
+            &ipc_types::aiding::REJECTED_NAMES,
         ),
         (
             "FUSED_FLAGS",

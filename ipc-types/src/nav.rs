@@ -150,6 +150,17 @@ pub mod aiding {
         (MAG_STALE, "mag"),
         (GNSS_STALE, "gnss"),
     ];
+
+    /// Every rejected-source bit with the source's name.
+    pub const REJECTED_NAMES: [(u32, &str); 1] = [(GNSS_REJECTED, "gnss")];
+
+    /// Every table of bit names with the suffix its names take in a readable list (`gnss-stale`,
+    /// `gnss-rejected`): together they name each bit of [`NavState::aiding`](crate::NavState).
+    pub const NAME_GROUPS: [(&[(u32, &str)], &str); 3] = [
+        (&SOURCE_NAMES, ""),
+        (&STALE_NAMES, "-stale"),
+        (&REJECTED_NAMES, "-rejected"),
+    ];
 }
 
 /// Aiding sources counted in [`NavState::aiding_accepted`] / [`NavState::aiding_rejected`], in

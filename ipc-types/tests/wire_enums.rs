@@ -253,6 +253,7 @@ fn every_flag_word_names_each_of_its_bits_once() {
         &fused_flags::NAMES[..],
         &aiding::SOURCE_NAMES[..],
         &aiding::STALE_NAMES[..],
+        &aiding::REJECTED_NAMES[..],
         &integrity_reason::NAMES[..],
     ] {
         let all = names.iter().fold(0u32, |acc, (bit, _)| {
@@ -276,6 +277,35 @@ fn every_flag_word_names_each_of_its_bits_once() {
         ),
         ["baro", "gravity"]
     );
+}
+
+#[test]
+fn every_aiding_bit_has_a_name() {
+    use rins_ipc_types::aiding::*;
+    let defined = [
+        BARO,
+        MAG,
+        ZUPT,
+        HUPT,
+        GRAVITY,
+        GNSS,
+        BARO_STALE,
+        MAG_STALE,
+        GNSS_STALE,
+        GNSS_REJECTED,
+    ];
+    let named =
+        NAME_GROUPS
+            .iter()
+            .flat_map(|(names, _)| names.iter())
+            .fold(0u32, |acc, (bit, _)| {
+                assert_eq!(acc & bit, 0, "bit {bit:#x} named twice");
+                acc | bit
+            });
+    for bit in defined {
+        assert_ne!(named & bit, 0, "aiding bit {bit:#x} has no name");
+    }
+    assert_eq!(named.count_ones() as usize, defined.len());
 }
 
 #[test]

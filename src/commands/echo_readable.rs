@@ -167,14 +167,7 @@ fn nav_status(map: &mut Map<String, Value>) {
     name(map, "integrity", |c| {
         Integrity::from_u8(c).map(Integrity::name)
     });
-    bits(
-        map,
-        "aiding",
-        &[
-            (&aiding::SOURCE_NAMES, ""),
-            (&aiding::STALE_NAMES, "-stale"),
-        ],
-    );
+    bits(map, "aiding", &aiding::NAME_GROUPS);
     bits(map, "integrity_reasons", &[(&integrity_reason::NAMES, "")]);
 }
 
@@ -377,6 +370,19 @@ mod tests {
         assert_eq!(v["aiding"], serde_json::json!(["baro", "mag-stale"]));
         assert_eq!(v["integrity_reasons"], serde_json::json!(["aiding-stale"]));
         assert!(v.get("_pad").is_none());
+    }
+
+    #[test]
+    fn nav_state_names_a_rejected_receiver() {
+        let nav = NavState {
+            aiding: aiding::BARO | aiding::GNSS_STALE | aiding::GNSS_REJECTED,
+            ..NavState::default()
+        };
+        let v = nav.readable().unwrap();
+        assert_eq!(
+            v["aiding"],
+            serde_json::json!(["baro", "gnss-stale", "gnss-rejected"])
+        );
     }
 
     #[test]

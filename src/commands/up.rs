@@ -262,14 +262,13 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     };
     if args.json {
         println!("{}", record::summary_json(&summary, recording.as_ref())?);
-    } else if args.duration.is_some() {
-        // A timed run ends with what it measured; one stopped by hand ends quietly.
+    } else {
+        // A run ends with what it measured, whether its duration ended or it was stopped by a
+        // signal (Ctrl-C on an interactive run).
         print!("{}", summary_text(&summary));
         if let Some(r) = &recording {
             print!("{}", r.text());
         }
-    } else if let Some(r) = &recording {
-        eprint!("{}", r.text());
     }
     // A timed run that never saw a frame did not do what was asked: a bring-up script must see it.
     if args.duration.is_some()

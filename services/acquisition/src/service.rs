@@ -158,7 +158,11 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
             Ok(port) => port,
             Err(e) => {
                 let retry = presence.open_failed(monotonic_ns());
-                if retry.first {
+                // The simulator's link under `rins up` appears moments after this service
+                // starts: waiting for it is expected, not worth a warning.
+                if retry.first && settings.in_run_dir(std::path::Path::new(&path)) {
+                    tracing::debug!(port = %path, error = %e, "waiting for the simulator's link");
+                } else if retry.first {
                     let backoff = presence.backoff();
                     tracing::warn!(
                         port = %path,

@@ -38,6 +38,7 @@ impl Service for GnssService {
         let heartbeat = Heartbeat::new(&node, ServiceKind::Gnss)?;
         Reader {
             config: &self.config,
+            simulator_link: ctx.settings.in_run_dir(std::path::Path::new(&path)),
             path: &path,
             shutdown: &ctx.shutdown,
             publisher,
@@ -53,6 +54,9 @@ impl Service for GnssService {
 /// The loop's state.
 struct Reader<'a> {
     config: &'a GnssConfig,
+    /// The port is the simulator's link under `rins up`, which appears moments after this
+    /// service starts: waiting for it is expected, not worth a warning.
+    simulator_link: bool,
     path: &'a str,
     shutdown: &'a Shutdown,
     publisher: StagePublisher<GnssFix>,
@@ -75,7 +79,9 @@ impl Reader<'_> {
                 Ok(port) => port,
                 Err(e) => {
                     let retry = presence.open_failed(monotonic_ns());
-                    if retry.first {
+                    if retry.first && self.simulator_link {
+                        tracing::debug!(port = %self.path, error = %e, "waiting for the simulator's link");
+                    } else if retry.first {
                         tracing::warn!(port = %self.path, error = %e, "waiting for the GNSS receiver: retrying with backoff");
                     }
                     self.wait(retry.delay)?;

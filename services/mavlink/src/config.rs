@@ -60,6 +60,9 @@ pub struct MavlinkConfig {
     /// Messages queued between the navigation loop and the network thread; beyond it they are
     /// dropped and counted, never waited for.
     pub queue_capacity: usize,
+    /// The horizontal position σ (m, the root of the north and east variances' sum) at which
+    /// ODOMETRY's `quality` is 50: `100·σ₀²/(σ₀² + σ_h²)`, so a larger σ gives less.
+    pub odometry_quality_sigma_m: f64,
     /// `[mavlink.rates]`: messages per second of each stream.
     pub rates: MavlinkRates,
 }
@@ -164,6 +167,7 @@ impl Default for MavlinkConfig {
             command_ack_rate_hz: 10.0,
             command_ack_burst: 10,
             queue_capacity: 512,
+            odometry_quality_sigma_m: 10.0,
             rates: MavlinkRates::default(),
         }
     }
@@ -187,6 +191,10 @@ impl Default for MavlinkRates {
 /// The most COMMAND_ACKs per second and at once that may be configured: far above what an
 /// operator sends, far below what would load the link.
 pub const MAX_ACK_RATE_HZ: f64 = 1000.0;
+
+/// The range of `odometry_quality_sigma_m`, m: from a centimetre (a σ₀ below any inertial
+/// solution's would rate every solution at the bottom) to ten kilometres (every solution 100).
+pub const QUALITY_SIGMA_RANGE_M: (f64, f64) = (0.01, 10_000.0);
 
 /// The highest rate a stream may ask for: one message per fused sample at the sensor block's
 /// fastest rate.
@@ -238,6 +246,13 @@ impl MavlinkConfig {
             return Err(format!(
                 "mavlink.queue_capacity = {}: must be 1..=65536",
                 self.queue_capacity
+            ));
+        }
+        let (lo, hi) = QUALITY_SIGMA_RANGE_M;
+        let sigma = self.odometry_quality_sigma_m;
+        if !(sigma.is_finite() && (lo..=hi).contains(&sigma)) {
+            return Err(format!(
+                "mavlink.odometry_quality_sigma_m = {sigma}: must be {lo} to {hi} m"
             ));
         }
         self.validate_commands()?;
@@ -390,6 +405,17 @@ mod tests {
         );
         assert!(bad(|c| c.system_id = 0).starts_with("mavlink.system_id = 0"));
         assert!(bad(|c| c.queue_capacity = 0).starts_with("mavlink.queue_capacity = 0"));
+        for sigma in [0.0, -5.0, 0.001, 1e5, f64::NAN, f64::INFINITY] {
+            let c = MavlinkConfig {
+                odometry_quality_sigma_m: sigma,
+                ..MavlinkConfig::default()
+            };
+            let e = c.validate().unwrap_err();
+            assert!(
+                e.starts_with(&format!("mavlink.odometry_quality_sigma_m = {sigma}:")),
+                "{e}"
+            );
+        }
         assert!(
             bad(|c| {
                 c.enabled = true;

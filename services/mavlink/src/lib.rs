@@ -7,7 +7,8 @@
 //! - [`position`]: the GLOBAL_POSITION_INT and LOCAL_POSITION_NED messages.
 //! - [`odometry`]: the ODOMETRY message with the covariance diagonal, the reset counter and the quality.
 //! - [`heartbeat`]: the HEARTBEAT message of the on-board profile and of the bench display profile.
-//! - [`sys_status`]: the SYS_STATUS message with the gyro, accelerometer and AHRS health bits.
+//! - [`sys_status`]: the SYS_STATUS message with the bits of what rins has (gyro, accelerometer,
+//!   AHRS; magnetometer, barometer and GPS when configured) and their health.
 //! - [`status_text`]: the STATUSTEXT messages of channel exclusions, returns, lane switches and
 //!   restarts; [`events`] finds them in the inputs.
 //! - [`highres_imu`], [`vibration`]: the fused IMU and how much it shakes.

@@ -41,15 +41,37 @@ impl ResetCounter {
     }
 }
 
-/// Quality in percent: −1 ("failed") while the solution is not usable or its integrity invalid, 50
-/// while degraded, 100 when ok.
-pub fn quality(nav: &NavState) -> i8 {
-    let usable = NavMode::from_u8(nav.mode).is_some_and(NavMode::is_usable);
-    match Integrity::from_u8(nav.integrity) {
-        Some(Integrity::Ok) if usable => 100,
-        Some(Integrity::Degraded) if usable => 50,
-        _ => -1,
+/// The horizontal position σ (m) of `nav`: the root of the north and east variances' sum (the
+/// distance RMS, √2 times the per-axis σ of a round error); NaN when either is not a variance.
+pub fn horizontal_sigma_m(nav: &NavState) -> f64 {
+    let (var_n, var_e) = (nav.covariance_diag[6], nav.covariance_diag[7]);
+    if var_n >= 0.0 && var_e >= 0.0 {
+        (var_n + var_e).sqrt()
+    } else {
+        f64::NAN
     }
+}
+
+/// Quality in percent, from the horizontal σ and the integrity: −1 ("failed") while the solution
+/// is not usable, its integrity invalid or its covariance not a variance; otherwise
+/// `100·σ₀²/(σ₀² + σ_h²)` with `σ₀ = sigma_50_m` (`[mavlink] odometry_quality_sigma_m`), so that
+/// σ_h = σ₀ gives 50 and a larger σ less (rounded down), halved while the integrity is degraded,
+/// and at least 1 (0 would mean "unknown").
+pub fn quality(nav: &NavState, sigma_50_m: f64) -> i8 {
+    let usable = NavMode::from_u8(nav.mode).is_some_and(NavMode::is_usable);
+    let scale = match Integrity::from_u8(nav.integrity) {
+        Some(Integrity::Ok) if usable => 1.0,
+        Some(Integrity::Degraded) if usable => 0.5,
+        _ => return -1,
+    };
+    let sigma = horizontal_sigma_m(nav);
+    if !sigma.is_finite() {
+        return -1;
+    }
+    let s0 = sigma_50_m * sigma_50_m;
+    let percent = scale * 100.0 * s0 / (s0 + sigma * sigma);
+    // Rounded down, so that any σ_h above σ₀ is below 50; in 1..=100, the cast cannot wrap.
+    percent.floor().clamp(1.0, 100.0) as i8
 }
 
 /// Rotation matrix body → NED of a quaternion [w, x, y, z].
@@ -85,13 +107,14 @@ fn covariance(diagonal: [f64; 6]) -> [f32; 21] {
 }
 
 /// The odometry of `nav` in the local frame of `origin`, with the body rate (FRD, rad/s) and its
-/// variance from the fused IMU, and the reset counter.
+/// variance from the fused IMU, the reset counter, and the σ of quality 50 ([`quality`]).
 pub fn odometry(
     nav: &NavState,
     origin: &LocalOrigin,
     body_rate_rps: [f64; 3],
     body_rate_var: [f64; 3],
     reset_counter: u8,
+    quality_sigma_50_m: f64,
 ) -> ODOMETRY_DATA {
     let [x, y, z] = origin.ned(nav.latitude_rad, nav.longitude_rad, nav.altitude_m);
     let r = body_to_ned(nav.quaternion);
@@ -137,7 +160,7 @@ pub fn odometry(
         // An inertial solution aided by baro and magnetometer has no type of its own in the
         // enumeration (GPS_INS needs satellites): unknown is the honest answer.
         estimator_type: MavEstimatorType::MAV_ESTIMATOR_TYPE_UNKNOWN,
-        quality: quality(nav),
+        quality: quality(nav, quality_sigma_50_m),
     }
 }
 
@@ -163,7 +186,7 @@ mod tests {
     fn the_covariance_diagonal_lands_on_the_triangle_diagonal() {
         let nav = navigating();
         let origin = LocalOrigin::new(0.0, 0.0, 0.0);
-        let m = odometry(&nav, &origin, [0.0; 3], [0.01, 0.02, 0.03], 0);
+        let m = odometry(&nav, &origin, [0.0; 3], [0.01, 0.02, 0.03], 0, SIGMA_50_M);
         let diag: Vec<f32> = COVARIANCE_DIAGONAL
             .iter()
             .map(|&i| m.pose_covariance[i])
@@ -182,7 +205,8 @@ mod tests {
             .collect();
         assert_eq!(diag, [4.0, 5.0, 6.0, 0.01, 0.02, 0.03]);
         assert_eq!((m.vx, m.vy, m.vz), (3.0, 4.0, -1.0));
-        assert_eq!(m.quality, 100);
+        // σ_h = √(7 + 8) m: 100·100/(100 + 15) = 86.96.
+        assert_eq!(m.quality, 86);
     }
 
     #[test]
@@ -199,6 +223,7 @@ mod tests {
             [0.0; 3],
             [0.0; 3],
             0,
+            SIGMA_50_M,
         );
         // North 3, east 4 → forward 4, right −3.
         assert!(
@@ -211,15 +236,66 @@ mod tests {
         assert!((m.velocity_covariance[6] - 4.0).abs() < 1e-6);
     }
 
+    /// The built-in σ of quality 50.
+    const SIGMA_50_M: f64 = 10.0;
+
+    /// A navigating solution of horizontal σ `sigma_h_m`, all of it north.
+    fn with_horizontal_sigma(sigma_h_m: f64) -> NavState {
+        let mut nav = navigating();
+        nav.covariance_diag[6] = sigma_h_m * sigma_h_m;
+        nav.covariance_diag[7] = 0.0;
+        nav
+    }
+
+    #[test]
+    fn quality_falls_with_the_horizontal_sigma() {
+        // 100·σ₀²/(σ₀² + σ_h²), rounded down.
+        for (sigma_h, expected) in [
+            (0.0, 100),
+            (1.0, 99),  // 100/1.01
+            (10.0, 50), // σ_h = σ₀
+            (15.0, 30), // 100/3.25 = 30.8
+            (47.0, 4),  // free-inertial drift: 100/23.09
+            (72.0, 1),  // 100/52.84 = 1.9
+            (1e6, 1),   // never 0, which means "unknown"
+        ] {
+            let nav = with_horizontal_sigma(sigma_h);
+            assert_eq!(quality(&nav, SIGMA_50_M), expected, "σ_h {sigma_h} m");
+        }
+        // North and east add up: 6 m and 8 m make σ_h = 10 m.
+        let mut nav = navigating();
+        (nav.covariance_diag[6], nav.covariance_diag[7]) = (36.0, 64.0);
+        assert_eq!(horizontal_sigma_m(&nav), 10.0);
+        assert_eq!(quality(&nav, SIGMA_50_M), 50);
+        // Any σ_h above σ₀ is below 50, and the curve never rises with σ_h.
+        let mut last = 100;
+        for i in 0..4000 {
+            let sigma_h = f64::from(i) * 0.025;
+            let q = quality(&with_horizontal_sigma(sigma_h), SIGMA_50_M);
+            assert!(q <= last, "σ_h {sigma_h}: {q} after {last}");
+            if sigma_h > SIGMA_50_M {
+                assert!(q < 50, "σ_h {sigma_h} m: quality {q}");
+            }
+            last = q;
+        }
+        // A tighter σ₀ judges the same solution worse.
+        let nav = with_horizontal_sigma(3.0);
+        assert!(quality(&nav, 2.0) < quality(&nav, SIGMA_50_M));
+    }
+
     #[test]
     fn quality_fails_unless_the_solution_is_usable() {
-        let nav = navigating();
-        assert_eq!(quality(&nav), 100);
+        let nav = with_horizontal_sigma(0.0);
+        assert_eq!(quality(&nav, SIGMA_50_M), 100);
         let degraded = NavState {
             integrity: Integrity::Degraded as u8,
             ..nav
         };
-        assert_eq!(quality(&degraded), 50);
+        assert_eq!(quality(&degraded, SIGMA_50_M), 50);
+        let mut no_variance = nav;
+        no_variance.covariance_diag[7] = f64::NAN;
+        let mut negative = nav;
+        negative.covariance_diag[6] = -1.0;
         for not_usable in [
             NavState {
                 mode: NavMode::Aligning as u8,
@@ -230,8 +306,10 @@ mod tests {
                 ..nav
             },
             NavState { mode: 77, ..nav },
+            no_variance,
+            negative,
         ] {
-            assert_eq!(quality(&not_usable), -1);
+            assert_eq!(quality(&not_usable, SIGMA_50_M), -1);
         }
     }
 

@@ -14,7 +14,7 @@ use crate::local_frame::LocalOrigin;
 use crate::odometry::{ResetCounter, odometry};
 use crate::position::{global_position_int, local_position_ned};
 use crate::rate_gate::RateGate;
-use crate::sys_status::sys_status;
+use crate::sys_status::{present, sys_status};
 use crate::vibration::VibrationMeter;
 
 /// Each stream's pacing.
@@ -42,6 +42,10 @@ pub struct MavlinkStream {
     events: EventWatch,
     fused: Option<FusedImu>,
     nav: Option<NavState>,
+    /// Every aiding bit a solution has shown: which aiding sensors SYS_STATUS reports present.
+    aiding_seen: u32,
+    /// `[mavlink] odometry_quality_sigma_m`: the horizontal σ of ODOMETRY quality 50.
+    quality_sigma_m: f64,
 }
 
 /// Whether `nav` may be shown as a solution: usable, integrity not invalid.
@@ -72,6 +76,8 @@ impl MavlinkStream {
             events: EventWatch::default(),
             fused: None,
             nav: None,
+            aiding_seen: 0,
+            quality_sigma_m: config.odometry_quality_sigma_m,
         }
     }
 
@@ -137,13 +143,21 @@ impl MavlinkStream {
         // learns it must not use it.
         if self.gates.odometry.due(t_ns) {
             let mut m = match &self.origin {
-                Some(origin) => odometry(nav, origin, rate, rate_var, reset_counter),
+                Some(origin) => odometry(
+                    nav,
+                    origin,
+                    rate,
+                    rate_var,
+                    reset_counter,
+                    self.quality_sigma_m,
+                ),
                 None => odometry(
                     nav,
                     &LocalOrigin::new(0.0, 0.0, 0.0),
                     rate,
                     rate_var,
                     reset_counter,
+                    self.quality_sigma_m,
                 ),
             };
             if !shown {
@@ -154,6 +168,7 @@ impl MavlinkStream {
             emit(MavMessage::ODOMETRY(m));
         }
         self.nav = Some(*nav);
+        self.aiding_seen |= nav.aiding;
     }
 
     /// The watchdog's report: restarts become events.
@@ -175,9 +190,73 @@ impl MavlinkStream {
             emit(MavMessage::SYS_STATUS(sys_status(
                 self.fused.as_ref(),
                 self.nav.as_ref(),
-                // rins has no single main loop whose load the field could mean: 0.
+                present(self.aiding_seen),
+                // Not measured: rins has no single main loop whose load the field could mean,
+                // and this process does not see the others' CPU time.
                 0,
             )));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use ipc_types::aiding;
+
+    use super::*;
+    use crate::dialect::{MavSysStatusSensor, MavSysStatusSensorExtended};
+
+    fn navigating(t_ns: u64, aiding: u32, sigma_h_m: f64) -> NavState {
+        let mut nav = NavState {
+            mode: NavMode::Navigating as u8,
+            aiding,
+            quaternion: [1.0, 0.0, 0.0, 0.0],
+            ..NavState::default()
+        };
+        nav.header.origin_rx_ns = t_ns;
+        nav.covariance_diag[6] = sigma_h_m * sigma_h_m;
+        nav
+    }
+
+    #[test]
+    fn odometry_quality_follows_the_configured_sigma_and_sys_status_what_was_configured() {
+        let config = MavlinkConfig {
+            odometry_quality_sigma_m: 20.0,
+            ..MavlinkConfig::default()
+        };
+        let mut stream = MavlinkStream::new(&config);
+        let mut sent = Vec::new();
+        // σ_h = 20 m = σ₀: quality 50 (with the built-in 10 m it would be 20).
+        let nav = navigating(1_000_000_000, aiding::BARO | aiding::MAG, 20.0);
+        stream.on_nav(&nav, 0, &mut |m| sent.push(m));
+        // The barometer then goes quiet: still present, no longer healthy.
+        let quiet = navigating(1_100_000_000, aiding::BARO_STALE | aiding::MAG, 20.0);
+        stream.on_nav(&quiet, 0, &mut |m| sent.push(m));
+        stream.on_clock(2_000_000_000, &mut |m| sent.push(m));
+        let quality: Vec<i8> = sent
+            .iter()
+            .filter_map(|m| match m {
+                MavMessage::ODOMETRY(o) => Some(o.quality),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(quality.first(), Some(&50));
+        let Some(MavMessage::SYS_STATUS(s)) =
+            sent.iter().find(|m| matches!(m, MavMessage::SYS_STATUS(_)))
+        else {
+            panic!("no SYS_STATUS in {sent:?}");
+        };
+        let baro = MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_ABSOLUTE_PRESSURE;
+        let mag = MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_3D_MAG;
+        let present = s.onboard_control_sensors_present;
+        assert!(present.contains(baro | mag), "{present:?}");
+        assert!(!present.contains(MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_GPS));
+        let health = s.onboard_control_sensors_health;
+        assert!(health.contains(mag) && !health.contains(baro), "{health:?}");
+        assert_eq!(
+            s.onboard_control_sensors_present_extended,
+            MavSysStatusSensorExtended::empty()
+        );
+        assert_eq!(s.load, 0);
     }
 }

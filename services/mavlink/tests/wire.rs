@@ -70,10 +70,12 @@ fn every_message_reads_back_as_written() {
             [0.1, 0.2, -0.3],
             [1e-6; 3],
             reset_counter,
+            10.0,
         )),
         MavMessage::SYS_STATUS(sys_status::sys_status(
             Some(&ipc_types::FusedImu::default()),
             Some(&nav),
+            sys_status::present(nav.aiding),
             87,
         )),
         MavMessage::STATUSTEXT(status_text::channel_event(
@@ -97,11 +99,13 @@ fn odometry_keeps_its_extension_fields_on_the_wire() {
         [0.0; 3],
         [0.0; 3],
         9,
+        10.0,
     ));
     let MavMessage::ODOMETRY(read) = round_trip(msg) else {
         panic!("not an ODOMETRY");
     };
-    assert_eq!((read.reset_counter, read.quality), (9, 100));
+    // σ_h = 0.5 m against σ₀ = 10 m: 100·100/100.25 = 99.75, rounded down.
+    assert_eq!((read.reset_counter, read.quality), (9, 99));
     assert_eq!(read.pose_covariance[0], 0.25);
     assert_eq!(read.time_usec, 987_654_321);
 }

@@ -285,6 +285,10 @@ pub struct NavigatorService {
 impl Service for NavigatorService {
     fn run(self, ctx: ServiceContext) -> Result<()> {
         let (lane, lanes) = (self.lane, self.lanes);
+        // The two lanes run the same code and log the same lines: each line this lane logs
+        // carries `lane=N`. Entered once for the whole run, so the per-sample path pays nothing;
+        // at the error level so that it is enabled whatever `RINS_LOG` lets through.
+        let _lane_span = tracing::error_span!("navigator", lane).entered();
         let kind = match (lane, lanes) {
             (0, 1 | 2) => ServiceKind::Navigator,
             (1, 2) => ServiceKind::NavigatorStandby,

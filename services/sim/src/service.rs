@@ -340,8 +340,12 @@ fn run(mut sim: Simulator, options: &SimOptions, ctx: &ServiceContext) -> Result
     let shutdown = &ctx.shutdown;
     let line = SerialLine::open(options.link.clone())?;
     let tty = line.tty().unwrap_or_default();
-    println!("{tty}");
-    let _ = std::io::stdout().flush();
+    // Without a link the path is how a person finds the device to read it; with one (under
+    // `rins up`) the link is the device's name and the log line below carries the path.
+    if options.link.is_none() {
+        println!("{tty}");
+        let _ = std::io::stdout().flush();
+    }
     tracing::info!(port = %tty, link = ?options.link, "simulated sensor block streaming");
 
     // Sleep precisely: the default 50 µs timer slack would show up as frame jitter.

@@ -102,6 +102,12 @@ impl IpcSettings {
         Ok(dir)
     }
 
+    /// Whether `path` lies in [`Self::run_dir`]: a device link the deployment makes itself (the
+    /// simulator's terminal), which appears moments after the services that read it start.
+    pub fn in_run_dir(&self, path: &std::path::Path) -> bool {
+        path.parent() == Some(self.run_dir().as_path())
+    }
+
     /// Refuses a root and prefix too long for iceoryx2's event sockets, which are named
     /// `ROOT/PREFIX<id>.event`: a Unix socket's path is limited, and the id (a u128 in decimal)
     /// grows with every port a process makes. Past the limit a listener fails at run time, in
@@ -143,6 +149,15 @@ impl IpcSettings {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn only_a_path_directly_in_the_run_dir_is_the_deployments_own() {
+        let s = IpcSettings::new("p_", "/tmp/root");
+        assert!(s.in_run_dir(std::path::Path::new("/tmp/root/p_run/sim-tty")));
+        assert!(!s.in_run_dir(std::path::Path::new("/tmp/root/late-tty")));
+        assert!(!s.in_run_dir(std::path::Path::new("/dev/ttyUSB0")));
+        assert!(!s.in_run_dir(std::path::Path::new("/tmp/root/q_run/sim-tty")));
+    }
 
     /// 62 bytes of root and prefix together pass; one more is refused, naming both and the limit.
     #[test]
