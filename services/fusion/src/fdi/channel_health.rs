@@ -63,6 +63,9 @@ pub const STUCK_FALSE_ALARMS_PER_HOUR: f64 = 0.01;
 /// from a frozen one by its counts.
 pub const MAX_STUCK_RUN: u32 = 100_000;
 
+/// Noise wider than this many counts is scored by a bound instead of the exact sum.
+const WIDE_NOISE_COUNTS: f64 = 64.0;
+
 /// P(|ε| < x) for ε ~ N(0, σ²) with σ = 1 and x ≥ 0: erf(x/√2).
 fn within(x: f64) -> f64 {
     regularized_gamma_p(0.5, x * x / 2.0)
@@ -75,7 +78,13 @@ pub fn repeat_run_probability(sigma_counts: f64, run: u32) -> f64 {
     if sigma_counts <= 0.0 {
         return 1.0;
     }
-    let mut total = within(0.5 / sigma_counts).powf(f64::from(run));
+    let central = within(0.5 / sigma_counts);
+    if sigma_counts > WIDE_NOISE_COUNTS {
+        // Σ p_k^run ≤ (max p_k)^(run−1) · Σ p_k ≤ p_0^(run−1): a conservative bound that stays
+        // cheap where the exact sum would need millions of terms (or overflow the count).
+        return central.powf(f64::from(run.saturating_sub(1)));
+    }
+    let mut total = central.powf(f64::from(run));
     // The terms fall off as exp(−k²/2σ²): 8σ + 1 counts either side is far past double precision.
     let reach = (8.0 * sigma_counts).ceil() as i32 + 1;
     for k in 1..=reach {
@@ -361,6 +370,29 @@ mod tests {
         assert!(repeat_run_probability(0.384, slow - 1) * 1.44e6 > STUCK_FALSE_ALARMS_PER_HOUR);
         // A noiseless channel cannot be judged by its counts.
         assert_eq!(stuck_run_needed(0.0, 1e7), MAX_STUCK_RUN);
+    }
+
+    #[test]
+    fn wide_noise_is_bounded_not_summed() {
+        // Just above the switch the bound p_0^(L−1) must not be below the exact sum.
+        let sigma = WIDE_NOISE_COUNTS * 1.01;
+        for run in [2, 3, 5] {
+            let central = within(0.5 / sigma);
+            let mut exact = central.powf(f64::from(run));
+            for k in 1..=600 {
+                let p = 0.5
+                    * (within((f64::from(k) + 0.5) / sigma) - within((f64::from(k) - 0.5) / sigma));
+                exact += 2.0 * p.max(0.0).powf(f64::from(run));
+            }
+            let bound = repeat_run_probability(sigma, run);
+            assert!(
+                bound >= exact && bound < 200.0 * exact,
+                "{run}: {bound} vs {exact}"
+            );
+        }
+        // Absurdly wide or infinite noise (a tiny full scale) answers at once with a short run.
+        assert_eq!(stuck_run_needed(1e300, 1e7), 2);
+        assert_eq!(stuck_run_needed(f64::INFINITY, 1e7), 2);
     }
 
     #[test]
