@@ -12,10 +12,17 @@ per-user defaults (`rins_<uid>_`; `$XDG_RUNTIME_DIR/rins/`, `/run/rins/` for roo
 
     import rins_topics as rt
     node = rt.open_node()
-    nav = rt.subscribe(node, rt.NAV_STATE, rt.NavState)
-    sample = nav.receive()          # None when nothing is queued
+    nav = rt.subscribe_nav(node, timeout_s=5)   # both navigator lanes, one stream
+    state = nav.receive(timeout_s=1.0)          # a NavState copy; None when none came
+    imu = rt.subscribe(node, rt.FUSED_IMU, rt.FusedImu)
+    sample = imu.receive()          # None when nothing is queued
     if sample is not None:
-        state = sample.payload().contents
+        fused = rt.FusedImu.from_buffer_copy(sample.payload().contents)
+        sample.delete()
+
+The navigation solution comes from two navigator lanes (`NAV_LANES`); `subscribe_nav` follows
+them as rins's own consumers do, through the lane selector of `lane_selector.py`: every sequence
+number once, in order, switching lanes when the one delivering dies.
 
 The structures alone need no iceoryx2: `NavState.from_buffer_copy(raw_bytes)` reads a payload from
 a recording.
@@ -26,6 +33,8 @@ import enum
 import os
 import time
 from pathlib import Path
+
+from lane_selector import LaneSelector, SelectorConfig
 
 #: Environment variables naming a deployment, as rins reads them.
 PREFIX_ENV = "RINS_IPC_PREFIX"
@@ -131,6 +140,99 @@ def wire_name(enum_type: type, value: int) -> str:
 def bit_names(bits: int, table: "dict[int, str]") -> "list[str]":
     """The names of the bits of `bits` that `table` lists (`INTEGRITY_REASONS`, `FUSED_FLAGS`...)."""
     return [name for bit, name in table.items() if bits & bit]
+
+
+class NavSubscription:
+    """The navigation stream as rins's own consumers see it: both navigator lanes' topics
+    (`NAV_LANES`) merged by a `LaneSelector` into one contiguous sequence, each sequence number once
+    and in order, from the lane the selector has chosen. Killing a navigator lane loses no sample:
+    the other lane's samples continue the stream at the next sequence number. With a single lane
+    the standby topic does not exist and the stream is the primary's.
+
+    Made by `subscribe_nav`."""
+
+    #: How often a standby topic that does not exist (yet) is looked for again, s.
+    STANDBY_RETRY_S = 0.5
+    #: Sleep between polls while `receive` waits, ms.
+    POLL_MS = 2
+
+    def __init__(self, node, timeout_s: float = 0.0, config: "SelectorConfig | None" = None):
+        import iceoryx2 as iox2
+
+        self._node = node
+        self._pause = iox2.Duration.from_millis(self.POLL_MS)
+        self.selector = LaneSelector(config or SelectorConfig())
+        self._lanes = [subscribe(node, NAV_LANES[0], NavState, timeout_s), None]
+        self._standby_due = 0.0
+        #: Samples received from each lane.
+        self.lane_totals = [0] * len(NAV_LANES)
+        #: Sequence numbers the output stepped over: missing in both lanes (a hole in the input),
+        #: or dropped from a full subscriber queue while this process did not receive.
+        self.skipped = 0
+        self._last_seq = None
+
+    @property
+    def selected_lane(self) -> int:
+        """The lane delivering now."""
+        return self.selector.selected
+
+    def receive(self, timeout_s: float = 0.0) -> "NavState | None":
+        """The next sample of the stream (a copy, out of shared memory), or None when none is due
+        within `timeout_s`. While waiting, iceoryx2 raises `NodeWaitFailure` when the process is
+        asked to stop (SIGINT, SIGTERM: the node handles them)."""
+        deadline = time.monotonic() + timeout_s
+        while True:
+            state = self._next()
+            if state is not None:
+                if self._last_seq is not None:
+                    self.skipped += max(state.header.origin_seq - self._last_seq - 1, 0)
+                self._last_seq = state.header.origin_seq
+                return state
+            if time.monotonic() >= deadline:
+                return None
+            self._node.wait(self._pause)
+
+    def _next(self) -> "NavState | None":
+        """Takes one sample of each lane at a time, so that a backlog waits in the subscribers'
+        queues, which are deep, and not in the selector, which keeps only what a switch needs; a
+        lane whose ring is full stays in its queue until the selected lane delivers or is found
+        dead (on this process's clock, CLOCK_MONOTONIC as the navigators stamp)."""
+        self._open_standby()
+        now_ns = time.monotonic_ns()
+        while True:
+            state = self.selector.pop(now_ns)
+            if state is not None:
+                return state
+            pulled = False
+            for lane, subscriber in enumerate(self._lanes):
+                if subscriber is None or not self.selector.has_room(lane):
+                    continue
+                sample = subscriber.receive()
+                if sample is None:
+                    continue
+                state = NavState.from_buffer_copy(sample.payload().contents)
+                sample.delete()
+                self.lane_totals[lane] += 1
+                self.selector.push(lane, state)
+                pulled = True
+            if not pulled:
+                return None
+
+    def _open_standby(self) -> None:
+        """Opens the standby lane's topic once it exists (it starts with its navigator)."""
+        if self._lanes[1] is not None or time.monotonic() < self._standby_due:
+            return
+        try:
+            self._lanes[1] = subscribe(self._node, NAV_LANES[1], NavState)
+        except TopicNotFound:
+            self._standby_due = time.monotonic() + self.STANDBY_RETRY_S
+
+
+def subscribe_nav(node, timeout_s: float = 0.0, config: "SelectorConfig | None" = None):
+    """The navigation stream of both navigator lanes, one sample per sequence number (see
+    `NavSubscription`). Waits up to `timeout_s` for the primary lane's topic; raises
+    `TopicNotFound` after that."""
+    return NavSubscription(node, timeout_s, config)
 
 
 # --- generated from the Rust layouts: do not edit ---

@@ -134,6 +134,13 @@ pub enum Command {
         #[command(subcommand)]
         what: ImportCommand,
     },
+    /// The recorded data sets the evaluations read: fetch them from their public repositories
+    /// into the layout the evaluations read, or list which are present.
+    Data {
+        /// What to do.
+        #[command(subcommand)]
+        what: DataCommand,
+    },
     /// Monte Carlo comparison of the redundant block with an orthogonal triad, with a gyro kill.
     Mc(McArgs),
     /// Fault sweep: one gyro or accelerometer fault per run (bias steps, a ramp, a noise increase)
@@ -177,6 +184,48 @@ pub struct CalibrateMagArgs {
     #[arg(long, allow_negative_numbers = true)]
     pub field_ut: Option<f64>,
     /// One JSON object on stdout instead of the summary.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// What `rins data` does.
+#[derive(Debug, Subcommand)]
+pub enum DataCommand {
+    /// Clone each set's public git repository (one commit, only the files used) into
+    /// DIR/.sources, convert it into the layout the evaluations read and write a PROVENANCE note
+    /// beside it (source, commit, licence, what was converted, where the peer figures come
+    /// from); a set already complete is left as it is.
+    Fetch(DataFetchArgs),
+    /// Which data sets are present in the recordings directory, which are incomplete or missing.
+    List(DataListArgs),
+}
+
+/// Options of `rins data fetch`.
+#[derive(Debug, Args)]
+pub struct DataFetchArgs {
+    /// The sets to fetch: quadrotor-4imu, pyshoe-vicon, xio-gait (default: all).
+    #[arg(value_name = "SET")]
+    pub sets: Vec<String>,
+    /// Recordings directory (default: $RINS_DATA_DIR, else data/ at the top of the repository).
+    #[arg(long)]
+    pub dir: Option<PathBuf>,
+    /// Fetch SET from another git repository (a mirror or a local copy) instead of its
+    /// published one; repeatable.
+    #[arg(long = "source", value_name = "SET=URL")]
+    pub sources: Vec<String>,
+    /// Clone the source again and build the set again even when it is complete, replacing its
+    /// directory.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// Options of `rins data list`.
+#[derive(Debug, Args)]
+pub struct DataListArgs {
+    /// Recordings directory (default: $RINS_DATA_DIR, else data/ at the top of the repository).
+    #[arg(long)]
+    pub dir: Option<PathBuf>,
+    /// One JSON object instead of the table.
     #[arg(long)]
     pub json: bool,
 }
@@ -409,7 +458,7 @@ pub enum ServiceName {
     Navigator,
     /// The hot-standby navigator lane.
     NavigatorStandby,
-    /// The MAVLink 2 output over UDP (`[mavlink]`).
+    /// The MAVLink 2 output over UDP or a serial port (`[mavlink]`).
     Mavlink,
     /// GNSS receiver acquisition (`[gnss]`): publishes one fix per receiver epoch.
     Gnss,
@@ -482,8 +531,8 @@ pub struct UpArgs {
     /// Simulator random seed (overrides sim.seed).
     #[arg(long)]
     pub seed: Option<u64>,
-    /// Stream MAVLink 2 to this endpoint (`udpout:HOST:PORT` or `udpin:ADDR:PORT`), enabling the
-    /// MAVLink output whatever the configuration says.
+    /// Stream MAVLink 2 to this endpoint (`udpout:HOST:PORT`, `udpin:ADDR:PORT` or
+    /// `serial:PATH:BAUD`), enabling the MAVLink output whatever the configuration says.
     #[arg(long, value_name = "ENDPOINT")]
     pub mavlink: Option<String>,
     /// A GNSS receiver is fitted: runs the gnss service (on the simulated receiver unless
@@ -700,7 +749,18 @@ mod tests {
 #[derive(Debug, Args)]
 pub struct RecordArgs {
     /// The MCAP file to write (refused if it exists, unless --overwrite).
-    pub file: PathBuf,
+    #[arg(required_unless_present = "dir", conflicts_with = "dir")]
+    pub file: Option<PathBuf>,
+    /// Record into numbered files in this directory instead, a new one each --max-file-mb, the
+    /// oldest of rins's own deleted past --max-total-mb (as `[record]` of `rins up`).
+    #[arg(long, value_name = "DIR")]
+    pub dir: Option<PathBuf>,
+    /// With --dir: a file this large, MB, is closed and the next one started (default 256).
+    #[arg(long, value_name = "MB", requires = "dir")]
+    pub max_file_mb: Option<u64>,
+    /// With --dir: the most rins's own recordings in DIR may take together, MB (default 2048).
+    #[arg(long, value_name = "MB", requires = "dir")]
+    pub max_total_mb: Option<u64>,
     /// Comma-separated short names of the topics to record (default: all): raw-imu, raw-baro,
     /// raw-mag, raw-aux, fused-imu, altitude, nav, nav-standby, truth, health, heartbeat, fault,
     /// sim-control, fusion-control, fusion-reply.

@@ -189,7 +189,7 @@ pub struct RinsConfig {
     pub watchdog: WatchdogConfig,
     /// `[deployment]`: which processes `rins up` runs.
     pub deployment: DeploymentConfig,
-    /// `[mavlink]`: the MAVLink 2 output over UDP.
+    /// `[mavlink]`: the MAVLink 2 output over UDP or a serial port.
     pub mavlink: MavlinkConfig,
     /// `[gnss]`: the GNSS receiver's serial line.
     pub gnss: GnssConfig,
@@ -197,6 +197,8 @@ pub struct RinsConfig {
     pub realtime: crate::realtime_config::RealtimeConfig,
     /// `[wait]`: how the stages wait for their input.
     pub wait: crate::wait_config::WaitConfig,
+    /// `[record]`: flight recordings from the start of `rins up`.
+    pub record: crate::record::config::RecordConfig,
 }
 
 impl RinsConfig {
@@ -260,6 +262,7 @@ impl RinsConfig {
         self.mavlink.validate()?;
         self.realtime.validate()?;
         self.wait.validate()?;
+        self.record.validate()?;
         Ok(())
     }
 

@@ -5,5 +5,6 @@ pub mod built_services;
 pub mod cli;
 pub mod config;
 pub mod realtime_config;
+pub mod record;
 pub mod replay;
 pub mod wait_config;

@@ -1,11 +1,15 @@
 //! The systemd unit is one systemd accepts as written: `systemd-analyze verify` has nothing to say
 //! about it, the start limits sit in [Unit] (where systemd reads them), and nothing binds the
 //! service to the sensor's device, so that unplugging the block leaves MAVLink running while
-//! acquisition reconnects.
+//! acquisition reconnects. The service records into its state directory through `[record]`: a
+//! deployment given `$STATE_DIRECTORY` as systemd gives it, with the installed configuration's
+//! `on_start = true`, records there.
 
 mod common;
 
 use std::process::Command;
+
+use common::{Isolated, Scratch, TempFile, last_json, stderr};
 
 const UNIT: &str = include_str!("../deploy/rins.service");
 /// Where the unit expects the installed executable.
@@ -88,4 +92,55 @@ fn systemd_analyze_verify_has_nothing_to_say_about_the_unit() {
         out.status.success(),
         "systemd-analyze verify failed:\n{said}"
     );
+}
+
+#[test]
+fn the_service_records_into_its_state_directory_through_record_on_start() {
+    // A fixed --record file would be replaced at every restart: the unit leaves it to [record].
+    let exec = section("[Service]")
+        .into_iter()
+        .find(|(k, _)| *k == "ExecStart")
+        .expect("ExecStart");
+    assert!(!exec.1.contains("--record"), "{exec:?}");
+    // The configuration as deploy/README.md installs it: the built-in one, recording on start.
+    let built_in = rins::config::BUILT_IN;
+    assert_eq!(built_in.matches("\non_start = false").count(), 1);
+    let installed = TempFile::new(
+        "deploy-unit",
+        "toml",
+        &built_in.replace("\non_start = false", "\non_start = true"),
+    );
+    let scratch = Scratch::new("deploy_unit", "state");
+    let state = scratch.path().join("rins");
+    std::os::unix::fs::DirBuilderExt::mode(&mut std::fs::DirBuilder::new(), 0o700)
+        .create(&state)
+        .expect("state directory");
+    let ipc = Isolated::new("state_dir");
+    let out = ipc
+        .command()
+        .env("STATE_DIRECTORY", &state)
+        .args(["up", "--config", installed.path(), "--scenario", "static"])
+        .args(["--duration", "3", "--json"])
+        .output()
+        .expect("cannot run rins up");
+    assert!(out.status.success(), "{}", stderr(&out));
+    let rec = last_json(&out)["recording"].clone();
+    assert_eq!(rec["file"], state.to_str().expect("utf-8"), "{rec}");
+    assert_eq!(rec["error"], serde_json::Value::Null, "{rec}");
+    let files: Vec<_> = std::fs::read_dir(&state)
+        .expect("list")
+        .map(|e| e.expect("entry").path())
+        .collect();
+    assert_eq!(files.len(), 1, "{files:?}");
+    let name = files[0].file_name().expect("name").to_string_lossy();
+    assert!(
+        name.starts_with("rins-000001-0001-") && name.ends_with("Z.mcap"),
+        "{name}"
+    );
+    let read = rins_recording::read_file(&files[0]).expect("the recording reads back");
+    assert_eq!(
+        read.messages.len() as u64,
+        rec["samples_written"].as_u64().expect("n")
+    );
+    assert!(read.messages.len() > 2_000, "{}", read.messages.len());
 }

@@ -323,6 +323,7 @@ fn layouts_json() -> serde_json::Value {
 }
 
 #[test]
+#[cfg_attr(not(rins_python), ignore = "needs RINS_PYTHON: python/setup-venv")]
 fn python_ctypes_lay_every_payload_out_as_rust_does() {
     let Some(python) =
         common::python::interpreter("python_ctypes_lay_every_payload_out_as_rust_does")
@@ -351,6 +352,7 @@ fn python_ctypes_lay_every_payload_out_as_rust_does() {
 }
 
 #[test]
+#[cfg_attr(not(rins_python), ignore = "needs RINS_PYTHON: python/setup-venv")]
 fn python_finds_the_default_deployment_where_rins_puts_it() {
     let Some(python) =
         common::python::interpreter("python_finds_the_default_deployment_where_rins_puts_it")

@@ -1,7 +1,9 @@
 //! Fault injection on the serial line: the simulator unplugs its device under a running pipeline
 //! (`rins inject disconnect`, `--inject disconnect=S@T`) and acquisition must ride it out: same
 //! process, one reconnect counted, data back within the backoff's bound, the frames of the outage
-//! lost and no others. Also: an acquisition started before its device waits for it.
+//! lost and no others; the same for an unplug of 5 s under the built-in configuration the
+//! service unit runs (deploy/rins.service), after which the navigation is usable again. Also: an
+//! acquisition started before its device waits for it.
 
 mod common;
 
@@ -17,8 +19,6 @@ use rins_runtime::ipc::{IpcSettings, TopicSubscriber, create_node};
 use rins_test_support::signal::{Signal, send_signal};
 use serde_json::Value;
 
-/// The outage injected, s.
-const OUTAGE_S: f64 = 1.0;
 /// Acquisition's backoff (built-in configuration): first retry after 10 ms, doubling, at most
 /// 1 s apart.
 const BACKOFF_FIRST_S: f64 = 0.010;
@@ -164,9 +164,24 @@ fn longest_pause(arrivals: impl Iterator<Item = Instant>, from: Instant) -> (usi
 
 #[test]
 fn acquisition_rides_out_a_disconnect_under_a_running_pipeline() {
+    rides_out_an_unplug("reconnect", 1.0);
+}
+
+/// An unplug of 5 s (a connector reseated in flight): the deployment as the service unit runs it
+/// (the built-in configuration, whose restart policy the watchdog applies) keeps every process,
+/// and navigates again, usably, once the block is back.
+#[test]
+fn the_pipeline_navigates_again_after_an_unplug_of_five_seconds() {
+    rides_out_an_unplug("reconnect_5s", 5.0);
+}
+
+/// Unplugs the simulated device for `outage_s` under a navigating pipeline and checks that
+/// acquisition rides it out: same process, one reconnect, data and navigation back within the
+/// outage plus the backoff's bound, only the outage's frames lost, navigation usable after it.
+fn rides_out_an_unplug(name: &str, outage_s: f64) {
     let _one = one_pipeline();
     let _slot = PipelineSlot::take();
-    let ipc = Isolated::new("reconnect");
+    let ipc = Isolated::new(name);
     let up = Guard(Some(spawn_up(
         &ipc,
         &["--scenario", "static", "--duration", "300", "--json"],
@@ -183,18 +198,18 @@ fn acquisition_rides_out_a_disconnect_under_a_running_pipeline() {
 
     let sent = Instant::now();
     let out = ipc.run_with_timeout(
-        &["inject", "disconnect", "--duration", &OUTAGE_S.to_string()],
+        &["inject", "disconnect", "--duration", &outage_s.to_string()],
         Duration::from_secs(10),
     );
     assert!(out.status.success(), "inject failed:\n{}", stderr(&out));
     let said = String::from_utf8_lossy(&out.stdout);
     assert!(
-        said.contains("disconnect 1 s: applied at device time"),
+        said.contains(&format!("disconnect {outage_s} s: applied at device time")),
         "{said}"
     );
 
     // Data back, and a heartbeat that counts the reconnect (heartbeats come once a second).
-    let bound = Duration::from_secs_f64(OUTAGE_S + BACKOFF_CAP_S + SLACK_S);
+    let bound = Duration::from_secs_f64(outage_s + BACKOFF_CAP_S + SLACK_S);
     collector.wait_for("the reconnect", bound + Duration::from_secs(3), |s| {
         s.acquisition.last().is_some_and(|h| h.reconnects > 0)
             && s.imu
@@ -206,6 +221,17 @@ fn acquisition_rides_out_a_disconnect_under_a_running_pipeline() {
     collector.wait_for("one more heartbeat", Duration::from_secs(3), |s| {
         s.acquisition.len() > beats
     });
+    // Navigation usable again after the outage (not aligning, not invalid).
+    collector.wait_for(
+        "usable navigation after the outage",
+        Duration::from_secs(10),
+        |s| {
+            s.nav.last().is_some_and(|n| {
+                n.2 > sent + Duration::from_secs_f64(outage_s)
+                    && NavMode::from_u8(n.1).is_some_and(NavMode::is_usable)
+            })
+        },
+    );
     let seen = collector.finish();
 
     let last = seen.acquisition.last().expect("heartbeats");
@@ -217,9 +243,9 @@ fn acquisition_rides_out_a_disconnect_under_a_running_pipeline() {
     let (i, pause) = longest_pause(seen.imu.iter().map(|s| s.2), sent);
     let (seq_before, t_before, _) = seen.imu[i - 1];
     let (seq_after, t_after, _) = seen.imu[i];
-    let reconnect_s = pause.as_secs_f64() - OUTAGE_S;
+    let reconnect_s = pause.as_secs_f64() - outage_s;
     eprintln!(
-        "raw IMU pause {:.3} s for an outage of {OUTAGE_S} s: data back {:.0} ms after the device \
+        "raw IMU pause {:.3} s for an outage of {outage_s} s: data back {:.0} ms after the device \
          (backoff {} ms doubling to {} ms)",
         pause.as_secs_f64(),
         reconnect_s * 1e3,
@@ -227,7 +253,7 @@ fn acquisition_rides_out_a_disconnect_under_a_running_pipeline() {
         BACKOFF_CAP_S * 1e3
     );
     assert!(
-        pause.as_secs_f64() > 0.9 * OUTAGE_S,
+        pause.as_secs_f64() > 0.9 * outage_s,
         "no outage seen: {pause:?}"
     );
     assert!(
@@ -250,6 +276,15 @@ fn acquisition_rides_out_a_disconnect_under_a_running_pipeline() {
         seen.nav[j..].iter().all(|n| n.1 != NavMode::Aligning as u8),
         "navigation restarted its alignment"
     );
+    // And usable again: flagged invalid for a moment after a long gap, then navigating.
+    let usable_after = seen.nav[j..]
+        .iter()
+        .position(|n| NavMode::from_u8(n.1).is_some_and(NavMode::is_usable))
+        .expect("no usable navigation after the outage");
+    eprintln!(
+        "navigation usable again {usable_after} outputs after the outage (mode {} first)",
+        nav_after.1
+    );
 
     // Frames lost: those the device made while unplugged, plus those it made after coming back
     // until acquisition reopened it (a real line drops what nobody reads), less what the terminal
@@ -262,7 +297,7 @@ fn acquisition_rides_out_a_disconnect_under_a_running_pipeline() {
         .expect("samples");
     let rate_hz = 1e6 / period_us as f64;
     let lost = seq_after - seq_before - 1;
-    let outage_frames = OUTAGE_S * rate_hz;
+    let outage_frames = outage_s * rate_hz;
     eprintln!("frames lost {lost} ({outage_frames} made during the outage)");
     assert!(lost as f64 >= outage_frames - 2.0, "lost {lost}");
     assert!(

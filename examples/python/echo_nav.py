@@ -9,7 +9,8 @@ Run it next to `rins up`, with the same deployment environment (both default to 
 It needs the `iceoryx2` package (`python/setup-venv` makes a venv with it) and imports
 `python/rins_topics.py` from this repository. Each line shows the header's sequence number, the
 navigator mode and integrity, roll/pitch/yaw in degrees, latitude/longitude in degrees and the
-altitude in metres. It subscribes to the primary lane (`rins/nav/state`).
+altitude in metres. It follows both navigator lanes through the lane selector
+(`rins_topics.subscribe_nav`): one sample per sequence number, whichever lane delivers.
 
 Exit status: 0 after --count samples (or when interrupted), 2 when no deployment is found (its
 configuration file is missing), 3 when nothing arrives within --timeout seconds.
@@ -77,7 +78,7 @@ def main() -> int:
     iox2.set_log_level_from_env_or(iox2.LogLevel.Warn)
     try:
         node = rt.open_node("echo-nav-py")
-        subscriber = rt.subscribe(node, rt.NAV_STATE, rt.NavState, timeout_s=args.timeout)
+        subscriber = rt.subscribe_nav(node, timeout_s=args.timeout)
     except rt.NoDeployment as e:
         print(f"echo_nav: {e}", file=sys.stderr)
         return 2
@@ -93,8 +94,8 @@ def main() -> int:
     pause = iox2.Duration.from_millis(5)
     try:
         while args.count == 0 or received < args.count:
-            sample = subscriber.receive()
-            if sample is None:
+            state = subscriber.receive()
+            if state is None:
                 if time.monotonic() - last > args.timeout:
                     print(
                         f"echo_nav: no sample on {rt.NAV_STATE} for {args.timeout} s "
@@ -104,9 +105,6 @@ def main() -> int:
                     return 3
                 node.wait(pause)
                 continue
-            # Copied out of shared memory, then the sample is given back at once.
-            state = rt.NavState.from_buffer_copy(sample.payload().contents)
-            sample.delete()
             received += 1
             last = time.monotonic()
             d = describe(state)

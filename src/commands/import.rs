@@ -97,8 +97,9 @@ fn require_dir(what: &str, dir: &Path) -> Result<()> {
         Ok(())
     } else {
         bail!(
-            "import {what}: data set directory {} does not exist or is not a directory",
-            dir.display()
+            "import {what}: data set directory {} does not exist or is not a directory; {}",
+            dir.display(),
+            rins_eval::data::fetch_hint(dir)
         )
     }
 }

@@ -3,6 +3,7 @@
 mod bench;
 mod calibrate;
 mod control;
+mod data;
 mod echo;
 mod echo_readable;
 mod eval;
@@ -30,7 +31,9 @@ use std::process::ExitCode;
 
 use anyhow::Result;
 
-use crate::cli::{BenchCommand, CalibrateCommand, Cli, Command, EvalCommand, ImportCommand};
+use crate::cli::{
+    BenchCommand, CalibrateCommand, Cli, Command, DataCommand, EvalCommand, ImportCommand,
+};
 
 pub fn run(cli: Cli) -> Result<ExitCode> {
     match cli.command {
@@ -96,6 +99,10 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Import { what } => match what {
             ImportCommand::Quadrotor(args) => import::run_quadrotor(&args),
             ImportCommand::Pyshoe(args) => import::run_pyshoe(&args),
+        },
+        Command::Data { what } => match what {
+            DataCommand::Fetch(args) => data::run_fetch(&args),
+            DataCommand::List(args) => data::run_list(&args),
         },
         Command::Mc(args) => mc::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Sweep(args) => sweep::run(&args).map(|()| ExitCode::SUCCESS),

@@ -3,8 +3,12 @@
 //! bounded queue; a writer thread compresses and writes them, so a slow disk costs counted drops,
 //! never a missed sample on the topics. A writer that fails (a full disk) ends the recording at
 //! once: the report says why and how much was not recorded, and the command fails.
+//!
+//! `rins record --dir DIR` (and `rins up` with `[record] on_start`) writes numbered files there
+//! instead, a new one whenever one reaches its size limit, the oldest of rins's own deleted to keep
+//! the total (`rins::record`).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
@@ -12,10 +16,9 @@ use ipc_types::{
     Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, Health, HealthReport, NavState,
     RawAux, RawBaro, RawImu, RawMag, SimControl, Truth, names,
 };
-use rins_recording::{
-    ChannelId, RecordError, RecordOptions, RecordSender, RecordSummary, Recordable, Recorder,
-    join_writer, spawn_writer,
-};
+use rins::record::dir as record_dir;
+use rins::record::rotation::{FileOutcome, Limits, MB, RecordSink, Rotation, error_text};
+use rins_recording::{ChannelId, RecordOptions, RecordSender, Recordable, Recorder};
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{IpcNode, TopicSubscriber};
 use rins_runtime::payload::Stamped;
@@ -29,6 +32,9 @@ const QUEUE: usize = 16_384;
 /// The longest sleep waiting for a raw IMU sample: how often the other topics, the stop flag and
 /// the progress line are served when the pipeline is quiet.
 const WAIT: Duration = Duration::from_millis(10);
+/// How often a rotating recording looks at its file's size: at 1 kHz, some 60 kB are written
+/// meanwhile, well within the margin a file keeps below its limit.
+const SIZE_CHECK: Duration = Duration::from_millis(100);
 
 /// One subscribed topic feeding the writer.
 trait Tap {
@@ -151,7 +157,7 @@ pub fn topic_names() -> Vec<&'static str> {
 /// What `rins record --json` prints last.
 #[derive(Debug, Serialize, Deserialize)]
 pub struct RecordReport {
-    /// The file written.
+    /// The file written; with `--dir`, the directory.
     pub file: String,
     /// Samples written, all topics.
     pub samples_written: u64,
@@ -167,10 +173,27 @@ pub struct RecordReport {
     pub error: Option<String>,
     /// How long the recording ran, s.
     pub seconds: f64,
-    /// Size of the file, bytes.
+    /// Size of the file, bytes; with `--dir`, of every file written.
     pub file_bytes: u64,
     /// Per topic: written and dropped.
     pub topics: Vec<TopicCount>,
+    /// With `--dir`: each file written, in order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub files: Vec<FileCount>,
+    /// With `--dir`: the older recordings deleted to keep the total.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub files_deleted: Vec<String>,
+}
+
+/// One file of a recording made with `--dir`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FileCount {
+    /// The file.
+    pub file: String,
+    /// Samples written to it.
+    pub samples_written: u64,
+    /// Its size, bytes.
+    pub file_bytes: u64,
 }
 
 /// One topic of [`RecordReport`].
@@ -185,60 +208,133 @@ pub struct TopicCount {
 }
 
 impl RecordReport {
-    fn new(summary: &RecordSummary, received: u64, seconds: f64) -> Self {
+    /// The report of the files of `target`, `received` samples taken off the topics in `seconds`.
+    fn new(
+        target: &Target,
+        (files, deleted, problems): (Vec<FileOutcome>, Vec<PathBuf>, Vec<String>),
+        received: u64,
+        seconds: f64,
+    ) -> Self {
+        let written: u64 = files.iter().map(|f| f.written).sum();
+        let mut topics: Vec<TopicCount> = Vec::new();
+        for (topic, w, d) in files.iter().flat_map(|f| f.topics.iter()) {
+            match topics.iter_mut().find(|t| t.topic == *topic) {
+                Some(t) => {
+                    t.written += w;
+                    t.dropped += d;
+                }
+                None => topics.push(TopicCount {
+                    topic: topic.clone(),
+                    written: *w,
+                    dropped: *d,
+                }),
+            }
+        }
+        // The first failure of a file, then what kept the rotation from its limits.
+        let error = files
+            .iter()
+            .find_map(|f| f.error.as_ref().map(|e| error_text(e)))
+            .or_else(|| (!problems.is_empty()).then(|| problems.join("; ")));
+        let rotating = matches!(target, Target::Dir(_));
         Self {
-            file: summary.path.display().to_string(),
-            samples_written: summary.samples_written,
-            samples_dropped: summary.samples_dropped,
+            file: target.path().display().to_string(),
+            samples_written: written,
+            samples_dropped: files.iter().map(|f| f.dropped).sum(),
             samples_received: received,
-            samples_not_recorded: received.saturating_sub(summary.samples_written),
-            error: None,
+            samples_not_recorded: received.saturating_sub(written),
+            error,
             seconds,
-            file_bytes: summary.file_bytes,
-            topics: summary
-                .topics
-                .iter()
-                .map(|t| TopicCount {
-                    topic: t.topic.clone(),
-                    written: t.written,
-                    dropped: t.dropped,
-                })
-                .collect(),
+            file_bytes: files.iter().map(|f| f.file_bytes).sum(),
+            topics,
+            files: if rotating {
+                files
+                    .iter()
+                    .map(|f| FileCount {
+                        file: f.path.display().to_string(),
+                        samples_written: f.written,
+                        file_bytes: f.file_bytes,
+                    })
+                    .collect()
+            } else {
+                Vec::new()
+            },
+            files_deleted: deleted.iter().map(|p| p.display().to_string()).collect(),
+        }
+    }
+}
+
+/// Where a recording goes.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Target {
+    /// One file.
+    File(PathBuf),
+    /// Numbered files in a directory, within its limits.
+    Dir(Limits),
+}
+
+impl Target {
+    /// The file, or the directory.
+    pub fn path(&self) -> &Path {
+        match self {
+            Self::File(f) => f,
+            Self::Dir(l) => &l.dir,
         }
     }
 
-    /// The report of a recording whose writer failed with `error` after writing `written` and
-    /// dropping `dropped` of the `received` samples.
-    fn failed(
-        file: &Path,
-        error: &RecordError,
-        (written, dropped, received): (u64, u64, u64),
-        seconds: f64,
-    ) -> Self {
-        Self {
-            file: file.display().to_string(),
-            samples_written: written,
-            samples_dropped: dropped,
-            samples_received: received,
-            samples_not_recorded: received.saturating_sub(written),
-            error: Some(error_text(error)),
-            seconds,
-            // What reached the disk before the failure, if it can still be asked.
-            file_bytes: std::fs::metadata(file).map_or(0, |m| m.len()),
-            topics: Vec::new(),
+    /// The recording `rins up` makes: `--record FILE`, else `[record]` when `on_start` (in
+    /// `state_directory`, systemd's `$STATE_DIRECTORY`, unless `dir` names one) and the raw
+    /// samples come from the device, not from a replay (`external_source`), else none.
+    pub fn for_up(
+        record: Option<&Path>,
+        cfg: &rins::record::config::RecordConfig,
+        state_directory: Option<&str>,
+        external_source: bool,
+    ) -> Option<Self> {
+        match record {
+            Some(file) => Some(Self::File(file.to_path_buf())),
+            None if cfg.on_start && !external_source => Some(Self::Dir(Limits {
+                dir: cfg.directory(state_directory),
+                max_file_bytes: cfg.max_file_mb * MB,
+                max_total_bytes: cfg.max_total_mb * MB,
+            })),
+            None => None,
+        }
+    }
+
+    /// Checks, before anything starts, that the recording can be made: see [`check_target`] for
+    /// a file; a directory is created when missing and refused when unsafe (`record.dir`).
+    pub fn check(&self) -> Result<()> {
+        match self {
+            Self::File(f) => check_target(f),
+            Self::Dir(l) => record_dir::prepare(&l.dir, "record.dir"),
+        }
+    }
+
+    /// The arguments of `rins record` that make this recording.
+    pub fn record_args(&self) -> Vec<std::ffi::OsString> {
+        match self {
+            Self::File(f) => vec![f.into(), "--overwrite".into()],
+            Self::Dir(l) => vec![
+                "--dir".into(),
+                l.dir.clone().into(),
+                "--max-file-mb".into(),
+                (l.max_file_bytes / MB).to_string().into(),
+                "--max-total-mb".into(),
+                (l.max_total_bytes / MB).to_string().into(),
+            ],
         }
     }
 }
 
 /// What to record and for how long.
 pub struct RecordRequest<'a> {
-    /// The MCAP file.
-    pub file: &'a Path,
+    /// The MCAP file, or the directory of a rotating recording.
+    pub target: &'a Target,
     /// Short topic names; empty: every topic.
     pub topics: &'a [String],
     /// Stop after this many seconds; none: until SIGINT/SIGTERM.
     pub duration_s: Option<f64>,
-    /// Replace an existing file.
+    /// Replace an existing file (one file only: a rotating recording never replaces one).
     pub overwrite: bool,
     /// Print a progress line to stderr each second.
     pub progress: bool,
@@ -263,11 +359,21 @@ pub fn record(req: &RecordRequest<'_>, shutdown: &Shutdown) -> Result<RecordRepo
         }
     }
     let tool = ToolNode::join("record")?;
-    let options = RecordOptions {
-        overwrite: req.overwrite,
-        ..RecordOptions::default()
+    let (recorder, rotation) = match req.target {
+        Target::File(file) => {
+            let options = RecordOptions {
+                overwrite: req.overwrite,
+                ..RecordOptions::default()
+            };
+            (Recorder::create(file, &options)?, None)
+        }
+        Target::Dir(limits) => {
+            record_dir::prepare(&limits.dir, "--dir")?;
+            let mut rotation = Rotation::new(limits.clone())?;
+            (rotation.create_next(&[])?, Some(rotation))
+        }
     };
-    let mut recorder = Recorder::create(req.file, &options)?;
+    let mut recorder = recorder;
     let mut taps = Vec::new();
     let mut imu_index = None;
     for c in &choices {
@@ -283,7 +389,7 @@ pub fn record(req: &RecordRequest<'_>, shutdown: &Shutdown) -> Result<RecordRepo
         Some(_) => Some(TopicSubscriber::<RawImu>::new(tool.node(), names::RAW_IMU)?),
         None => None,
     };
-    let (sender, writer) = spawn_writer(recorder, QUEUE).context("cannot start the writer")?;
+    let mut sink = RecordSink::start(recorder, rotation, QUEUE)?;
     if let Some(ready) = req.ready_file {
         std::fs::write(ready, b"").with_context(|| format!("cannot create {}", ready.display()))?;
     }
@@ -291,26 +397,15 @@ pub fn record(req: &RecordRequest<'_>, shutdown: &Shutdown) -> Result<RecordRepo
     let end = req.duration_s.map(|d| started + Duration::from_secs_f64(d));
     let mut received = 0u64;
     let mut next_progress = started + Duration::from_secs(1);
-    let mut writer = Some(writer);
-    // Why the writer stopped, once it did: said at once, and the samples that arrive afterwards
-    // are still taken off the topics and counted as not recorded until the run ends.
-    let mut failure: Option<RecordError> = None;
+    let mut next_size_check = started + SIZE_CHECK;
     while !shutdown.requested() && end.is_none_or(|e| Instant::now() < e) {
-        if failure.is_none()
-            && sender.writer_failed()
-            && let Some(handle) = writer.take()
-        {
-            let e = match join_writer(handle) {
-                Err(e) => e,
-                // Flagged, so it failed; a summary here would be a contradiction of the flag.
-                Ok(_) => RecordError::WriterPanicked,
-            };
+        // Once the writer failed, the samples that arrive are still taken off the topics and
+        // counted as not recorded until the run ends.
+        if let Some(why) = sink.newly_failed() {
             eprintln!(
-                "recording {} failed, nothing more is recorded: {}",
-                req.file.display(),
-                error_text(&e)
+                "recording {} failed, nothing more is recorded: {why}",
+                sink.path().display()
             );
-            failure = Some(e);
         }
         match &wake {
             Some(w) => {
@@ -321,62 +416,67 @@ pub fn record(req: &RecordRequest<'_>, shutdown: &Shutdown) -> Result<RecordRepo
         }
         let now = monotonic_ns();
         for (_, tap) in &mut taps {
-            received += tap.drain(&sender, now)?;
+            received += tap.drain(sink.sender(), now)?;
+        }
+        if Instant::now() >= next_size_check {
+            next_size_check += SIZE_CHECK;
+            // Between two drains: every sample taken off the topics goes to one file or the next.
+            if let Some(next) = sink.rotate_if_full()
+                && req.progress
+            {
+                eprintln!("recording on in {}", next.display());
+            }
+            sink.collect_closed();
         }
         if req.progress && Instant::now() >= next_progress {
             next_progress += Duration::from_secs(1);
             eprintln!(
                 "recording {}: {:.0} s, {received} samples, {} dropped",
-                req.file.display(),
+                sink.path().display(),
                 started.elapsed().as_secs_f64(),
-                sender.dropped_total()
+                sink.dropped_total()
             );
         }
     }
     // What arrived while stopping is written too.
     let now = monotonic_ns();
     for (_, tap) in &mut taps {
-        received += tap.drain(&sender, now)?;
+        received += tap.drain(sink.sender(), now)?;
     }
     let seconds = started.elapsed().as_secs_f64();
-    // Read before the writer is joined: after a failure, the counts are only known here.
-    let counts = (sender.written_total(), sender.dropped_total(), received);
-    drop(sender);
-    let joined = match (writer, failure) {
-        (_, Some(e)) => Err(e),
-        (Some(handle), None) => join_writer(handle),
-        // Taken only when a failure was recorded.
-        (None, None) => Err(RecordError::WriterPanicked),
-    };
+    let outcome = sink.finish();
     drop(taps);
     drop(wake);
     drop(tool);
-    Ok(match joined {
-        Ok(summary) => RecordReport::new(&summary, received, seconds),
-        Err(e) => RecordReport::failed(req.file, &e, counts, seconds),
-    })
-}
-
-/// `e` and the causes under it, each once: the MCAP writer's message repeats its source's.
-fn error_text(e: &(dyn std::error::Error + 'static)) -> String {
-    let mut text = e.to_string();
-    let mut cause = e.source();
-    while let Some(c) = cause {
-        let more = c.to_string();
-        if !text.contains(&more) {
-            text = format!("{text}: {more}");
-        }
-        cause = c.source();
-    }
-    text
+    Ok(RecordReport::new(req.target, outcome, received, seconds))
 }
 
 /// `rins record`: records until Ctrl-C or `--duration`, then prints what was written.
 pub fn run(args: &crate::cli::RecordArgs) -> Result<()> {
     let shutdown = Shutdown::install()?;
+    let target = match (&args.file, &args.dir) {
+        (Some(file), _) if args.max_file_mb.is_some() || args.max_total_mb.is_some() => bail!(
+            "--max-file-mb and --max-total-mb apply to --dir: {} is one file",
+            file.display()
+        ),
+        (Some(file), _) => Target::File(file.clone()),
+        (None, Some(dir)) => {
+            let defaults = rins::record::config::RecordConfig::default();
+            let max_file_mb = args.max_file_mb.unwrap_or(defaults.max_file_mb);
+            let max_total_mb = args.max_total_mb.unwrap_or(defaults.max_total_mb);
+            rins::record::config::check_limits(max_file_mb, max_total_mb, "--")
+                .map_err(anyhow::Error::msg)?;
+            Target::Dir(Limits {
+                dir: dir.clone(),
+                max_file_bytes: max_file_mb * MB,
+                max_total_bytes: max_total_mb * MB,
+            })
+        }
+        (None, None) => bail!("name the FILE to record into, or --dir"),
+    };
     let report = record(
         &RecordRequest {
-            file: &args.file,
+            target: &target,
             topics: &args.topics,
             duration_s: args.duration,
             overwrite: args.overwrite,
@@ -418,10 +518,16 @@ pub struct RecordingOutcome {
     pub samples_dropped: u64,
     /// Samples received that are not in the file.
     pub samples_not_recorded: u64,
-    /// Size of the file, bytes.
+    /// Size of the file, bytes (of every file, in a directory).
     pub file_bytes: u64,
     /// Why the recording failed (a write error, the recorder stopping); `null` when it did not.
     pub error: Option<String>,
+    /// In a directory (`[record]`): each file written, in order.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub files: Vec<FileCount>,
+    /// In a directory: the older recordings deleted to keep the total.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub files_deleted: Vec<String>,
 }
 
 impl RecordingOutcome {
@@ -444,6 +550,8 @@ impl RecordingOutcome {
                 samples_dropped: r.samples_dropped,
                 samples_not_recorded: r.samples_not_recorded,
                 file_bytes: r.file_bytes,
+                files: r.files,
+                files_deleted: r.files_deleted,
             },
             None => Self::lost(
                 file,
@@ -461,6 +569,8 @@ impl RecordingOutcome {
             samples_not_recorded: 0,
             file_bytes: std::fs::metadata(file).map_or(0, |m| m.len()),
             error: Some(error),
+            files: Vec::new(),
+            files_deleted: Vec::new(),
         }
     }
 
@@ -482,10 +592,17 @@ impl RecordingOutcome {
 
     /// One line of the text summary.
     pub fn text(&self) -> String {
-        let head = format!(
+        let mut head = format!(
             "  recording {}: {} samples written, {} dropped, {} bytes",
             self.file, self.samples_written, self.samples_dropped, self.file_bytes
         );
+        if !self.files.is_empty() {
+            head.push_str(&format!(
+                " in {} files, {} older deleted",
+                self.files.len(),
+                self.files_deleted.len()
+            ));
+        }
         match self.failure() {
             Some(why) => format!("{head}\n  FAILED: {why}\n"),
             None => format!("{head}\n"),
@@ -615,6 +732,8 @@ mod tests {
             seconds: 3.0,
             file_bytes: 262_144,
             topics: Vec::new(),
+            files: Vec::new(),
+            files_deleted: Vec::new(),
         };
         let stdout = format!("{}\n", serde_json::to_string(&report).unwrap());
         let r =
@@ -650,6 +769,8 @@ mod tests {
             seconds: 1.0,
             file_bytes: 100,
             topics: Vec::new(),
+            files: Vec::new(),
+            files_deleted: Vec::new(),
         };
         let stdout = serde_json::to_string(&report).unwrap();
         let r =
@@ -666,6 +787,51 @@ mod tests {
         assert_eq!(r.failure(), None);
         let json = summary_json(&rins_watchdog::summary::Summary::default(), None).unwrap();
         assert!(!json.contains("recording"), "{json}");
+    }
+
+    #[test]
+    fn up_records_its_file_else_the_configured_directory_but_not_a_replay() {
+        let mut cfg = rins::record::config::RecordConfig::default();
+        let file = Path::new("/tmp/f.mcap");
+        assert_eq!(
+            Target::for_up(None, &cfg, Some("/var/lib/rins"), false),
+            None
+        );
+        cfg.on_start = true;
+        assert_eq!(
+            Target::for_up(Some(file), &cfg, Some("/var/lib/rins"), false),
+            Some(Target::File(file.into()))
+        );
+        let dir = Target::for_up(None, &cfg, Some("/var/lib/rins"), false).expect("a target");
+        assert_eq!(
+            dir,
+            Target::Dir(Limits {
+                dir: "/var/lib/rins".into(),
+                max_file_bytes: 256_000_000,
+                max_total_bytes: 2_048_000_000,
+            })
+        );
+        let args: Vec<String> = dir
+            .record_args()
+            .iter()
+            .map(|a| a.to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(
+            args,
+            [
+                "--dir",
+                "/var/lib/rins",
+                "--max-file-mb",
+                "256",
+                "--max-total-mb",
+                "2048"
+            ]
+        );
+        // A replay's deployment feeds recorded samples: no flight to record.
+        assert_eq!(
+            Target::for_up(None, &cfg, Some("/var/lib/rins"), true),
+            None
+        );
     }
 
     #[test]

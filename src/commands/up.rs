@@ -93,8 +93,16 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     let mut cfg = config::load(args.config.as_deref())?;
     apply_overrides(&mut cfg, args)?;
     // A recording that cannot be made is refused before anything starts, naming the path.
-    if let Some(file) = &args.record {
-        record::check_target(file)?;
+    // `[record]` records into systemd's state directory when the unit gives one.
+    let state_directory = std::env::var("STATE_DIRECTORY").ok();
+    let record_target = record::Target::for_up(
+        args.record.as_deref(),
+        &cfg.record,
+        state_directory.as_deref(),
+        args.external_source,
+    );
+    if let Some(target) = &record_target {
+        target.check()?;
     }
     // Refused here, before any child runs, rather than by a child in a restart loop.
     cfg.build_services()?;
@@ -203,8 +211,8 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
                 stops_last: !matches!(kind, ServiceKind::Acquisition | ServiceKind::Gnss),
             })?;
         }
-        if let Some(file) = &args.record {
-            recorder = Some(start_recorder(&exe, file, &run_dir, &shutdown)?);
+        if let Some(target) = &record_target {
+            recorder = Some(start_recorder(&exe, target, &run_dir, &shutdown)?);
         }
         if simulate {
             supervisor.start(ChildSpec {
@@ -240,8 +248,8 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     supervisor.stop_all(Duration::from_millis(cfg.watchdog.stop_grace_ms));
     // The recorder last: it writes what the services published while stopping.
     let recording = recorder
-        .zip(args.record.as_deref())
-        .map(|(child, file)| stop_recorder(child, file));
+        .zip(record_target.as_ref())
+        .map(|(child, target)| stop_recorder(child, target.path()));
     settings.remove_iceoryx_config_file();
     // Drain what the children published while stopping, then release our own ports.
     let _ = monitor.drain();
@@ -297,20 +305,22 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
 /// a process).
 const RECORDER_START: Duration = Duration::from_secs(10);
 
-/// Starts `rins record FILE` on this deployment and waits until it has subscribed to every topic,
-/// so that the recording starts with the first sample; fails as soon as the recorder exits.
+/// Starts `rins record` (one file, or a directory's rotating files) on this deployment and waits
+/// until it has subscribed to every topic, so that the recording starts with the first sample;
+/// fails as soon as the recorder exits.
 fn start_recorder(
     exe: &Path,
-    file: &Path,
+    target: &record::Target,
     run_dir: &Path,
     shutdown: &Shutdown,
 ) -> Result<std::process::Child> {
+    let file = target.path();
     let ready = run_dir.join("recorder-ready");
     let _ = std::fs::remove_file(&ready);
     let mut child = std::process::Command::new(exe)
         .arg("record")
-        .arg(file)
-        .args(["--overwrite", "--json", "--ready-file"])
+        .args(target.record_args())
+        .args(["--json", "--ready-file"])
         .arg(&ready)
         .stdout(std::process::Stdio::piped())
         .spawn()

@@ -8,15 +8,21 @@
 //!
 //! Switching rule, built against the known failure modes of lane switching:
 //! - **Dead lane** (liveness): the selected lane has delivered nothing beyond the output while the
-//!   other lane is [`SelectorConfig::switch_lag`] samples ahead *and* has published for
-//!   [`SelectorConfig::dead_after_ns`] since the selected lane's last sample (navigator publish
-//!   times). One late sample is not a failure (no switch on a glitch): the lag has to build up
-//!   first, which bounds the output gap to `switch_lag` sample periods. Nor is a burst: when a
-//!   restarted fusion replays its history, or the serial line delivers what waited in it, both
-//!   lanes work through hundreds of samples within a millisecond and one is briefly ahead; the
-//!   selected lane is only dead when it has been silent for the time, not merely behind in count.
-//!   A lane so far ahead that its pending samples would overflow ([`FORCE_SWITCH_PENDING`]) is
-//!   taken regardless, since losing samples is worse than a switch.
+//!   other lane is [`SelectorConfig::switch_lag`] samples ahead *and* the selected lane has been
+//!   silent for [`SelectorConfig::dead_after_ns`]. Silence is measured on the navigators' publish
+//!   times, from the later of the selected lane's last sample and the other lane's first sample
+//!   the selected lane still owes: a lane is late only once there was work for it to do. So one
+//!   late sample is not a failure (no switch on a glitch), nor is a burst: when the input resumes
+//!   after a gap (a starved acquisition, a restarted fusion replaying its history, the serial
+//!   line delivering what waited in it), both lanes work through hundreds of samples within a
+//!   few milliseconds and one is briefly ahead; the time since the selected lane's last sample
+//!   then includes the gap, in which no lane had anything to do, and must not count.
+//!   Samples without publish times are judged by the count alone.
+//! - **Full ring**: the other lane's pending samples fill the ring. The consumer then stops
+//!   taking that lane's samples ([`LaneSelector::has_room`]; they wait in its queue) and the
+//!   selected lane is still only left once it has been silent for the dead time, on the
+//!   consumer's clock (the other lane's newest publish time no longer moves while nothing is
+//!   taken). A selected lane merely late by less than the dead time is never left.
 //! - **Untrusted lane** (quality): the selected lane is aligning, its solution invalid, or younger than
 //!   [`SelectorConfig::settle`] samples (it just reset or took over), while the other lane is trusted
 //!   and has the next sample. A lane that just reset is never chosen for quality: only a dead
@@ -27,9 +33,11 @@
 //!   other lane does (there is no preferred lane to return to), and a quality switch needs
 //!   [`SelectorConfig::min_dwell`] samples since the last switch.
 //!
+//! Every switch says why ([`SwitchReason`]) and is counted by cause ([`SwitchCounts`]).
 //! Allocation-free after construction: each lane's pending samples sit in a fixed ring.
 
 use std::collections::VecDeque;
+use std::fmt;
 
 use ipc_types::{NavMode, NavState, Stage};
 
@@ -38,17 +46,14 @@ pub const LANES: usize = 2;
 
 /// Pending samples kept per lane; more than any switch lag and than a burst that builds up while
 /// the selected lane is silent for less than the dead time, so a switch always finds the next one.
-const PENDING: usize = 512;
-
-/// Pending samples of the other lane at which a silent selected lane is left at once.
-pub const FORCE_SWITCH_PENDING: usize = PENDING / 2;
+pub const PENDING: usize = 512;
 
 /// When the selector leaves a lane for the other.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SelectorConfig {
     /// Samples the other lane must be ahead of the output before the selected lane counts as dead.
     pub switch_lag: u64,
-    /// And how long the other lane must have published since the selected lane's last sample, ns
+    /// And how long the selected lane must have been silent while the other lane published, ns
     /// (samples without publish times are judged by the count alone).
     pub dead_after_ns: u64,
     /// The same when the other lane is not trusted (aligning, invalid, or younger than `settle`).
@@ -73,13 +78,73 @@ impl Default for SelectorConfig {
     }
 }
 
-/// Why the selector changed lanes.
+/// Why a solution is not trusted ([`distrust`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Distrust {
+    /// Still aligning.
+    Aligning,
+    /// Its mode is invalid (or a mode this build cannot read).
+    Invalid,
+    /// Its solution has run only this many samples (since alignment or takeover).
+    Young {
+        /// Samples since the solution started (0: no start recorded).
+        run: u64,
+    },
+    /// Its attitude is not finite.
+    NonFinite,
+}
+
+impl Distrust {
+    /// One word or two, for logs and one-line messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Aligning => "aligning",
+            Self::Invalid => "invalid",
+            Self::Young { .. } => "too young",
+            Self::NonFinite => "non-finite",
+        }
+    }
+}
+
+/// Why the selector changed lanes: what it saw when it did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SwitchReason {
-    /// The selected lane stopped delivering.
-    Dead,
-    /// The selected lane was aligning, invalid or too young, the other one trusted.
-    Untrusted,
+    /// The selected lane delivered nothing for `silent_ns` (navigator publish times) while the
+    /// other lane was `ahead` samples ahead of the output.
+    Silent {
+        /// How long the selected lane had been silent, ns.
+        silent_ns: u64,
+        /// Samples of the other lane pending ahead of the output.
+        ahead: u32,
+    },
+    /// The selected lane delivered nothing while the other lane, whose samples carry no publish
+    /// times, was `ahead` samples ahead: judged by the count alone.
+    Behind {
+        /// Samples of the other lane pending ahead of the output.
+        ahead: u32,
+    },
+    /// The other lane's pending samples filled the ring (`ahead` of them) and the selected lane
+    /// had been silent for `silent_ns` on the consumer's clock.
+    RingFull {
+        /// How long the selected lane had been silent, ns.
+        silent_ns: u64,
+        /// Samples of the other lane pending ahead of the output.
+        ahead: u32,
+    },
+    /// The selected lane's next sample was not trusted and the other lane's was.
+    Untrusted(Distrust),
+}
+
+impl SwitchReason {
+    /// A name for the cause alone, for counts and structured logs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Silent { .. } => "silent",
+            Self::Behind { .. } => "behind",
+            Self::RingFull { .. } => "ring-full",
+            Self::Untrusted(_) => "untrusted",
+        }
+    }
 }
 
 /// A change of the lane delivering, and why.
@@ -95,6 +160,67 @@ pub struct Switch {
     pub at_seq: u64,
 }
 
+impl fmt::Display for Switch {
+    /// `lane 0 → 1 at seq 1234: lane 0 silent 12.3 ms while lane 1 was 15 samples ahead`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (from, to) = (self.from, self.to);
+        write!(f, "lane {from} → {to} at seq {}: ", self.at_seq)?;
+        match self.reason {
+            SwitchReason::Silent { silent_ns, ahead } => write!(
+                f,
+                "lane {from} silent {:.1} ms while lane {to} was {ahead} samples ahead",
+                silent_ns as f64 * 1e-6
+            ),
+            SwitchReason::Behind { ahead } => write!(
+                f,
+                "lane {from} silent while lane {to} was {ahead} samples ahead (no publish times)"
+            ),
+            SwitchReason::RingFull { silent_ns, ahead } => write!(
+                f,
+                "lane {to}'s {ahead} pending samples filled the ring, lane {from} silent {:.1} ms",
+                silent_ns as f64 * 1e-6
+            ),
+            SwitchReason::Untrusted(Distrust::Young { run }) => write!(
+                f,
+                "lane {from}'s solution too young ({run} samples), lane {to} trusted"
+            ),
+            SwitchReason::Untrusted(d) => {
+                write!(f, "lane {from} {}, lane {to} trusted", d.name())
+            }
+        }
+    }
+}
+
+/// Lane changes since start, by cause.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SwitchCounts {
+    /// [`SwitchReason::Silent`].
+    pub silent: u64,
+    /// [`SwitchReason::Behind`].
+    pub behind: u64,
+    /// [`SwitchReason::RingFull`].
+    pub ring_full: u64,
+    /// [`SwitchReason::Untrusted`].
+    pub untrusted: u64,
+}
+
+impl SwitchCounts {
+    /// All of them.
+    pub fn total(&self) -> u64 {
+        self.silent + self.behind + self.ring_full + self.untrusted
+    }
+
+    fn count(&mut self, reason: SwitchReason) {
+        let slot = match reason {
+            SwitchReason::Silent { .. } => &mut self.silent,
+            SwitchReason::Behind { .. } => &mut self.behind,
+            SwitchReason::RingFull { .. } => &mut self.ring_full,
+            SwitchReason::Untrusted(_) => &mut self.untrusted,
+        };
+        *slot += 1;
+    }
+}
+
 /// See the module documentation.
 #[derive(Debug, Clone)]
 pub struct LaneSelector {
@@ -106,17 +232,34 @@ pub struct LaneSelector {
     /// or unstamped).
     selected_published_ns: u64,
     last_switch_seq: Option<u64>,
-    switches: u64,
+    counts: SwitchCounts,
     last_switch: Option<Switch>,
     filled: u64,
+    overwritten: u64,
+}
+
+/// Why `s` is not a solution the selector may choose for quality; `None` when it is.
+pub fn distrust(s: &NavState, settle: u64) -> Option<Distrust> {
+    let run = s.header.origin_seq.saturating_sub(s.solution_start_seq);
+    match NavMode::from_u8(s.mode) {
+        Some(NavMode::Aligning) => Some(Distrust::Aligning),
+        Some(m) if !m.is_usable() => Some(Distrust::Invalid),
+        None => Some(Distrust::Invalid),
+        Some(_) if s.solution_start_seq == 0 => Some(Distrust::Young { run: 0 }),
+        Some(_) if run < settle => Some(Distrust::Young { run }),
+        Some(_) if !s.quaternion.iter().all(|q| q.is_finite()) => Some(Distrust::NonFinite),
+        Some(_) => None,
+    }
 }
 
 /// A solution the selector may choose for quality.
 pub fn trusted(s: &NavState, settle: u64) -> bool {
-    NavMode::from_u8(s.mode).is_some_and(NavMode::is_usable)
-        && s.solution_start_seq != 0
-        && s.header.origin_seq.saturating_sub(s.solution_start_seq) >= settle
-        && s.quaternion.iter().all(|q| q.is_finite())
+    distrust(s, settle).is_none()
+}
+
+/// A navigator's publish time of `s`, `None` for a sample without one.
+fn published_ns(s: &NavState) -> Option<u64> {
+    Some(s.header.stage_ns(Stage::Navigator)).filter(|&ns| ns != 0)
 }
 
 impl LaneSelector {
@@ -129,9 +272,10 @@ impl LaneSelector {
             last_delivered: None,
             selected_published_ns: 0,
             last_switch_seq: None,
-            switches: 0,
+            counts: SwitchCounts::default(),
             last_switch: None,
             filled: 0,
+            overwritten: 0,
         }
     }
 
@@ -142,12 +286,29 @@ impl LaneSelector {
 
     /// Lane changes since start.
     pub fn switches(&self) -> u64 {
-        self.switches
+        self.counts.total()
+    }
+
+    /// Lane changes since start, by cause.
+    pub fn switch_counts(&self) -> SwitchCounts {
+        self.counts
     }
 
     /// The most recent lane change.
     pub fn last_switch(&self) -> Option<Switch> {
         self.last_switch
+    }
+
+    /// Whether `lane`'s ring takes another sample without overwriting its oldest pending one. A
+    /// consumer leaves a lane's samples in its queue while not.
+    pub fn has_room(&self, lane: usize) -> bool {
+        self.pending.get(lane).is_some_and(|q| q.len() < PENDING)
+    }
+
+    /// Pending samples overwritten because a lane's ring was full (a consumer that pushes without
+    /// asking [`LaneSelector::has_room`]).
+    pub fn overwritten(&self) -> u64 {
+        self.overwritten
     }
 
     /// Takes one sample of `lane` (samples of a lane arrive in sequence order). Samples at or before
@@ -171,16 +332,24 @@ impl LaneSelector {
         }
         if queue.len() == PENDING {
             queue.pop_front();
+            self.overwritten += 1;
         }
         queue.push_back(sample);
     }
 
-    /// The next sample of the output stream, or `None` until one is due.
+    /// The next sample of the output stream, or `None` until one is due; time is read from the
+    /// navigators' publish times alone.
     pub fn pop(&mut self) -> Option<NavState> {
+        self.pop_at(0)
+    }
+
+    /// [`LaneSelector::pop`] for a consumer whose clock (CLOCK_MONOTONIC, ns, as the navigators
+    /// stamp) reads `now_ns`: a full ring of the other lane is timed on it.
+    pub fn pop_at(&mut self, now_ns: u64) -> Option<NavState> {
         self.discard_delivered();
         let other = 1 - self.selected;
-        if self.should_switch(other) {
-            self.switch_to(other);
+        if let Some(reason) = self.switch_reason(other, now_ns) {
+            self.switch_to(other, reason);
         }
         let next = self.pending[self.selected].front()?.header.origin_seq;
         // A sample the selected lane skipped but the other lane has fills the hole; the selection
@@ -218,57 +387,78 @@ impl LaneSelector {
         }
     }
 
-    fn should_switch(&self, other: usize) -> bool {
-        let Some(candidate) = self.pending[other].front() else {
-            return false;
-        };
+    /// Why the selector should leave the selected lane for `other` now, if it should.
+    fn switch_reason(&self, other: usize, now_ns: u64) -> Option<SwitchReason> {
+        let candidate = self.pending[other].front()?;
+        let candidate_distrust = distrust(candidate, self.config.settle);
         let selected = &self.pending[self.selected];
         let Some(next) = selected.front() else {
-            // Dead: nothing from the selected lane while the other has delivered `switch_lag`
-            // samples ahead of the output. Counted in samples, not in sequence numbers, so that a
-            // hole in the input (both lanes skip the same numbers) is no reason to switch.
-            // Towards a lane that just reset, only after a longer silence: a selected lane that
-            // is merely starved of CPU for a few milliseconds must not hand the output to it.
-            let dead_after = if trusted(candidate, self.config.settle) {
-                self.config.dead_after_ns
-            } else {
-                self.config.dead_after_untrusted_ns
-            };
-            let ahead = self.pending[other].len();
-            return ahead >= FORCE_SWITCH_PENDING
-                || (ahead as u64 >= self.config.switch_lag && self.silent_for(other, dead_after));
+            return self.dead_reason(other, candidate_distrust.is_none(), now_ns);
         };
         // Untrusted: only towards a trusted lane that has the next sample (not behind the
         // selected one), and not within the dwell time of the last switch.
         let dwelt = self
             .last_switch_seq
             .is_none_or(|at| next.header.origin_seq.saturating_sub(at) >= self.config.min_dwell);
-        dwelt
-            && !trusted(next, self.config.settle)
-            && trusted(candidate, self.config.settle)
-            && candidate.header.origin_seq <= next.header.origin_seq
-    }
-
-    /// The other lane has published for `dead_after` ns since the selected lane's last sample.
-    fn silent_for(&self, other: usize, dead_after: u64) -> bool {
-        let newest = self.pending[other]
-            .back()
-            .map_or(0, |s| s.header.stage_ns(Stage::Navigator));
-        if self.selected_published_ns == 0 || newest == 0 {
-            return true;
+        if !dwelt
+            || candidate_distrust.is_some()
+            || candidate.header.origin_seq > next.header.origin_seq
+        {
+            return None;
         }
-        newest.saturating_sub(self.selected_published_ns) >= dead_after
+        distrust(next, self.config.settle).map(SwitchReason::Untrusted)
     }
 
-    fn switch_to(&mut self, lane: usize) {
+    /// Nothing from the selected lane while the other has samples ahead of the output: dead once
+    /// the other lane is `switch_lag` samples ahead and the selected one silent for the dead time.
+    /// Counted in samples, not in sequence numbers, so that a hole in the input (both lanes skip
+    /// the same numbers) is no reason to switch. Towards a lane that just reset, only after a
+    /// longer silence: a selected lane that is merely starved of CPU for a few milliseconds must
+    /// not hand the output to it.
+    fn dead_reason(
+        &self,
+        other: usize,
+        candidate_trusted: bool,
+        now_ns: u64,
+    ) -> Option<SwitchReason> {
+        let pending = &self.pending[other];
+        let ahead = u32::try_from(pending.len()).unwrap_or(u32::MAX);
+        if u64::from(ahead) < self.config.switch_lag {
+            return None;
+        }
+        let dead_after = if candidate_trusted {
+            self.config.dead_after_ns
+        } else {
+            self.config.dead_after_untrusted_ns
+        };
+        let full = pending.len() >= PENDING;
+        let (Some(first_owed), Some(newest)) = (
+            pending.front().and_then(published_ns),
+            pending.back().and_then(published_ns),
+        ) else {
+            return Some(SwitchReason::Behind { ahead });
+        };
+        // Silent since its last sample, or since the other lane published the first sample the
+        // selected lane still owes, whichever is later: before that it had nothing to do.
+        let since = self.selected_published_ns.max(first_owed);
+        // With a full ring nothing newer is taken from the other lane: the consumer's clock tells
+        // how the silence goes on.
+        let clock = if full { newest.max(now_ns) } else { newest };
+        let silent_ns = clock.saturating_sub(since);
+        if silent_ns < dead_after {
+            return None;
+        }
+        Some(if full {
+            SwitchReason::RingFull { silent_ns, ahead }
+        } else {
+            SwitchReason::Silent { silent_ns, ahead }
+        })
+    }
+
+    fn switch_to(&mut self, lane: usize, reason: SwitchReason) {
         let at_seq = self.pending[lane]
             .front()
             .map_or(0, |s| s.header.origin_seq);
-        let reason = if self.pending[self.selected].is_empty() {
-            SwitchReason::Dead
-        } else {
-            SwitchReason::Untrusted
-        };
         self.last_switch = Some(Switch {
             from: self.selected,
             to: lane,
@@ -279,7 +469,7 @@ impl LaneSelector {
         // The new lane's clock starts with its first delivery.
         self.selected_published_ns = 0;
         self.last_switch_seq = Some(at_seq);
-        self.switches += 1;
+        self.counts.count(reason);
     }
 }
 
@@ -387,7 +577,7 @@ mod tests {
             Some(Switch {
                 from: 0,
                 to: 1,
-                reason: SwitchReason::Dead,
+                reason: SwitchReason::Behind { ahead: 8 },
                 at_seq: 201
             })
         );
@@ -470,9 +660,20 @@ mod tests {
             drain(&mut sel, &mut out);
             stall += u32::from(out.len() == before);
         }
-        // Lane 1 publishes 208 at 208 ms, 8 ms after lane 0's last sample: the switch.
-        assert_eq!(stall, 7);
-        assert_eq!(sel.last_switch().map(|s| (s.to, s.at_seq)), Some((1, 201)));
+        // Lane 1 publishes 209 at 209 ms, 8 ms after its 201, the first sample lane 0 owed: the
+        // switch.
+        assert_eq!(stall, 8);
+        assert_eq!(
+            sel.last_switch().map(|s| (s.to, s.at_seq, s.reason)),
+            Some((
+                1,
+                201,
+                SwitchReason::Silent {
+                    silent_ns: 8 * MS,
+                    ahead: 9
+                }
+            ))
+        );
         assert_eq!(out.len(), 300);
     }
 
@@ -513,23 +714,195 @@ mod tests {
         assert_eq!(seqs, (1..=880).collect::<Vec<_>>());
     }
 
+    /// A consumer's pass: takes each lane's samples published by `now` while its ring has room,
+    /// then delivers what is due on its clock.
+    fn consume(
+        sel: &mut LaneSelector,
+        lanes: &mut [std::collections::VecDeque<NavState>; 2],
+        now: u64,
+        out: &mut Vec<(u64, u8)>,
+    ) {
+        loop {
+            let mut pulled = false;
+            for (lane, queue) in lanes.iter_mut().enumerate() {
+                if sel.has_room(lane)
+                    && queue
+                        .front()
+                        .is_some_and(|s| s.header.stage_ns(Stage::Navigator) <= now)
+                    && let Some(s) = queue.pop_front()
+                {
+                    sel.push(lane, s);
+                    pulled = true;
+                }
+            }
+            while let Some(s) = sel.pop_at(now) {
+                out.push((s.header.origin_seq, s.lane));
+            }
+            if !pulled {
+                return;
+            }
+        }
+    }
+
     #[test]
-    fn a_burst_that_would_overflow_the_pending_samples_switches_at_once() {
+    fn a_burst_that_fills_the_ring_waits_for_the_dead_time_and_loses_nothing() {
         let mut sel = LaneSelector::new(cfg());
         let mut out = Vec::new();
-        for seq in 1..=200 {
-            sel.push(0, stamped(0, seq, seq * MS));
-            sel.push(1, stamped(1, seq, seq * MS));
-            drain(&mut sel, &mut out);
+        let mut lanes: [std::collections::VecDeque<NavState>; 2] = Default::default();
+        for seq in 1..=100 {
+            for (lane, queue) in lanes.iter_mut().enumerate() {
+                queue.push_back(stamped(lane as u8, seq, seq * MS));
+            }
         }
-        // Lane 0 is gone; lane 1 replays 2 × PENDING samples within a millisecond.
-        for seq in 201..=200 + 2 * PENDING as u64 {
-            sel.push(1, stamped(1, seq, 200 * MS + seq));
-            drain(&mut sel, &mut out);
+        // The input stops for 300 ms, then 1000 samples arrive at once: lane 1 works through
+        // them within 1 ms at 400 ms, lane 0 (waiting for a CPU) 5 ms later.
+        let burst = 101..=1100u64;
+        for seq in burst.clone() {
+            lanes[1].push_back(stamped(1, seq, 400 * MS + seq * 1_000));
         }
-        assert_eq!(sel.last_switch().map(|s| (s.to, s.at_seq)), Some((1, 201)));
+        for seq in burst {
+            lanes[0].push_back(stamped(0, seq, 405 * MS + seq * 1_000));
+        }
+        for now in (1..=420).map(|ms| ms * MS) {
+            consume(&mut sel, &mut lanes, now, &mut out);
+        }
+        assert_eq!((sel.switches(), sel.overwritten()), (0, 0));
+        assert!(out.iter().all(|o| o.1 == 0));
+        // Lane 0 is gone; lane 1 delivers another burst of 1000 at 500 ms. Its ring fills within
+        // a millisecond and the rest waits in its queue: the switch comes when lane 0 has been
+        // silent for the dead time on the consumer's clock, from the first sample it owed.
+        for seq in 1101..=2100u64 {
+            lanes[1].push_back(stamped(1, seq, 500 * MS + (seq - 1100) * 500));
+        }
+        let mut switched_at = None;
+        for now in (421..=600).map(|ms| ms * MS) {
+            consume(&mut sel, &mut lanes, now, &mut out);
+            if switched_at.is_none() && sel.switches() == 1 {
+                switched_at = Some(now);
+            }
+        }
+        let first_owed = 500 * MS + 500;
+        assert_eq!(switched_at, Some(first_owed - 500 + 9 * MS));
+        let switch = sel.last_switch().expect("switched");
+        assert_eq!((switch.to, switch.at_seq), (1, 1101));
+        let SwitchReason::RingFull { silent_ns, ahead } = switch.reason else {
+            panic!("{switch:?}");
+        };
+        assert_eq!(ahead as usize, PENDING);
+        assert!((8 * MS..9 * MS).contains(&silent_ns), "{silent_ns}");
+        assert_eq!(sel.switch_counts().ring_full, 1);
         let seqs: Vec<u64> = out.iter().map(|o| o.0).collect();
-        assert_eq!(seqs, (1..=200 + 2 * PENDING as u64).collect::<Vec<_>>());
+        assert_eq!(seqs, (1..=2100).collect::<Vec<_>>());
+        assert_eq!(sel.overwritten(), 0);
+    }
+
+    #[test]
+    fn a_ring_overwritten_by_a_consumer_that_does_not_ask_is_counted() {
+        let mut sel = LaneSelector::new(cfg());
+        for seq in 1..=PENDING as u64 + 3 {
+            assert_eq!(sel.has_room(1), seq <= PENDING as u64);
+            sel.push(1, stamped(1, seq, MS + seq));
+        }
+        assert_eq!(sel.overwritten(), 3);
+        assert!(!sel.has_room(7));
+    }
+
+    #[test]
+    fn a_selected_lane_late_by_less_than_the_dead_time_is_kept() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        let mut lanes: [std::collections::VecDeque<NavState>; 2] = Default::default();
+        // Lane 1 publishes every millisecond. Lane 0 keeps pace but every 100 ms is descheduled
+        // and publishes the first sample it owes 7.9 ms late (just under the dead time), with the
+        // others it owes at once.
+        for seq in 1..=3000u64 {
+            lanes[1].push_back(stamped(1, seq, seq * MS));
+            let phase = seq % 100;
+            let ns = if (1..=9).contains(&phase) {
+                (seq - phase) * MS + 8_900_000 + phase
+            } else {
+                seq * MS + 100_000
+            };
+            lanes[0].push_back(stamped(0, seq, ns));
+        }
+        for now in (1..=31_000u64).map(|step| step * MS / 10) {
+            consume(&mut sel, &mut lanes, now, &mut out);
+        }
+        assert_eq!(sel.switches(), 0);
+        assert_eq!(out.len(), 3000);
+        assert!(out.iter().all(|o| o.1 == 0));
+    }
+
+    #[test]
+    fn a_selected_lane_late_by_more_than_the_dead_time_is_left_and_the_silence_reported() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        let mut lanes: [std::collections::VecDeque<NavState>; 2] = Default::default();
+        // As above, but lane 0's pause at 1000 ms lasts 12 ms.
+        for seq in 1..=1100u64 {
+            lanes[1].push_back(stamped(1, seq, seq * MS));
+            let ns = if (1001..=1012).contains(&seq) {
+                1012 * MS + 100_000 + seq
+            } else {
+                seq * MS + 100_000
+            };
+            lanes[0].push_back(stamped(0, seq, ns));
+        }
+        for now in (1..=11_100u64).map(|step| step * MS / 10) {
+            consume(&mut sel, &mut lanes, now, &mut out);
+        }
+        let switch = sel.last_switch().expect("switched");
+        // Lane 0's last sample came at 1000.1 ms, the first it owed (1001) at 1001 ms: silent
+        // from then; lane 1's 1009 at 1009 ms makes 8 ms and 9 samples ahead.
+        assert_eq!(
+            switch,
+            Switch {
+                from: 0,
+                to: 1,
+                reason: SwitchReason::Silent {
+                    silent_ns: 8 * MS,
+                    ahead: 9
+                },
+                at_seq: 1001
+            }
+        );
+        assert_eq!(
+            switch.to_string(),
+            "lane 0 → 1 at seq 1001: lane 0 silent 8.0 ms while lane 1 was 9 samples ahead"
+        );
+        assert_eq!(sel.switch_counts().silent, 1);
+        let seqs: Vec<u64> = out.iter().map(|o| o.0).collect();
+        assert_eq!(seqs, (1..=1100).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn a_burst_after_a_gap_in_the_input_is_not_a_dead_lane() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        let mut lanes: [std::collections::VecDeque<NavState>; 2] = Default::default();
+        for seq in 1..=100 {
+            for (lane, queue) in lanes.iter_mut().enumerate() {
+                queue.push_back(stamped(lane as u8, seq, seq * MS));
+            }
+        }
+        // The input stops for 300 ms (a starved acquisition) and 300 samples arrive at once at
+        // 400 ms: lane 1 takes them at 20 µs each, lane 0 gets a CPU 6 ms later; then both carry
+        // on in real time. Lane 0's last sample is 306 ms old when lane 1 is 100 ahead, but it was
+        // never more than 6 ms late with work to do.
+        for seq in 101..=400u64 {
+            lanes[1].push_back(stamped(1, seq, 400 * MS + (seq - 100) * 20_000));
+            lanes[0].push_back(stamped(0, seq, 406 * MS + (seq - 100) * 20_000));
+        }
+        for seq in 401..=600u64 {
+            lanes[1].push_back(stamped(1, seq, seq * 2 * MS));
+            lanes[0].push_back(stamped(0, seq, seq * 2 * MS + 300_000));
+        }
+        for now in (1..=12_100u64).map(|step| step * MS / 10) {
+            consume(&mut sel, &mut lanes, now, &mut out);
+        }
+        assert_eq!(sel.switches(), 0);
+        assert_eq!(out.len(), 600);
+        assert!(out.iter().all(|o| o.1 == 0));
     }
 
     #[test]
@@ -571,7 +944,7 @@ mod tests {
         }
         assert_eq!(
             sel.last_switch().map(|s| (s.to, s.reason, s.at_seq)),
-            Some((1, SwitchReason::Untrusted, 500))
+            Some((1, SwitchReason::Untrusted(Distrust::Aligning), 500))
         );
         let seqs: Vec<u64> = out.iter().map(|o| o.0).collect();
         assert_eq!(seqs, (1..=700).collect::<Vec<_>>());
@@ -653,8 +1026,176 @@ mod tests {
         assert_eq!(sel.switches(), 2);
         assert_eq!(
             sel.last_switch().map(|s| (s.to, s.reason, s.at_seq)),
-            Some((0, SwitchReason::Untrusted, 251))
+            Some((0, SwitchReason::Untrusted(Distrust::Aligning), 251))
         );
         assert_eq!(out.len(), 400);
+    }
+
+    #[test]
+    fn every_distrust_is_named_and_reported() {
+        let settled = nav(0, 1 + SETTLE, 1);
+        assert_eq!(distrust(&settled, SETTLE), None);
+        let cases = [
+            (aligning(0, 500), Distrust::Aligning),
+            (
+                NavState {
+                    mode: NavMode::Invalid as u8,
+                    ..settled
+                },
+                Distrust::Invalid,
+            ),
+            (NavState { mode: 4, ..settled }, Distrust::Invalid),
+            (nav(0, 130, 100), Distrust::Young { run: 30 }),
+            (nav(0, 130, 0), Distrust::Young { run: 0 }),
+            (
+                NavState {
+                    quaternion: [f64::NAN, 0.0, 0.0, 0.0],
+                    ..settled
+                },
+                Distrust::NonFinite,
+            ),
+        ];
+        for (s, want) in cases {
+            assert_eq!(distrust(&s, SETTLE), Some(want), "{s:?}");
+        }
+    }
+
+    /// Lane 0 delivers `bad` at `at` (and is settled otherwise); lane 1 is trusted throughout.
+    fn quality_switch(bad: impl Fn(u64) -> NavState, at: u64) -> Option<Switch> {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        for seq in 1..=at + 20 {
+            sel.push(0, if seq >= at { bad(seq) } else { nav(0, seq, 1) });
+            sel.push(1, nav(1, seq, 1));
+            drain(&mut sel, &mut out);
+        }
+        assert_eq!(out.len() as u64, at + 20);
+        sel.last_switch()
+    }
+
+    #[test]
+    fn a_quality_switch_says_what_was_wrong_with_the_selected_lane() {
+        let invalid = |seq| NavState {
+            mode: NavMode::Invalid as u8,
+            ..nav(0, seq, 1)
+        };
+        let switch = quality_switch(invalid, 300).expect("switched");
+        assert_eq!(switch.reason, SwitchReason::Untrusted(Distrust::Invalid));
+        assert_eq!(switch.at_seq, 300);
+        assert_eq!(
+            switch.to_string(),
+            "lane 0 → 1 at seq 300: lane 0 invalid, lane 1 trusted"
+        );
+        // A lane that reset its solution at 300 (a takeover) is too young from there on.
+        let switch = quality_switch(|seq| nav(0, seq, 300), 300).expect("switched");
+        assert_eq!(
+            switch.reason,
+            SwitchReason::Untrusted(Distrust::Young { run: 0 })
+        );
+        assert_eq!(
+            switch.to_string(),
+            "lane 0 → 1 at seq 300: lane 0's solution too young (0 samples), lane 1 trusted"
+        );
+        let non_finite = |seq| NavState {
+            quaternion: [f64::NAN; 4],
+            ..nav(0, seq, 1)
+        };
+        let switch = quality_switch(non_finite, 300).expect("switched");
+        assert_eq!(switch.reason, SwitchReason::Untrusted(Distrust::NonFinite));
+        let mut counts = SwitchCounts::default();
+        for r in [
+            switch.reason,
+            SwitchReason::Behind { ahead: 8 },
+            SwitchReason::Silent {
+                silent_ns: 1,
+                ahead: 8,
+            },
+        ] {
+            counts.count(r);
+        }
+        assert_eq!(
+            (
+                counts.untrusted,
+                counts.behind,
+                counts.silent,
+                counts.total()
+            ),
+            (1, 1, 1, 3)
+        );
+    }
+
+    #[test]
+    fn the_reasons_read_as_what_happened() {
+        let switch = |reason| Switch {
+            from: 1,
+            to: 0,
+            reason,
+            at_seq: 42,
+        };
+        assert_eq!(
+            switch(SwitchReason::Behind { ahead: 8 }).to_string(),
+            "lane 1 → 0 at seq 42: lane 1 silent while lane 0 was 8 samples ahead (no publish times)"
+        );
+        assert_eq!(
+            switch(SwitchReason::RingFull {
+                silent_ns: 8_250_000,
+                ahead: 512
+            })
+            .to_string(),
+            "lane 1 → 0 at seq 42: lane 0's 512 pending samples filled the ring, lane 1 silent 8.2 ms"
+        );
+        assert_eq!(
+            switch(SwitchReason::Untrusted(Distrust::Aligning)).to_string(),
+            "lane 1 → 0 at seq 42: lane 1 aligning, lane 0 trusted"
+        );
+        let names = [
+            SwitchReason::Silent {
+                silent_ns: 0,
+                ahead: 0,
+            },
+            SwitchReason::Behind { ahead: 0 },
+            SwitchReason::RingFull {
+                silent_ns: 0,
+                ahead: 0,
+            },
+            SwitchReason::Untrusted(Distrust::Invalid),
+        ]
+        .map(SwitchReason::name);
+        assert_eq!(names, ["silent", "behind", "ring-full", "untrusted"]);
+    }
+
+    #[test]
+    fn a_lane_just_switched_to_is_not_left_for_being_late_by_less_than_the_dead_time() {
+        let mut sel = LaneSelector::new(cfg());
+        let mut out = Vec::new();
+        let mut lanes: [std::collections::VecDeque<NavState>; 2] = Default::default();
+        // Lane 0 turns invalid at 300 for one sample: a quality switch to lane 1 at 300. Lane 1
+        // then pauses (301..=308 published together, 301 7.4 ms late) while lane 0 is punctual:
+        // lane 1 has delivered nothing yet since the switch and lane 0 is 8 samples ahead, but
+        // that is no reason to switch back.
+        for seq in 1..=600u64 {
+            let mut s0 = stamped(0, seq, seq * MS + 100_000);
+            if seq == 300 {
+                s0.mode = NavMode::Invalid as u8;
+            }
+            lanes[0].push_back(s0);
+            let ns1 = if (301..=308).contains(&seq) {
+                308 * MS + 500_000 + seq
+            } else {
+                seq * MS
+            };
+            lanes[1].push_back(stamped(1, seq, ns1));
+        }
+        for now in (1..=6_100u64).map(|step| step * MS / 10) {
+            consume(&mut sel, &mut lanes, now, &mut out);
+        }
+        assert_eq!(sel.switches(), 1);
+        assert_eq!(
+            sel.last_switch().map(|s| (s.to, s.at_seq, s.reason)),
+            Some((1, 300, SwitchReason::Untrusted(Distrust::Invalid)))
+        );
+        let seqs: Vec<u64> = out.iter().map(|o| o.0).collect();
+        assert_eq!(seqs, (1..=600).collect::<Vec<_>>());
+        assert!(out[299..].iter().all(|o| o.1 == 1));
     }
 }

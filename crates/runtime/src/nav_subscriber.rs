@@ -1,13 +1,14 @@
 //! The navigation stream as consumers see it: both navigator lanes read and merged by the
 //! [`LaneSelector`] into one contiguous sequence. With a single lane the standby topic stays
-//! silent and the stream is the primary's.
+//! silent and the stream is the primary's. Every lane switch is logged once, with its cause.
 
 use std::time::Duration;
 
 use ipc_types::{NavState, names};
 
+use crate::clock::monotonic_ns;
 use crate::ipc::{IpcError, IpcNode, SampleSource, TopicSubscriber, TopicWaitSet};
-use crate::lane_selector::{LANES, LaneSelector, SelectorConfig, Switch};
+use crate::lane_selector::{LANES, LaneSelector, SelectorConfig, Switch, SwitchCounts};
 
 /// Both navigator lanes' topics, merged into the stream consumers see.
 pub struct NavSubscriber {
@@ -17,6 +18,8 @@ pub struct NavSubscriber {
     selector: LaneSelector,
     lane_totals: [u64; LANES],
     lane_latest: [Option<NavState>; LANES],
+    /// Switches already logged.
+    logged_switches: u64,
 }
 
 impl NavSubscriber {
@@ -34,19 +37,27 @@ impl NavSubscriber {
             selector: LaneSelector::new(SelectorConfig::default()),
             lane_totals: [0; LANES],
             lane_latest: [None; LANES],
+            logged_switches: 0,
         })
     }
 
     /// Next sample of the merged stream, if one is due. Takes one sample of each lane at a time,
     /// so that a backlog (a consumer that slept) waits in the lanes' queues, which are deep, and
-    /// not in the selector's ring, which holds only what a switch needs.
+    /// not in the selector's ring, which holds only what a switch needs; a lane whose ring is full
+    /// is left in its queue until the selected lane delivers or is found dead.
     pub fn receive(&mut self) -> Result<Option<NavState>, IpcError> {
+        let now_ns = monotonic_ns();
         loop {
-            if let Some(s) = self.selector.pop() {
+            let next = self.selector.pop_at(now_ns);
+            self.log_switch();
+            if let Some(s) = next {
                 return Ok(Some(s));
             }
             let mut pulled = false;
             for (lane, sub) in self.lanes.iter().enumerate() {
+                if !self.selector.has_room(lane) {
+                    continue;
+                }
                 if let Some(s) = sub.receive()? {
                     self.lane_totals[lane] += 1;
                     self.lane_latest[lane] = Some(s);
@@ -57,6 +68,25 @@ impl NavSubscriber {
             if !pulled {
                 return Ok(None);
             }
+        }
+    }
+
+    /// One log line per switch, naming its cause; nothing while the lane stays.
+    fn log_switch(&mut self) {
+        let switches = self.selector.switches();
+        if switches == self.logged_switches {
+            return;
+        }
+        self.logged_switches = switches;
+        if let Some(s) = self.selector.last_switch() {
+            tracing::warn!(
+                from = s.from,
+                to = s.to,
+                at_seq = s.at_seq,
+                cause = s.reason.name(),
+                switches,
+                "navigation lane switch: {s}"
+            );
         }
     }
 
@@ -88,6 +118,11 @@ impl NavSubscriber {
     /// Lane changes since start, and the most recent one.
     pub fn switches(&self) -> (u64, Option<Switch>) {
         (self.selector.switches(), self.selector.last_switch())
+    }
+
+    /// Lane changes since start, by cause.
+    pub fn switch_counts(&self) -> SwitchCounts {
+        self.selector.switch_counts()
     }
 }
 

@@ -66,6 +66,16 @@ impl CommandGate {
         sender: (u32, u8),
         from: SocketAddr,
     ) -> Result<(), Refusal> {
+        self.admit_wired(signature, sender)?;
+        if !self.addresses.is_empty() && !self.addresses.iter().any(|a| a.matches(from)) {
+            return Err(Refusal::Address);
+        }
+        Ok(())
+    }
+
+    /// [`Self::admit`] for a command that came over a serial port: the port is a wire to one
+    /// device and has no address, so only the signature and the sender are checked.
+    pub fn admit_wired(&self, signature: SignatureCheck, sender: (u32, u8)) -> Result<(), Refusal> {
         let signature_ok = match signature {
             SignatureCheck::Valid => self.signed,
             SignatureCheck::NotChecked => !self.signed && self.unsigned_pass,
@@ -78,9 +88,6 @@ impl CommandGate {
         }
         if !self.sources.is_empty() && !self.sources.iter().any(|s| s.matches(sender.0, sender.1)) {
             return Err(Refusal::Sender);
-        }
-        if !self.addresses.is_empty() && !self.addresses.iter().any(|a| a.matches(from)) {
-            return Err(Refusal::Address);
         }
         Ok(())
     }

@@ -6,6 +6,7 @@ use std::net::{IpAddr, SocketAddr};
 
 use serde::{Deserialize, Serialize};
 
+use crate::autopilot::Autopilot;
 use crate::dialect::MavType;
 use crate::endpoint::Endpoint;
 use crate::heartbeat::Profile;
@@ -27,6 +28,10 @@ pub struct MavlinkConfig {
     /// `onboard` (an onboard controller beside the autopilot) or `display` (a vehicle for a ground
     /// station on a bench; never beside a real autopilot).
     pub profile: String,
+    /// The autopilot ODOMETRY is shaped for: `generic` (the message as the message set defines
+    /// it), `px4` or `ardupilot` (the frames and fields each one's receiver takes, and the global
+    /// origin announced with SET_GPS_GLOBAL_ORIGIN). Only with the `onboard` profile.
+    pub autopilot: String,
     /// The vehicle type the `display` profile shows: `quadrotor`, `fixed-wing`, `helicopter`,
     /// `hexarotor`, `octorotor`, `ground-rover`.
     pub display_vehicle: String,
@@ -157,6 +162,7 @@ impl Default for MavlinkConfig {
             system_id: 1,
             component_id: 197,
             profile: "onboard".into(),
+            autopilot: "generic".into(),
             display_vehicle: "quadrotor".into(),
             accept_commands: false,
             signing_key_file: None,
@@ -242,6 +248,7 @@ impl MavlinkConfig {
             return Err("mavlink.component_id = 0: 0 is the broadcast id, use 1..=255".into());
         }
         self.profile()?;
+        self.autopilot()?;
         if !(1..=65_536).contains(&self.queue_capacity) {
             return Err(format!(
                 "mavlink.queue_capacity = {}: must be 1..=65536",
@@ -343,6 +350,20 @@ impl MavlinkConfig {
         }
     }
 
+    /// The autopilot this configuration shapes ODOMETRY for. A bench display is never beside a
+    /// real autopilot, so it takes only `generic`.
+    pub fn autopilot(&self) -> Result<Autopilot, String> {
+        let autopilot = Autopilot::parse(&self.autopilot)?;
+        if autopilot != Autopilot::Generic && matches!(self.profile(), Ok(Profile::Display { .. }))
+        {
+            return Err(format!(
+                "mavlink.autopilot = {:?} with mavlink.profile = \"display\": the display profile is never beside an autopilot; use \"generic\" or the \"onboard\" profile",
+                self.autopilot
+            ));
+        }
+        Ok(autopilot)
+    }
+
     /// The component id rins speaks as: the configured one on board, 1 in the display profile (a
     /// ground station draws a vehicle only for component 1).
     pub fn speaking_component(&self) -> u8 {
@@ -364,6 +385,33 @@ mod tests {
         assert!(!c.enabled);
         assert_eq!(c.profile(), Ok(Profile::Onboard));
         assert_eq!(c.speaking_component(), 197);
+        assert_eq!(c.autopilot(), Ok(Autopilot::Generic));
+    }
+
+    #[test]
+    fn the_autopilot_parses_and_a_display_takes_only_generic() {
+        let c: MavlinkConfig = toml::from_str("autopilot = \"ardupilot\"").unwrap();
+        assert_eq!(c.validate(), Ok(()));
+        assert_eq!(c.autopilot(), Ok(Autopilot::Ardupilot));
+        let bad = MavlinkConfig {
+            autopilot: "apm".into(),
+            ..MavlinkConfig::default()
+        };
+        assert!(
+            bad.validate()
+                .unwrap_err()
+                .starts_with("mavlink.autopilot = \"apm\": must be one of generic, px4, ardupilot")
+        );
+        let display = MavlinkConfig {
+            profile: "display".into(),
+            autopilot: "px4".into(),
+            ..MavlinkConfig::default()
+        };
+        let e = display.validate().unwrap_err();
+        assert!(
+            e.starts_with("mavlink.autopilot = \"px4\" with mavlink.profile = \"display\""),
+            "{e}"
+        );
     }
 
     #[test]

@@ -6,6 +6,8 @@ use ipc_types::{
     ChannelState, FaultReason, FusedImu, HealthReport, MAX_SUPERVISED, SensorType, ServiceKind,
 };
 
+use rins_runtime::lane_selector::Switch;
+
 use crate::dialect::STATUSTEXT_DATA;
 use crate::status_text::{channel_event, lane_switch, service_restarted};
 
@@ -58,10 +60,17 @@ impl EventWatch {
         self.channels = Some(now);
     }
 
-    /// A lane switch when the count of switches grew; `lane` is the lane delivering now.
-    pub fn on_switches(&mut self, switches: u64, lane: u8, mut emit: impl FnMut(STATUSTEXT_DATA)) {
-        if switches > self.switches {
-            emit(lane_switch(lane));
+    /// A lane switch, with its cause, when the selector's count of switches grew; `last` is its
+    /// latest switch.
+    pub fn on_switches(
+        &mut self,
+        (switches, last): (u64, Option<Switch>),
+        mut emit: impl FnMut(STATUSTEXT_DATA),
+    ) {
+        if switches > self.switches
+            && let Some(s) = last
+        {
+            emit(lane_switch(&s));
         }
         self.switches = switches;
     }
@@ -92,6 +101,7 @@ impl EventWatch {
 mod tests {
     use super::*;
     use ipc_types::ServiceHealth;
+    use rins_runtime::lane_selector::{Distrust, SwitchReason};
 
     fn texts(run: impl FnOnce(&mut dyn FnMut(STATUSTEXT_DATA))) -> Vec<String> {
         let mut out = Vec::new();
@@ -126,11 +136,19 @@ mod tests {
     #[test]
     fn switches_and_restarts() {
         let mut w = EventWatch::default();
-        assert!(texts(|e| w.on_switches(0, 0, e)).is_empty());
+        assert!(texts(|e| w.on_switches((0, None), e)).is_empty());
+        let switch = Switch {
+            from: 0,
+            to: 1,
+            reason: SwitchReason::Untrusted(Distrust::Invalid),
+            at_seq: 7,
+        };
         assert_eq!(
-            texts(|e| w.on_switches(1, 1, e)),
-            ["rins navigation switched to lane 1"]
+            texts(|e| w.on_switches((1, Some(switch)), e)),
+            ["rins lane 0->1: lane 0 invalid"]
         );
+        // Once per switch, not per sample.
+        assert!(texts(|e| w.on_switches((1, Some(switch)), e)).is_empty());
         let mut report = HealthReport {
             count: 2,
             ..HealthReport::default()

@@ -5,7 +5,9 @@
 //! - [`local_frame`]: the local NED frame the local position and odometry are expressed in.
 //! - [`attitude`]: the ATTITUDE_QUATERNION message.
 //! - [`position`]: the GLOBAL_POSITION_INT and LOCAL_POSITION_NED messages.
-//! - [`odometry`]: the ODOMETRY message with the covariance diagonal, the reset counter and the quality.
+//! - [`odometry`]: the ODOMETRY message with the covariance diagonal, the reset counter and the quality;
+//!   [`autopilot`]: its frames and fields as PX4 or ArduPilot takes them; [`origin`]: the local
+//!   frame's origin and its SET_GPS_GLOBAL_ORIGIN announcement.
 //! - [`heartbeat`]: the HEARTBEAT message of the on-board profile and of the bench display profile.
 //! - [`sys_status`]: the SYS_STATUS message with the bits of what rins has (gyro, accelerometer,
 //!   AHRS; magnetometer, barometer and GPS when configured) and their health.
@@ -16,13 +18,15 @@
 //!   [`command_gate`]: from whom it takes commands and how fast it answers them; [`signing`]: the
 //!   MAVLink 2 signing key, signing and verification.
 //! - [`stream`]: all of it as one state machine paced by [`rate_gate`]; [`link`] moves the messages
-//!   to the network on its own threads; [`service`] is the process around them, [`config`] its
-//!   `[mavlink]` table and [`endpoint`] its addresses.
+//!   to the network on its own threads, [`serial_link`] to and from a serial port; [`service`] is
+//!   the process around them, [`config`] its `[mavlink]` table and [`endpoint`] its addresses;
+//!   [`pipeline_cpu`] measures the pipeline's load for SYS_STATUS.
 //!
 //! Every message carries the measurement's time, not the send time: the receive time of the serial
 //! frame the solution comes from, on the avionics computer's CLOCK_MONOTONIC (time since boot).
 
 pub mod attitude;
+pub mod autopilot;
 pub mod command;
 pub mod command_gate;
 pub mod config;
@@ -32,8 +36,11 @@ pub mod heartbeat;
 pub mod highres_imu;
 pub mod link;
 pub mod odometry;
+pub mod origin;
+pub mod pipeline_cpu;
 pub mod position;
 pub mod rate_gate;
+pub mod serial_link;
 pub mod service;
 pub mod signing;
 pub mod status_text;

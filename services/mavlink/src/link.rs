@@ -1,10 +1,12 @@
 //! The network side of the MAVLink output: one thread sends what the navigation loop queued, one
 //! thread per socket reads what peers send (TIMESYNC is answered there and then, commands that
-//! pass the [`CommandGate`] go to the navigation loop). The navigation loop never touches a
-//! socket: it hands messages over a bounded queue and counts what did not fit, so a slow or absent
-//! network never holds up the solution. With a signing key, every frame sent is signed and only
+//! pass the [`CommandGate`] go to the navigation loop); a serial port has a reader and a writer of
+//! its own ([`crate::serial_link`]), fed by the sending thread. The navigation loop never touches
+//! a socket or a port: it hands messages over a bounded queue and counts what did not fit, so a
+//! slow or absent network or line never holds up the solution. With a signing key, every frame sent is signed and only
 //! frames signed with the key are acted on.
 
+use std::fmt;
 use std::io;
 use std::net::{SocketAddr, UdpSocket};
 use std::sync::atomic::{AtomicBool, AtomicU8, AtomicU64, Ordering};
@@ -21,13 +23,14 @@ use mavlink::{
 use crate::command_gate::{CommandGate, Refusal};
 use crate::dialect::{COMMAND_LONG_DATA, MavMessage};
 use crate::endpoint::Endpoint;
+use crate::serial_link::{self, Frame};
 use crate::signing::{self, KEY_BYTES, SignatureCheck, Verifier};
 use crate::timesync;
 
 /// Largest MAVLink 2 frame (header 10, payload 255, checksum 2, signature 13).
-const MAX_FRAME: usize = 280;
+pub(crate) const MAX_FRAME: usize = 280;
 /// How often a reader looks at the stop flag while nothing arrives.
-const READ_POLL: Duration = Duration::from_millis(100);
+pub(crate) const READ_POLL: Duration = Duration::from_millis(100);
 /// Commands queued for the navigation loop; a peer flooding commands loses the excess.
 const COMMAND_QUEUE: usize = 16;
 
@@ -47,13 +50,22 @@ pub struct LinkCounters {
     pub queued: AtomicU64,
     /// Messages dropped because the queue to the network thread was full.
     pub dropped: AtomicU64,
-    /// Datagrams sent (one per message and endpoint with a peer).
+    /// Datagrams sent (one per message and endpoint with a peer), and frames written to serial
+    /// ports.
     pub sent: AtomicU64,
     /// Sends the system refused (unreachable peer, no route).
     pub send_errors: AtomicU64,
     /// Datagrams received that were not, in whole, MAVLink 2 messages of the common set: one per
-    /// such datagram, whatever it held besides.
+    /// such datagram, whatever it held besides; on a serial port, frames with a valid checksum of
+    /// a message the common set does not know or cannot decode.
     pub undecodable: AtomicU64,
+    /// Frames not written to a serial port: the port was away (unplugged, not yet reopened), its
+    /// queue was full (a line too slow for the configured rates) or the write failed.
+    pub serial_dropped: AtomicU64,
+    /// Times a serial port was lost (unplugged, hung up, failed reading).
+    pub serial_lost: AtomicU64,
+    /// Times a serial port was opened again after it was lost or could not be opened.
+    pub serial_reopened: AtomicU64,
     /// TIMESYNC requests answered.
     pub timesync_answered: AtomicU64,
     /// Commands dropped because the navigation loop had not taken the earlier ones.
@@ -77,7 +89,7 @@ pub struct LinkCounters {
 impl LinkCounters {
     /// Counts `refusal`; the first of each kind is logged, with who sent it, so that a link set up
     /// wrongly (a ground station not signing) shows at once without a flood of log lines.
-    fn refused(&self, refusal: Refusal, sender: (u32, u8), from: SocketAddr) {
+    fn refused(&self, refusal: Refusal, sender: (u32, u8), from: Origin<'_>) {
         let (counter, why) = match refusal {
             Refusal::Unsigned => (&self.unsigned_refused, "not signed"),
             Refusal::BadSignature => (&self.bad_signature_refused, "not signed with the key"),
@@ -120,6 +132,24 @@ pub struct LinkSecurity {
     pub gate: CommandGate,
 }
 
+/// Where an inbound message came from.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Origin<'a> {
+    /// A UDP peer.
+    Peer(SocketAddr),
+    /// A serial port, by its device path.
+    Port(&'a str),
+}
+
+impl fmt::Display for Origin<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Peer(addr) => write!(f, "{addr}"),
+            Self::Port(path) => write!(f, "{path}"),
+        }
+    }
+}
+
 /// One socket and where its stream goes.
 struct Socket {
     socket: UdpSocket,
@@ -129,7 +159,7 @@ struct Socket {
 }
 
 /// Who rins speaks as, the sequence number every frame it sends shares, and its signer.
-struct Speaker {
+pub(crate) struct Speaker {
     system: u8,
     component: u8,
     sequence: AtomicU8,
@@ -138,7 +168,7 @@ struct Speaker {
 
 impl Speaker {
     /// `msg` framed as MAVLink 2 into `buf`, signed when a key is set; the frame's length.
-    fn frame(&self, msg: &MavMessage, buf: &mut [u8; MAX_FRAME]) -> Option<usize> {
+    pub(crate) fn frame(&self, msg: &MavMessage, buf: &mut [u8; MAX_FRAME]) -> Option<usize> {
         let header = MavHeader {
             system_id: u32::from(self.system),
             component_id: self.component,
@@ -202,6 +232,8 @@ fn open(endpoint: &Endpoint) -> io::Result<Socket> {
             (UdpSocket::bind(any)?, Some(addr), false)
         }
         Endpoint::UdpIn { .. } => (UdpSocket::bind(addr)?, None, true),
+        // `socket_addr` refused it already: a serial port is no socket.
+        Endpoint::Serial { .. } => return Err(io::ErrorKind::InvalidInput.into()),
     };
     socket.set_read_timeout(Some(READ_POLL))?;
     Ok(Socket {
@@ -227,7 +259,13 @@ impl Link {
         security: LinkSecurity,
     ) -> io::Result<Self> {
         let mut sockets = Vec::with_capacity(endpoints.len());
+        let mut ports = Vec::new();
         for e in endpoints {
+            if let Endpoint::Serial { path, baud } = e {
+                // Opened by its reader, which waits for a port that is not there yet.
+                ports.push((path.clone(), *baud));
+                continue;
+            }
             let s = open(e).map_err(|err| io::Error::new(err.kind(), format!("{e}: {err}")))?;
             sockets.push(s);
         }
@@ -248,18 +286,21 @@ impl Link {
         let stop = Arc::new(AtomicBool::new(false));
         let (tx, rx) = bounded::<MavMessage>(queue_capacity);
         let (cmd_tx, cmd_rx) = bounded::<InboundCommand>(COMMAND_QUEUE);
+        let inbound = Inbound {
+            speaker: Arc::clone(&speaker),
+            counters: Arc::clone(&counters),
+            commands: cmd_tx,
+            verifier,
+            gate,
+        };
         let mut threads = Vec::new();
         for s in &sockets {
             let reader = ReaderThread {
                 socket: s.socket.try_clone()?,
                 peer: Arc::clone(&s.peer),
                 listening: s.listening,
-                speaker: Arc::clone(&speaker),
-                counters: Arc::clone(&counters),
-                commands: cmd_tx.clone(),
                 stop: Arc::clone(&stop),
-                verifier: verifier.clone(),
-                gate: Arc::clone(&gate),
+                inbound: inbound.clone(),
             };
             threads.push(
                 std::thread::Builder::new()
@@ -267,11 +308,27 @@ impl Link {
                     .spawn(move || reader.run())?,
             );
         }
+        let mut port_queues = Vec::with_capacity(ports.len());
+        for (path, baud) in ports {
+            // Frames wait here for the port's writer, so that a slow line holds up neither the
+            // sockets nor the navigation loop.
+            let (frame_tx, frame_rx) = bounded::<Frame>(queue_capacity);
+            port_queues.push(frame_tx);
+            threads.extend(serial_link::start(
+                path,
+                baud,
+                frame_rx,
+                inbound.clone(),
+                Arc::clone(&stop),
+            )?);
+        }
         let sender_counters = Arc::clone(&counters);
         threads.push(
             std::thread::Builder::new()
                 .name("mavlink-tx".into())
-                .spawn(move || send_loop(&rx, &sockets, &speaker, &sender_counters))?,
+                .spawn(move || {
+                    send_loop(&rx, &sockets, &port_queues, &speaker, &sender_counters);
+                })?,
         );
         Ok(Self {
             outbound: Some(tx),
@@ -306,10 +363,12 @@ impl Drop for Link {
     }
 }
 
-/// Sends every queued message to every endpoint that has a peer, until the queue closes.
+/// Sends every queued message to every endpoint that has a peer and hands it to every serial
+/// port's writer, until the queue closes.
 fn send_loop(
     rx: &Receiver<MavMessage>,
     sockets: &[Socket],
+    ports: &[Sender<Frame>],
     speaker: &Speaker,
     counters: &LinkCounters,
 ) {
@@ -318,6 +377,11 @@ fn send_loop(
         let Some(len) = speaker.frame(&msg, &mut buf) else {
             continue;
         };
+        for port in ports {
+            if port.try_send(Frame::new(&buf[..len])).is_err() {
+                counters.serial_dropped.fetch_add(1, Ordering::Relaxed);
+            }
+        }
         for s in sockets {
             let Some(peer) = peer_of(&s.peer) else {
                 continue;
@@ -330,19 +394,26 @@ fn send_loop(
     }
 }
 
+/// What every reader, of a socket or of a serial port, acts on messages with.
+#[derive(Clone)]
+pub(crate) struct Inbound {
+    speaker: Arc<Speaker>,
+    pub(crate) counters: Arc<LinkCounters>,
+    commands: Sender<InboundCommand>,
+    /// The signature check, when a key is set; one for every endpoint: a frame replayed onto
+    /// another endpoint is still a replay.
+    verifier: Option<Arc<Mutex<Verifier>>>,
+    gate: Arc<CommandGate>,
+}
+
 /// Reads one socket: answers TIMESYNC, forwards admitted commands, learns a listening socket's
 /// peer.
 struct ReaderThread {
     socket: UdpSocket,
     peer: Arc<Mutex<Option<SocketAddr>>>,
     listening: bool,
-    speaker: Arc<Speaker>,
-    counters: Arc<LinkCounters>,
-    commands: Sender<InboundCommand>,
     stop: Arc<AtomicBool>,
-    /// The signature check, when a key is set.
-    verifier: Option<Arc<Mutex<Verifier>>>,
-    gate: Arc<CommandGate>,
+    inbound: Inbound,
 }
 
 impl ReaderThread {
@@ -369,10 +440,16 @@ impl ReaderThread {
             // A datagram may carry several frames.
             let mut authentic = false;
             let clean = decode_datagram(&datagram[..n], |raw, msg| {
-                authentic |= self.on_message(raw, msg, from, &mut frame);
+                let reply = |bytes: &[u8]| self.socket.send_to(bytes, from).is_ok();
+                authentic |=
+                    self.inbound
+                        .on_message(raw, msg, Origin::Peer(from), &mut frame, reply);
             });
             if !clean {
-                self.counters.undecodable.fetch_add(1, Ordering::Relaxed);
+                self.inbound
+                    .counters
+                    .undecodable
+                    .fetch_add(1, Ordering::Relaxed);
             }
             // The stream follows only a peer that spoke MAVLink (signed with the key, when one
             // is set): a stray or forged datagram cannot divert it.
@@ -381,7 +458,9 @@ impl ReaderThread {
             }
         }
     }
+}
 
+impl Inbound {
     /// What `raw`'s signature shows.
     fn signature(&self, raw: &MAVLinkV2MessageRaw) -> SignatureCheck {
         match &self.verifier {
@@ -393,13 +472,15 @@ impl ReaderThread {
         }
     }
 
-    /// Acts on one message; returns whether it is authentic (signed with the key, or no key set).
-    fn on_message(
+    /// Acts on one message from `from`; `reply` sends a frame back there and says whether it
+    /// went. Returns whether the message is authentic (signed with the key, or no key set).
+    pub(crate) fn on_message(
         &self,
         raw: &MAVLinkV2MessageRaw,
         msg: MavMessage,
-        from: SocketAddr,
+        from: Origin<'_>,
         frame: &mut [u8; MAX_FRAME],
+        reply: impl FnOnce(&[u8]) -> bool,
     ) -> bool {
         let signature = self.signature(raw);
         let authentic = matches!(
@@ -427,7 +508,7 @@ impl ReaderThread {
                     answer.target_system = u8::try_from(header.system_id).unwrap_or(0);
                     answer.target_component = header.component_id;
                     if let Some(len) = self.speaker.frame(&MavMessage::TIMESYNC(answer), frame)
-                        && self.socket.send_to(&frame[..len], from).is_ok()
+                        && reply(&frame[..len])
                     {
                         self.counters
                             .timesync_answered
@@ -436,7 +517,11 @@ impl ReaderThread {
                 }
             }
             MavMessage::COMMAND_LONG(command) => {
-                if let Err(refusal) = self.gate.admit(signature, sender, from) {
+                let admitted = match from {
+                    Origin::Peer(addr) => self.gate.admit(signature, sender, addr),
+                    Origin::Port(_) => self.gate.admit_wired(signature, sender),
+                };
+                if let Err(refusal) = admitted {
                     self.counters.refused(refusal, sender, from);
                     return authentic;
                 }

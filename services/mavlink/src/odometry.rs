@@ -1,7 +1,8 @@
 //! ODOMETRY (#331), the message an autopilot's estimator takes as an external source: pose in the
 //! local NED frame, velocity and body rates in the body (FRD) frame, the covariance diagonal of
 //! each from the filter, a reset counter that tells the receiver when the estimate jumped, and a
-//! quality that says when it must not be used.
+//! quality that says when it must not be used. [`odometry`] builds it in the generic frames
+//! (`LOCAL_NED`, `BODY_FRD`); [`crate::autopilot`] relabels and blanks it for the receiver.
 
 use ipc_types::{Integrity, NavMode, NavState};
 
@@ -28,6 +29,12 @@ pub struct ResetCounter {
 }
 
 impl ResetCounter {
+    /// Counts a reset that does not come from the lanes: the local frame's origin moved, so every
+    /// local position jumps.
+    pub fn bump(&mut self) {
+        self.count = self.count.wrapping_add(1);
+    }
+
     /// The counter for `nav`, delivered after `switches` lane switches of the selector.
     pub fn observe(&mut self, nav: &NavState, switches: u64) -> u8 {
         let lane = usize::from(nav.lane.min(1));
@@ -333,5 +340,8 @@ mod tests {
         };
         assert_eq!(c.observe(&new, 1), 2);
         assert_eq!(c.observe(&new, 1), 2);
+        // The origin moved.
+        c.bump();
+        assert_eq!(c.observe(&new, 1), 3);
     }
 }

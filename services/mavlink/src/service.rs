@@ -1,7 +1,8 @@
 //! The MAVLink process: the merged navigation stream, the fused IMU and the watchdog's report in;
-//! MAVLink 2 over UDP out through the [`Link`]'s network thread; re-admission commands from the
-//! link carried to fusion and acknowledged with fusion's answer, no faster than the configured
-//! acknowledgement rate.
+//! MAVLink 2 over UDP and serial ports out through the [`Link`]'s threads; the pipeline's CPU
+//! measured for SYS_STATUS on a thread of its own; re-admission commands from the link carried to
+//! fusion and acknowledged with fusion's answer, no faster than the configured acknowledgement
+//! rate.
 
 use std::time::{Duration, Instant};
 
@@ -135,12 +136,13 @@ impl Commands {
 }
 
 /// The link's counters into the heartbeat's: messages queued are published, messages the queue
-/// could not take are lost, undecodable datagrams are malformed, commands not carried out for
-/// the link's reasons (refused by the gate, or dropped for a full queue) are rejected.
+/// could not take or a serial port could not be given are lost, undecodable datagrams are
+/// malformed, commands not carried out for the link's reasons (refused by the gate, or dropped for
+/// a full queue) are rejected.
 fn copy_counters(link: &LinkCounters, counters: &mut ipc_types::Health) {
     use std::sync::atomic::Ordering::Relaxed;
     counters.published = link.queued.load(Relaxed);
-    counters.lost = link.dropped.load(Relaxed);
+    counters.lost = link.dropped.load(Relaxed) + link.serial_dropped.load(Relaxed);
     counters.malformed = link.undecodable.load(Relaxed);
     counters.rejected = link.commands_dropped.load(Relaxed) + link.refused_total();
 }
@@ -184,11 +186,16 @@ impl Service for MavlinkService {
             system = own.0,
             component = own.1,
             profile = %config.profile,
+            autopilot = %config.autopilot,
             accept_commands = config.accept_commands,
             signed = key.is_some(),
             "streaming MAVLink 2"
         );
         let mut stream = MavlinkStream::new(&config);
+        // The pipeline's CPU for SYS_STATUS, measured on its own thread: the loop only reads it.
+        let load_stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let (load, load_thread) =
+            crate::pipeline_cpu::start(config.rates.sys_status_hz, load_stop.clone());
         while lp.running() {
             nav.wait(WAIT)?;
             let mut emit = |m: MavMessage| link.queue(m);
@@ -198,11 +205,12 @@ impl Service for MavlinkService {
             }
             while let Some(n) = nav.receive()? {
                 lp.counters.received += 1;
-                stream.on_nav(&n, nav.switches().0, &mut emit);
+                stream.on_nav(&n, nav.switches(), &mut emit);
             }
             while let Some(h) = health.receive()? {
                 stream.on_health(&h, &mut emit);
             }
+            stream.set_load_permille(load.permille());
             stream.on_clock(monotonic_ns(), &mut emit);
             while let Ok(c) = link.commands.try_recv() {
                 commands.on_command(&c, &link)?;
@@ -212,6 +220,10 @@ impl Service for MavlinkService {
             lp.beat()?;
         }
         copy_counters(&link.counters, &mut lp.counters);
+        load_stop.store(true, std::sync::atomic::Ordering::Relaxed);
+        if let Some(t) = load_thread {
+            let _ = t.join();
+        }
         let c = &link.counters;
         use std::sync::atomic::Ordering::Relaxed;
         tracing::info!(
@@ -228,6 +240,10 @@ impl Service for MavlinkService {
             sender_refused = c.sender_refused.load(Relaxed),
             address_refused = c.address_refused.load(Relaxed),
             acks_dropped = c.acks_dropped.load(Relaxed),
+            serial_dropped = c.serial_dropped.load(Relaxed),
+            serial_lost = c.serial_lost.load(Relaxed),
+            serial_reopened = c.serial_reopened.load(Relaxed),
+            load_unreadable = load.unreadable.load(Relaxed),
             "MAVLink output stopped"
         );
         Ok(())

@@ -2,6 +2,7 @@
 //! lane switch, a service restarted — as one line of at most 50 characters with its severity.
 
 use ipc_types::{ChannelState, FaultReason, SensorType};
+use rins_runtime::lane_selector::{Switch, SwitchReason};
 
 use crate::dialect::{MavSeverity, STATUSTEXT_DATA};
 
@@ -46,11 +47,24 @@ pub fn channel_event(
     }
 }
 
-/// The consumers now follow navigation lane `lane`.
-pub fn lane_switch(lane: u8) -> STATUSTEXT_DATA {
+/// The consumers now follow navigation lane `s.to`, and why they left `s.from`:
+/// `rins lane 0->1: lane 0 silent 12 ms, 15 behind`.
+pub fn lane_switch(s: &Switch) -> STATUSTEXT_DATA {
+    let (from, to) = (s.from, s.to);
+    let ms = |ns: u64| ns.saturating_add(500_000) / 1_000_000;
+    let why = match s.reason {
+        SwitchReason::Silent { silent_ns, ahead } => {
+            format!("lane {from} silent {} ms, {ahead} behind", ms(silent_ns))
+        }
+        SwitchReason::Behind { ahead } => format!("lane {from} {ahead} behind, no times"),
+        SwitchReason::RingFull { silent_ns, ahead } => {
+            format!("{ahead} pending, lane {from} silent {} ms", ms(silent_ns))
+        }
+        SwitchReason::Untrusted(d) => format!("lane {from} {}", d.name()),
+    };
     status_text(
         MavSeverity::MAV_SEVERITY_WARNING,
-        &format!("rins navigation switched to lane {lane}"),
+        &format!("rins lane {from}->{to}: {why}"),
     )
 }
 
@@ -87,10 +101,62 @@ mod tests {
             (m.severity, text(&m).as_str()),
             (MavSeverity::MAV_SEVERITY_INFO, "rins accel0 in service")
         );
-        assert_eq!(text(&lane_switch(1)), "rins navigation switched to lane 1");
         assert_eq!(
             text(&service_restarted("navigator-standby")),
             "rins navigator-standby restarted"
+        );
+    }
+
+    #[test]
+    fn a_lane_switch_says_why() {
+        use rins_runtime::lane_selector::Distrust;
+        let switch = |reason| Switch {
+            from: 0,
+            to: 1,
+            reason,
+            at_seq: 1001,
+        };
+        let cases = [
+            (
+                SwitchReason::Silent {
+                    silent_ns: 12_400_000,
+                    ahead: 15,
+                },
+                "rins lane 0->1: lane 0 silent 12 ms, 15 behind",
+            ),
+            (
+                SwitchReason::Behind { ahead: 8 },
+                "rins lane 0->1: lane 0 8 behind, no times",
+            ),
+            (
+                SwitchReason::RingFull {
+                    silent_ns: 8_600_000,
+                    ahead: 512,
+                },
+                "rins lane 0->1: 512 pending, lane 0 silent 9 ms",
+            ),
+            (
+                SwitchReason::Untrusted(Distrust::Aligning),
+                "rins lane 0->1: lane 0 aligning",
+            ),
+            (
+                SwitchReason::Untrusted(Distrust::Young { run: 3 }),
+                "rins lane 0->1: lane 0 too young",
+            ),
+        ];
+        for (reason, want) in cases {
+            let m = lane_switch(&switch(reason));
+            assert_eq!(m.severity, MavSeverity::MAV_SEVERITY_WARNING);
+            assert_eq!(text(&m), want);
+        }
+        // A silence of a day is cut at the message size.
+        let long = lane_switch(&switch(SwitchReason::Silent {
+            silent_ns: 99_999_000_000_000,
+            ahead: 512,
+        }));
+        assert_eq!(
+            text(&long),
+            "rins lane 0->1: lane 0 silent 99999000 ms, 512 beh"
         );
     }
 

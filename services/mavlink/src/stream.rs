@@ -5,6 +5,7 @@
 use ipc_types::{FusedImu, HealthReport, Integrity, NavMode, NavState};
 
 use crate::attitude::attitude_quaternion;
+use crate::autopilot::Autopilot;
 use crate::config::MavlinkConfig;
 use crate::dialect::MavMessage;
 use crate::events::EventWatch;
@@ -12,6 +13,7 @@ use crate::heartbeat::{Profile, heartbeat};
 use crate::highres_imu::highres_imu;
 use crate::local_frame::LocalOrigin;
 use crate::odometry::{ResetCounter, odometry};
+use crate::origin::{OriginAnnouncer, OriginChange, OriginTracker};
 use crate::position::{global_position_int, local_position_ned};
 use crate::rate_gate::RateGate;
 use crate::sys_status::{present, sys_status};
@@ -35,8 +37,13 @@ struct Gates {
 pub struct MavlinkStream {
     profile: Profile,
     gates: Gates,
-    /// The local frame's origin: the first usable solution's position.
-    origin: Option<LocalOrigin>,
+    /// The local frame's origin: the first shown solution's position, moved to the first known
+    /// one.
+    origin: OriginTracker,
+    /// The autopilot ODOMETRY is shaped for.
+    autopilot: Autopilot,
+    /// The global origin's announcement, to an autopilot that takes it.
+    announcer: Option<OriginAnnouncer>,
     resets: ResetCounter,
     vibration: VibrationMeter,
     events: EventWatch,
@@ -46,6 +53,8 @@ pub struct MavlinkStream {
     aiding_seen: u32,
     /// `[mavlink] odometry_quality_sigma_m`: the horizontal σ of ODOMETRY quality 50.
     quality_sigma_m: f64,
+    /// The pipeline's CPU load, ‰, for SYS_STATUS (0: not measured).
+    load_permille: u16,
 }
 
 /// Whether `nav` may be shown as a solution: usable, integrity not invalid.
@@ -70,7 +79,13 @@ impl MavlinkStream {
                 sys_status: RateGate::new(r.sys_status_hz),
                 vibration: RateGate::new(r.vibration_hz),
             },
-            origin: None,
+            origin: OriginTracker::default(),
+            autopilot: config.autopilot().unwrap_or(Autopilot::Generic),
+            announcer: config
+                .autopilot()
+                .ok()
+                .and_then(Autopilot::origin_form)
+                .map(|form| OriginAnnouncer::new(config.system_id, form)),
             resets: ResetCounter::default(),
             vibration: VibrationMeter::default(),
             events: EventWatch::default(),
@@ -78,12 +93,13 @@ impl MavlinkStream {
             nav: None,
             aiding_seen: 0,
             quality_sigma_m: config.odometry_quality_sigma_m,
+            load_permille: 0,
         }
     }
 
     /// The local frame's origin, once a usable solution set it.
     pub fn origin(&self) -> Option<&LocalOrigin> {
-        self.origin.as_ref()
+        self.origin.origin()
     }
 
     /// A fused IMU sample: HIGHRES_IMU and VIBRATION when due, channel events.
@@ -100,18 +116,26 @@ impl MavlinkStream {
         self.fused = Some(*f);
     }
 
-    /// A solution of the merged stream; `switches` is the lane selector's count of lane changes.
-    pub fn on_nav(&mut self, nav: &NavState, switches: u64, emit: &mut impl FnMut(MavMessage)) {
+    /// A solution of the merged stream; `switches` is the lane selector's count of lane changes
+    /// and its latest ([`rins_runtime::nav_subscriber::NavSubscriber::switches`]).
+    pub fn on_nav(
+        &mut self,
+        nav: &NavState,
+        switches: (u64, Option<rins_runtime::lane_selector::Switch>),
+        emit: &mut impl FnMut(MavMessage),
+    ) {
         let t_ns = nav.header.origin_rx_ns;
         self.events
-            .on_switches(switches, nav.lane, |m| emit(MavMessage::STATUSTEXT(m)));
+            .on_switches(switches, |m| emit(MavMessage::STATUSTEXT(m)));
+        let switches = switches.0;
         let shown = trustworthy(nav);
-        if shown && self.origin.is_none() {
-            self.origin = Some(LocalOrigin::new(
-                nav.latitude_rad,
-                nav.longitude_rad,
-                nav.altitude_m,
-            ));
+        if self.origin.observe(nav, shown) == OriginChange::Moved {
+            self.resets.bump();
+        }
+        if let (Some(announcer), Some(origin)) = (&mut self.announcer, self.origin.known())
+            && let Some(m) = announcer.due(origin, nav)
+        {
+            emit(m);
         }
         let reset_counter = self.resets.observe(nav, switches);
         // The body rate: the fused rate less the filter's bias estimate.
@@ -127,7 +151,7 @@ impl MavlinkStream {
                 nav, rate,
             )));
         }
-        if let (true, Some(origin)) = (shown, &self.origin) {
+        if let (true, Some(origin)) = (shown, self.origin.origin()) {
             if self.gates.global_position.due(t_ns) {
                 emit(MavMessage::GLOBAL_POSITION_INT(global_position_int(
                     nav, origin,
@@ -139,10 +163,10 @@ impl MavlinkStream {
                 )));
             }
         }
-        // Odometry goes out whatever the solution's state: its quality (−1) is how a receiver
-        // learns it must not use it.
+        // Odometry goes out whatever the solution's state (unless the autopilot must not see it
+        // then): its quality (−1) is how a receiver learns it must not use it.
         if self.gates.odometry.due(t_ns) {
-            let mut m = match &self.origin {
+            let m = match self.origin.origin() {
                 Some(origin) => odometry(
                     nav,
                     origin,
@@ -160,12 +184,9 @@ impl MavlinkStream {
                     self.quality_sigma_m,
                 ),
             };
-            if !shown {
-                // Nothing to show: unknown position and attitude, as the message defines them.
-                (m.x, m.y, m.z) = (f32::NAN, f32::NAN, f32::NAN);
-                m.q = [f32::NAN; 4];
+            if let Some(m) = self.autopilot.shape(m, shown) {
+                emit(MavMessage::ODOMETRY(m));
             }
-            emit(MavMessage::ODOMETRY(m));
         }
         self.nav = Some(*nav);
         self.aiding_seen |= nav.aiding;
@@ -175,6 +196,12 @@ impl MavlinkStream {
     pub fn on_health(&mut self, report: &HealthReport, emit: &mut impl FnMut(MavMessage)) {
         self.events
             .on_health(report, |m| emit(MavMessage::STATUSTEXT(m)));
+    }
+
+    /// The load SYS_STATUS reports from now on: the pipeline's CPU, ‰ (see
+    /// [`crate::pipeline_cpu`]; 0: not measured).
+    pub fn set_load_permille(&mut self, permille: u16) {
+        self.load_permille = permille;
     }
 
     /// HEARTBEAT and SYS_STATUS when due at `now_ns` (CLOCK_MONOTONIC): they say the stream is
@@ -191,9 +218,7 @@ impl MavlinkStream {
                 self.fused.as_ref(),
                 self.nav.as_ref(),
                 present(self.aiding_seen),
-                // Not measured: rins has no single main loop whose load the field could mean,
-                // and this process does not see the others' CPU time.
-                0,
+                self.load_permille,
             )));
         }
     }
@@ -228,10 +253,10 @@ mod tests {
         let mut sent = Vec::new();
         // σ_h = 20 m = σ₀: quality 50 (with the built-in 10 m it would be 20).
         let nav = navigating(1_000_000_000, aiding::BARO | aiding::MAG, 20.0);
-        stream.on_nav(&nav, 0, &mut |m| sent.push(m));
+        stream.on_nav(&nav, (0, None), &mut |m| sent.push(m));
         // The barometer then goes quiet: still present, no longer healthy.
         let quiet = navigating(1_100_000_000, aiding::BARO_STALE | aiding::MAG, 20.0);
-        stream.on_nav(&quiet, 0, &mut |m| sent.push(m));
+        stream.on_nav(&quiet, (0, None), &mut |m| sent.push(m));
         stream.on_clock(2_000_000_000, &mut |m| sent.push(m));
         let quality: Vec<i8> = sent
             .iter()
@@ -257,6 +282,67 @@ mod tests {
             s.onboard_control_sensors_present_extended,
             MavSysStatusSensorExtended::empty()
         );
+        // Not measured until the service sets it.
         assert_eq!(s.load, 0);
+        stream.set_load_permille(137);
+        let mut later = Vec::new();
+        stream.on_clock(3_000_000_000, &mut |m| later.push(m));
+        assert!(
+            later
+                .iter()
+                .any(|m| matches!(m, MavMessage::SYS_STATUS(s) if s.load == 137)),
+            "{later:?}"
+        );
+    }
+
+    #[test]
+    fn an_autopilot_gets_its_frames_and_the_origin_and_a_moved_origin_is_a_reset() {
+        use crate::dialect::MavFrame;
+        use ipc_types::integrity_reason;
+        let config = MavlinkConfig {
+            autopilot: "ardupilot".into(),
+            system_id: 9,
+            ..MavlinkConfig::default()
+        };
+        let mut stream = MavlinkStream::new(&config);
+        let mut sent = Vec::new();
+        // Aligning: ArduPilot gets no ODOMETRY, and there is no origin yet.
+        let aligning = NavState {
+            mode: NavMode::Aligning as u8,
+            ..navigating(1_000_000_000, 0, 1.0)
+        };
+        stream.on_nav(&aligning, (0, None), &mut |m| sent.push(m));
+        assert!(sent.is_empty(), "{sent:?}");
+        // Navigating with a placeholder position: the frame starts, nothing is announced.
+        let mut placeholder = navigating(2_000_000_000, 0, 1.0);
+        placeholder.integrity = Integrity::Degraded as u8;
+        placeholder.integrity_reasons = integrity_reason::POSITION_UNKNOWN;
+        stream.on_nav(&placeholder, (0, None), &mut |m| sent.push(m));
+        let odometry = |sent: &[MavMessage]| -> Vec<(MavFrame, u8)> {
+            sent.iter()
+                .filter_map(|m| match m {
+                    MavMessage::ODOMETRY(o) => Some((o.frame_id, o.reset_counter)),
+                    _ => None,
+                })
+                .collect()
+        };
+        assert_eq!(odometry(&sent), [(MavFrame::MAV_FRAME_LOCAL_FRD, 0)]);
+        assert!(!sent.iter().any(|m| matches!(m, MavMessage::COMMAND_INT(_))));
+        // The position becomes known: the origin moves there (a reset) and is announced to
+        // system 9's autopilot.
+        sent.clear();
+        let mut known = navigating(3_000_000_000, 0, 1.0);
+        (known.latitude_rad, known.longitude_rad) = (0.8, 0.15);
+        stream.on_nav(&known, (0, None), &mut |m| sent.push(m));
+        assert_eq!(odometry(&sent), [(MavFrame::MAV_FRAME_LOCAL_FRD, 1)]);
+        let Some(MavMessage::COMMAND_INT(c)) = sent
+            .iter()
+            .find(|m| matches!(m, MavMessage::COMMAND_INT(_)))
+        else {
+            panic!("no origin command in {sent:?}");
+        };
+        assert_eq!((c.target_system, c.x), (9, 458_366_236));
+        let origin = stream.origin().expect("an origin");
+        assert_eq!((origin.latitude_rad, origin.longitude_rad), (0.8, 0.15));
     }
 }

@@ -85,8 +85,9 @@ pub fn health(fused: Option<&FusedImu>, nav: Option<&NavState>) -> MavSysStatusS
 }
 
 /// SYS_STATUS for the latest fused sample and solution, with the sensors `present` (enabled
-/// alike: rins uses all it has); `load_permille` is the load in ‰ (0: not measured); no battery
-/// (the invalid values), nothing of the extended set.
+/// alike: rins uses all it has); `load_permille` is the load in ‰, the pipeline's CPU share
+/// ([`crate::pipeline_cpu`]; 0: not measured), at most 1000; no battery (the invalid values),
+/// nothing of the extended set.
 pub fn sys_status(
     fused: Option<&FusedImu>,
     nav: Option<&NavState>,

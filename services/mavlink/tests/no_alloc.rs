@@ -71,7 +71,7 @@ fn streaming_and_framing_do_not_allocate() {
     let allocations = allocations_during(|| {
         for k in 1..=2000 {
             stream.on_fused(&fused(k), &mut emit);
-            stream.on_nav(&flying(k), 0, &mut emit);
+            stream.on_nav(&flying(k), (0, None), &mut emit);
             stream.on_clock(k * 1_000_000, &mut emit);
         }
     });

@@ -56,6 +56,8 @@ pub fn summarise(
             .collect(),
         nav_lane_samples: monitor.nav_lanes().lane_totals(),
         nav_lane_switches: monitor.nav_lanes().switches().0,
+        nav_lane_switch_causes: monitor.nav_lanes().switch_counts().into(),
+        nav_lane_last_switch: monitor.nav_lanes().switches().1.map(|s| s.to_string()),
         nav_lane_filled: monitor.nav_lanes().filled(),
         nav_integrity_samples: monitor.integrity_samples.into(),
         att_err_deg_rms: sim(acc.attitude_deg.rms()),

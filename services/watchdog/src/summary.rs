@@ -16,6 +16,31 @@ pub struct IntegritySamples {
     pub invalid: u64,
 }
 
+/// Lane switches of the selector by cause.
+#[derive(Debug, Clone, Copy, Default, Serialize, PartialEq, Eq)]
+pub struct LaneSwitchCauses {
+    /// The selected lane silent for the dead time while the other was ahead.
+    pub silent: u64,
+    /// The selected lane behind by the switch lag, samples without publish times.
+    pub behind: u64,
+    /// The other lane's pending samples filled the selector's ring and the selected lane was
+    /// silent for the dead time.
+    pub ring_full: u64,
+    /// The selected lane aligning, invalid or too young while the other was trusted.
+    pub untrusted: u64,
+}
+
+impl From<rins_runtime::lane_selector::SwitchCounts> for LaneSwitchCauses {
+    fn from(c: rins_runtime::lane_selector::SwitchCounts) -> Self {
+        Self {
+            silent: c.silent,
+            behind: c.behind,
+            ring_full: c.ring_full,
+            untrusted: c.untrusted,
+        }
+    }
+}
+
 impl From<[u64; 3]> for IntegritySamples {
     fn from([ok, degraded, invalid]: [u64; 3]) -> Self {
         Self {
@@ -85,6 +110,10 @@ pub struct Summary {
     pub nav_lane_samples: [u64; 2],
     /// Switches between navigator lanes.
     pub nav_lane_switches: u64,
+    /// Those switches by cause.
+    pub nav_lane_switch_causes: LaneSwitchCauses,
+    /// The last switch and why, as the watchdog's log line said (`None` without switches).
+    pub nav_lane_last_switch: Option<String>,
     /// Samples of one lane filled in from the other.
     pub nav_lane_filled: u64,
     /// Navigation samples after alignment the navigator judged ok, degraded and invalid.

@@ -16,6 +16,17 @@ pub fn summary_text(s: &Summary) -> String {
             s.failed_services.join(", ")
         ));
     }
+    if s.nav_lane_switches > 0 {
+        let c = &s.nav_lane_switch_causes;
+        let last = s
+            .nav_lane_last_switch
+            .as_deref()
+            .map_or_else(String::new, |l| format!("; last {l}"));
+        out.push_str(&format!(
+            "  navigation lane switches: {} (silent {}, behind {}, ring full {}, untrusted {}){last}\n",
+            s.nav_lane_switches, c.silent, c.behind, c.ring_full, c.untrusted
+        ));
+    }
     if !s.processes.is_empty() {
         let peak: u64 = s.processes.iter().map(|p| p.peak_rss_kib).sum();
         out.push_str(&format!(
@@ -118,6 +129,8 @@ mod tests {
             restart_to_publish_ms_by_service: Vec::new(),
             nav_lane_samples: [0, 0],
             nav_lane_switches: 0,
+            nav_lane_switch_causes: Default::default(),
+            nav_lane_last_switch: None,
             nav_lane_filled: 0,
             nav_integrity_samples: Default::default(),
             att_err_deg_rms: Some(1.5),
@@ -177,6 +190,31 @@ mod tests {
         let text = summary_text(&s);
         assert!(
             text.contains("horizontal end-point error: 0.20 m, 0.0 m travelled"),
+            "{text}"
+        );
+    }
+
+    /// Lane switches are a line with their causes and the last one, none without switches.
+    #[test]
+    fn lane_switches_are_counted_by_cause() {
+        assert!(!summary_text(&summary()).contains("lane switches"));
+        let s = Summary {
+            nav_lane_switches: 3,
+            nav_lane_switch_causes: crate::summary::LaneSwitchCauses {
+                silent: 2,
+                untrusted: 1,
+                ..Default::default()
+            },
+            nav_lane_last_switch: Some(
+                "lane 1 → 0 at seq 9: lane 1 aligning, lane 0 trusted".into(),
+            ),
+            ..summary()
+        };
+        let text = summary_text(&s);
+        assert!(
+            text.contains(
+                "navigation lane switches: 3 (silent 2, behind 0, ring full 0, untrusted 1); last lane 1 → 0 at seq 9: lane 1 aligning, lane 0 trusted\n"
+            ),
             "{text}"
         );
     }

@@ -7,6 +7,7 @@
 //!   isolation, and the attitude error while the navigator's integrity said ok.
 //! - [`fdi`]: fault detection and isolation on the real quadrotor recordings (false alarms, and
 //!   faults injected into the data).
+//! - [`data`]: where each recorded data set is published and how it becomes the layout read here.
 //! - [`datasets`]: loaders of recorded data sets (the four-IMU quadrotor flights).
 //! - [`integrity_tally`]: the share of a recording the navigator judged ok, degraded, invalid.
 //! - [`import`]: the public recordings as rins's own (raw IMU counts, truth, configuration).
@@ -15,6 +16,7 @@
 //!   alone and the units fused.
 //! - [`stats`]: mean, 2σ and RMS helpers.
 
+pub mod data;
 pub mod datasets;
 pub mod fault_sweep;
 pub mod fdi;

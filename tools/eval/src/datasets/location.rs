@@ -24,7 +24,7 @@ pub fn recording_set(name: &str) -> Option<PathBuf> {
         Some(dir)
     } else {
         eprintln!(
-            "note: {} not found (set {RECORDINGS_DIR_ENV}); test skipped",
+            "note: {} not found (`rins data fetch {name}` downloads it, or set {RECORDINGS_DIR_ENV}); test skipped",
             dir.display()
         );
         None

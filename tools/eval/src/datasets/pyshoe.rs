@@ -49,7 +49,7 @@ pub fn list_trials(dir: &Path) -> Result<Vec<PathBuf>, DatasetError> {
     let entries = std::fs::read_dir(dir).map_err(|source| match source.kind() {
         std::io::ErrorKind::NotFound => DatasetError::MissingFile {
             path: dir.to_path_buf(),
-            what: "pyshoe data directory",
+            what: "pyshoe data directory; `rins data fetch pyshoe-vicon` downloads it",
         },
         _ => DatasetError::Io {
             path: dir.to_path_buf(),

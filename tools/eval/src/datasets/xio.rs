@@ -50,7 +50,7 @@ fn sample_from_row(r: &[f64; 7]) -> FootSample {
 
 /// Loads one walk; the peer figure is looked up by the file stem.
 pub fn load_walk(path: &Path) -> Result<FootTrial, DatasetError> {
-    let text = read_text(path, "x-io walk")?;
+    let text = read_text(path, "x-io walk; `rins data fetch xio-gait` downloads it")?;
     parse_walk(path, &text)
 }
 

@@ -94,8 +94,9 @@ pub fn evaluate(request: &FdiRequest, progress: &mut dyn FnMut(usize, usize)) ->
     let dir = &request.dir;
     if !dir.is_dir() {
         return Err(anyhow!(
-            "eval fdi: data set directory {} does not exist or is not a directory",
-            dir.display()
+            "eval fdi: data set directory {} does not exist or is not a directory; {}",
+            dir.display(),
+            crate::data::fetch_hint(dir)
         ));
     }
     let entries = list_trials(dir)

@@ -168,8 +168,9 @@ pub fn require_data_dir(dir: &Path) -> Result<()> {
         Ok(())
     } else {
         Err(anyhow!(
-            "eval quadrotor: data set directory {} does not exist or is not a directory",
-            dir.display()
+            "eval quadrotor: data set directory {} does not exist or is not a directory; {}",
+            dir.display(),
+            crate::data::fetch_hint(dir)
         ))
     }
 }
