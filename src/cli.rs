@@ -4,6 +4,22 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+mod capture_args;
+mod data_args;
+mod eval_args;
+
+pub use capture_args::{
+    BenchCommand, BenchIpcArgs, BenchRatesArgs, LatencyArgs, RecordArgs, ReplayArgs,
+};
+pub use data_args::{
+    CalibrateCommand, CalibrateMagArgs, DataCommand, DataFetchArgs, DataListArgs, ImportArgs,
+    ImportCommand,
+};
+pub use eval_args::{
+    EvalCommand, EvalFdiArgs, EvalProfileArgs, EvalPyshoeArgs, EvalQuadrotorArgs, EvalXioArgs,
+    FootMethodArg, QuadrotorMode, SweepArgs,
+};
+
 #[derive(Debug, Parser)]
 #[command(
     name = "rins",
@@ -17,35 +33,43 @@ pub struct Cli {
     pub command: Command,
 }
 
+/// `rins service NAME`: the service and where its configuration comes from.
+#[derive(Debug, Args)]
+pub struct ServiceArgs {
+    /// The service to run.
+    pub name: ServiceName,
+    /// Configuration file (default: the built-in configuration).
+    #[arg(long, conflicts_with = "resolved_config")]
+    pub config: Option<PathBuf>,
+    /// The whole configuration of a deployment, as `rins up` resolved it (its file, the command
+    /// line and the defaults) into a private file: read as it is, with nothing applied on top.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["port", "mavlink", "gnss", "imu_rate", "realtime"])]
+    pub resolved_config: Option<PathBuf>,
+    /// Serial device for acquisition, or for the gnss service its receiver (overrides
+    /// acquisition.port or gnss.port).
+    #[arg(long)]
+    pub port: Option<String>,
+    /// MAVLink endpoint for the mavlink service (overrides mavlink.endpoints).
+    #[arg(long, value_name = "ENDPOINT")]
+    pub mavlink: Option<String>,
+    /// A GNSS receiver is fitted: turns on `[gnss]`, `[navigator.gnss]` and `[sim.gnss]`.
+    #[arg(long)]
+    pub gnss: bool,
+    /// IMU sample rate, Hz (overrides device.imu_rate_hz).
+    #[arg(long, value_name = "HZ")]
+    pub imu_rate: Option<f64>,
+    /// Ask for the `[realtime]` settings (as `realtime.enabled = true`).
+    #[arg(long)]
+    pub realtime: bool,
+}
+
 /// The subcommands: one per process kind and tool.
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Start the whole pipeline (simulator unless --port, every service) under the watchdog.
     Up(UpArgs),
     /// Run one service in this process (the watchdog starts each service this way).
-    Service {
-        /// The service to run.
-        name: ServiceName,
-        /// Configuration file (default: the built-in configuration).
-        #[arg(long)]
-        config: Option<PathBuf>,
-        /// Serial device for acquisition, or for the gnss service its receiver (overrides
-        /// acquisition.port or gnss.port).
-        #[arg(long)]
-        port: Option<String>,
-        /// MAVLink endpoint for the mavlink service (overrides mavlink.endpoints).
-        #[arg(long, value_name = "ENDPOINT")]
-        mavlink: Option<String>,
-        /// A GNSS receiver is fitted: turns on `[gnss]`, `[navigator.gnss]` and `[sim.gnss]`.
-        #[arg(long)]
-        gnss: bool,
-        /// IMU sample rate, Hz (overrides device.imu_rate_hz).
-        #[arg(long, value_name = "HZ")]
-        imu_rate: Option<f64>,
-        /// Ask for the `[realtime]` settings (as `realtime.enabled = true`).
-        #[arg(long)]
-        realtime: bool,
-    },
+    Service(ServiceArgs),
     /// Run the device simulator on a pseudo-terminal.
     Sim(SimArgs),
     /// Randomised faults under a running pipeline (SIGKILLs, hangs, sensor-channel faults, serial
@@ -166,230 +190,6 @@ pub enum Command {
     },
 }
 
-/// The calibrations `rins calibrate` fits.
-#[derive(Debug, Subcommand)]
-pub enum CalibrateCommand {
-    /// Magnetometer hard and soft iron from samples taken while the vehicle is turned through many
-    /// orientations; prints the fit and a `[navigator.mag_calibration]` configuration fragment.
-    Mag(CalibrateMagArgs),
-}
-
-/// Options of `rins calibrate mag`.
-#[derive(Debug, Args)]
-pub struct CalibrateMagArgs {
-    /// CSV file: the output of `rins echo raw-mag --csv`, or a `mx_ut,my_ut,mz_ut` header and rows.
-    pub file: PathBuf,
-    /// Local field magnitude, µT (default: mean magnitude of the samples once the hard iron is
-    /// removed).
-    #[arg(long, allow_negative_numbers = true)]
-    pub field_ut: Option<f64>,
-    /// One JSON object on stdout instead of the summary.
-    #[arg(long)]
-    pub json: bool,
-}
-
-/// What `rins data` does.
-#[derive(Debug, Subcommand)]
-pub enum DataCommand {
-    /// Clone each set's public git repository (one commit, only the files used) into
-    /// DIR/.sources, convert it into the layout the evaluations read and write a PROVENANCE note
-    /// beside it (source, commit, licence, what was converted, where the peer figures come
-    /// from); a set already complete is left as it is.
-    Fetch(DataFetchArgs),
-    /// Which data sets are present in the recordings directory, which are incomplete or missing.
-    List(DataListArgs),
-}
-
-/// Options of `rins data fetch`.
-#[derive(Debug, Args)]
-pub struct DataFetchArgs {
-    /// The sets to fetch: quadrotor-4imu, pyshoe-vicon, xio-gait (default: all).
-    #[arg(value_name = "SET")]
-    pub sets: Vec<String>,
-    /// Recordings directory (default: $RINS_DATA_DIR, else data/ at the top of the repository).
-    #[arg(long)]
-    pub dir: Option<PathBuf>,
-    /// Fetch SET from another git repository (a mirror or a local copy) instead of its
-    /// published one; repeatable.
-    #[arg(long = "source", value_name = "SET=URL")]
-    pub sources: Vec<String>,
-    /// Clone the source again and build the set again even when it is complete, replacing its
-    /// directory.
-    #[arg(long)]
-    pub force: bool,
-}
-
-/// Options of `rins data list`.
-#[derive(Debug, Args)]
-pub struct DataListArgs {
-    /// Recordings directory (default: $RINS_DATA_DIR, else data/ at the top of the repository).
-    #[arg(long)]
-    pub dir: Option<PathBuf>,
-    /// One JSON object instead of the table.
-    #[arg(long)]
-    pub json: bool,
-}
-
-/// The data sets `rins import` converts.
-#[derive(Debug, Subcommand)]
-pub enum ImportCommand {
-    /// The four-IMU quadrotor flights (`<group>/path_<N>/IMU_k.csv`, `GT.csv`): one redundant
-    /// block of every unit's triads, UAV profile, started in the air from the truth.
-    Quadrotor(ImportArgs),
-    /// The pyshoe foot-mounted walks (`*.csv` with the Vicon position), pedestrian profile.
-    Pyshoe(ImportArgs),
-}
-
-/// Options of `rins import`.
-#[derive(Debug, Args)]
-pub struct ImportArgs {
-    /// Directory of the data set.
-    pub dir: PathBuf,
-    /// Output directory: `<run>.mcap`, `<run>.toml` (configuration) and `<run>.json` (clock
-    /// offsets, repairs, scales) per run, a flight's under its group directory.
-    pub out: PathBuf,
-    /// Replace output files that already exist (refused otherwise).
-    #[arg(long)]
-    pub force: bool,
-    /// End with one JSON object instead of the summary.
-    #[arg(long)]
-    pub json: bool,
-}
-
-/// The evaluations on recorded data `rins eval` runs.
-#[derive(Debug, Subcommand)]
-pub enum EvalCommand {
-    /// Fault detection and isolation on the four-IMU quadrotor recordings: false alarms without
-    /// faults, then detection and isolation of faults injected into the real data.
-    Fdi(EvalFdiArgs),
-    /// Foot-mounted walks with Vicon truth: 2-D position RMSE per trial, pedestrian profile.
-    Pyshoe(EvalPyshoeArgs),
-    /// Foot-mounted closed-loop walks: end-point error, m and % of distance, pedestrian profile.
-    Xio(EvalXioArgs),
-    /// Quadrotor flights, free inertial from the truth at the start: roll/pitch RMSE and height
-    /// error of each IMU alone and of the four fused, UAV profile.
-    Quadrotor(EvalQuadrotorArgs),
-}
-
-/// What `rins eval quadrotor` runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum QuadrotorMode {
-    /// Free-inertial from the reference at t0: no aiding at all.
-    Free,
-    /// The navigator's tilt updates (AHRS), cross-validated leave-one-flight-out, beside each
-    /// unit alone and each unit's own on-board filter.
-    Ahrs,
-    /// GNSS-aided from a standard receiver made from the reference (5 Hz, σ 1.5 m / 3 m /
-    /// 0.1 m/s): attitude, heading and position errors, receiver rejections.
-    Gnss,
-    /// As `gnss` with the receiver cut for the last 10 s: the horizontal error at the end of
-    /// the outage, the fused units against each unit alone.
-    Outage,
-}
-
-/// Options of `rins eval quadrotor`.
-#[derive(Debug, Args)]
-pub struct EvalQuadrotorArgs {
-    /// Data set directory (holding `<group>/path_<N>/IMU_k.csv` and `GT.csv`).
-    pub dir: PathBuf,
-    /// What to run.
-    #[arg(long, value_enum, default_value = "free")]
-    pub mode: QuadrotorMode,
-    /// With `--mode ahrs`: run each flight's scored fused solution again through the running
-    /// processes (fusion and the navigator lanes, a private deployment per flight) and report
-    /// their figures beside the in-process ones.
-    #[arg(long)]
-    pub live: bool,
-    /// Output format and navigator profile.
-    #[command(flatten)]
-    pub common: EvalProfileArgs,
-}
-
-/// The estimator a foot-mounted evaluation shows.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum FootMethodArg {
-    /// The navigator with the pedestrian profile.
-    Rins,
-    /// The peer's published method: SHOE detector and zero-velocity EKF, one threshold for all
-    /// trials.
-    Reference,
-}
-
-/// Options of `rins eval pyshoe`.
-#[derive(Debug, Args)]
-pub struct EvalPyshoeArgs {
-    /// Directory of trials (`*.csv`, with the peer's figures in a `.json` beside each).
-    pub dir: PathBuf,
-    /// The estimator whose figures, means and plots are shown (both are always run).
-    #[arg(long, value_enum, default_value = "rins")]
-    pub method: FootMethodArg,
-    /// Write one PNG per trial into this directory.
-    #[arg(long, value_name = "DIR")]
-    pub plot: Option<PathBuf>,
-    /// Run each trial's held-out rins run again through the running processes (fusion and the
-    /// navigator lanes, a private deployment per trial) and report their figures beside the
-    /// in-process ones.
-    #[arg(long)]
-    pub live: bool,
-    /// Output format and navigator profile.
-    #[command(flatten)]
-    pub common: EvalProfileArgs,
-}
-
-/// Options of `rins eval xio`.
-#[derive(Debug, Args)]
-pub struct EvalXioArgs {
-    /// Walk files (`Time (s),Gyroscope X (deg/s),…` CSV).
-    #[arg(required = true)]
-    pub files: Vec<PathBuf>,
-    /// The estimator evaluated.
-    #[arg(long, value_enum, default_value = "rins")]
-    pub method: FootMethodArg,
-    /// Write one PNG per walk into this directory.
-    #[arg(long, value_name = "DIR")]
-    pub plot: Option<PathBuf>,
-    /// Output format and navigator profile.
-    #[command(flatten)]
-    pub common: EvalProfileArgs,
-}
-
-/// Options the navigation evaluations share: output format and navigator profile.
-#[derive(Debug, Args)]
-pub struct EvalProfileArgs {
-    /// One JSON object on stdout instead of a table.
-    #[arg(long)]
-    pub json: bool,
-    /// Profile configuration file (its `[navigator]` settings are used; default: the command's
-    /// built-in profile, config/pedestrian.toml for pyshoe and xio, config/uav.toml for
-    /// quadrotor).
-    #[arg(long)]
-    pub profile: Option<PathBuf>,
-}
-
-/// Options of `rins eval fdi`.
-#[derive(Debug, Args)]
-pub struct EvalFdiArgs {
-    /// Data set directory (holding `<group>/path_<N>/IMU_k.csv`).
-    pub dir: PathBuf,
-    /// One JSON object on stdout instead of tables.
-    #[arg(long)]
-    pub json: bool,
-    /// Configuration file (its `[fusion.fdi]` settings are used, except those the evaluation
-    /// chooses by cross-validation: false-alarm probability, noise, motion noise, timing skew,
-    /// noise-outlier ratio; geometry is the evaluation's).
-    #[arg(long)]
-    pub config: Option<PathBuf>,
-    /// Only trials whose name contains this text, e.g. `Horizontal/path_1`. Repeatable.
-    #[arg(long = "trial", value_name = "NAME")]
-    pub trials: Vec<String>,
-    /// Also draw the cross-validated ROC into this PNG file.
-    #[arg(long, value_name = "FILE.png")]
-    pub plot: Option<PathBuf>,
-    /// Worker threads (default: the machine's cores).
-    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=256))]
-    pub threads: Option<u16>,
-}
-
 /// Options of `rins mc`.
 #[derive(Debug, Args)]
 pub struct McArgs {
@@ -415,34 +215,6 @@ pub struct McArgs {
     /// Simulator scenario both blocks fly (default: uav, whatever the configuration names).
     #[arg(long)]
     pub scenario: Option<ScenarioArg>,
-}
-
-/// Options of `rins sweep`.
-#[derive(Debug, Args)]
-pub struct SweepArgs {
-    /// Configuration file whose sim, fusion, altimeter and navigator settings are swept (default:
-    /// the built-in configuration); the `uav` scenario is flown whatever it names.
-    #[arg(long)]
-    pub config: Option<PathBuf>,
-    /// Simulator seed of every run (default: sim.seed).
-    #[arg(long)]
-    pub seed: Option<u64>,
-    /// Injection time, s of device time; repeat for several (default: 8 and 120, the ground roll
-    /// and the first turn).
-    #[arg(long = "at", value_name = "S", allow_negative_numbers = true)]
-    pub at: Vec<f64>,
-    /// Flight after each injection, s (default 45).
-    #[arg(long, value_name = "S", allow_negative_numbers = true)]
-    pub window: Option<f64>,
-    /// Only this channel (gyro0 … accel3); repeat for several (default: every channel).
-    #[arg(long, value_name = "CHANNEL")]
-    pub channel: Vec<String>,
-    /// Worker threads (default 2).
-    #[arg(long)]
-    pub threads: Option<usize>,
-    /// One JSON object on stdout instead of the table.
-    #[arg(long)]
-    pub json: bool,
 }
 
 /// A service `rins service` can run.
@@ -637,8 +409,12 @@ pub struct SimArgs {
     #[arg(long, value_name = "HZ")]
     pub imu_rate: Option<f64>,
     /// Configuration file (default: the built-in configuration).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "resolved_config")]
     pub config: Option<PathBuf>,
+    /// The whole configuration of a deployment, as `rins up` resolved it into a private file:
+    /// read as it is, with no scenario, seed or rate applied on top.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["scenario", "seed", "imu_rate"])]
+    pub resolved_config: Option<PathBuf>,
     /// Also make this path a symbolic link to the pseudo-terminal (replaced if it exists).
     #[arg(long)]
     pub link: Option<PathBuf>,
@@ -743,147 +519,4 @@ mod tests {
         assert!(matches!(mc.command, super::Command::Mc(_)));
         assert!(Cli::try_parse_from(["rins", "up", "--scenario", "quadcopter"]).is_err());
     }
-}
-
-/// `rins record FILE`.
-#[derive(Debug, Args)]
-pub struct RecordArgs {
-    /// The MCAP file to write (refused if it exists, unless --overwrite).
-    #[arg(required_unless_present = "dir", conflicts_with = "dir")]
-    pub file: Option<PathBuf>,
-    /// Record into numbered files in this directory instead, a new one each --max-file-mb, the
-    /// oldest of rins's own deleted past --max-total-mb (as `[record]` of `rins up`).
-    #[arg(long, value_name = "DIR")]
-    pub dir: Option<PathBuf>,
-    /// With --dir: a file this large, MB, is closed and the next one started (default 256).
-    #[arg(long, value_name = "MB", requires = "dir")]
-    pub max_file_mb: Option<u64>,
-    /// With --dir: the most rins's own recordings in DIR may take together, MB (default 2048).
-    #[arg(long, value_name = "MB", requires = "dir")]
-    pub max_total_mb: Option<u64>,
-    /// Comma-separated short names of the topics to record (default: all): raw-imu, raw-baro,
-    /// raw-mag, raw-aux, fused-imu, altitude, nav, nav-standby, truth, health, heartbeat, fault,
-    /// sim-control, fusion-control, fusion-reply.
-    #[arg(long, value_delimiter = ',')]
-    pub topics: Vec<String>,
-    /// Stop after this many seconds.
-    #[arg(long, allow_negative_numbers = true)]
-    pub duration: Option<f64>,
-    /// Replace FILE if it exists (a symbolic link is replaced, never followed).
-    #[arg(long)]
-    pub overwrite: bool,
-    /// Print one JSON summary object as the last line (`samples_written`, `samples_dropped`, ...).
-    #[arg(long)]
-    pub json: bool,
-    /// Create this file once every topic is subscribed (for `rins up --record`).
-    #[arg(long, hide = true)]
-    pub ready_file: Option<PathBuf>,
-}
-
-/// `rins replay FILE`.
-#[derive(Debug, Args)]
-pub struct ReplayArgs {
-    /// The MCAP file (`rins record`, `rins up --record`).
-    pub file: PathBuf,
-    /// Replay at this multiple of the recorded pace (default 1).
-    #[arg(
-        long,
-        allow_negative_numbers = true,
-        conflicts_with = "as_fast_as_possible"
-    )]
-    pub speed: Option<f64>,
-    /// Replay as fast as the pipeline takes it (paced by its output, never losing a sample).
-    #[arg(long)]
-    pub as_fast_as_possible: bool,
-    /// Run the services' library code in this process, without IPC, for batch analysis.
-    #[arg(long)]
-    pub offline: bool,
-    /// Configuration file of the replaying deployment (default: the built-in configuration).
-    #[arg(long)]
-    pub config: Option<PathBuf>,
-    /// Print one JSON summary object as the last line (`nav_samples_compared`,
-    /// `nav_samples_different`, ...).
-    #[arg(long)]
-    pub json: bool,
-}
-
-/// `rins latency`.
-#[derive(Debug, Args)]
-pub struct LatencyArgs {
-    /// How long to measure, s.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 5.0)]
-    pub seconds: f64,
-    /// One JSON object instead of the table.
-    #[arg(long)]
-    pub json: bool,
-    /// Also write every sample's path as Chrome Trace Event JSON (opens in the Perfetto UI): one
-    /// track per process, one flow arrow per sample from serial receive to this consumer.
-    #[arg(long, value_name = "FILE.json")]
-    pub trace: Option<PathBuf>,
-    /// Also write HDR histogram interval logs, one histogram per hop and interval (ns).
-    #[arg(long, value_name = "FILE")]
-    pub hdr: Option<PathBuf>,
-    /// Length of one HDR log interval, s.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0)]
-    pub hdr_interval: f64,
-    /// Replace the trace or HDR file if it exists (a symbolic link is replaced, never followed).
-    #[arg(long)]
-    pub overwrite: bool,
-}
-
-/// `rins bench` benchmarks.
-#[derive(Debug, Subcommand)]
-pub enum BenchCommand {
-    /// Every IPC hop of the pipeline against the bare iceoryx2 hop with the same payload, the
-    /// same service settings and the same wait strategy, measured in one invocation.
-    Ipc(BenchIpcArgs),
-    /// The pipeline at each IMU rate: a fault-free run (false alarms, drops, CPU, end-to-end
-    /// latency) and runs with injected faults (detected, isolated, how fast); one JSON row per
-    /// rate with --json.
-    Rates(BenchRatesArgs),
-    /// The receiving process of the bare hops (started by `rins bench ipc`).
-    #[command(hide = true)]
-    IpcReceiver {
-        /// Longest wait for a phase to end, s.
-        #[arg(long, default_value_t = 60.0)]
-        phase_limit: f64,
-    },
-}
-
-/// `rins bench rates`.
-#[derive(Debug, Args)]
-pub struct BenchRatesArgs {
-    /// IMU rates, Hz, comma-separated.
-    #[arg(
-        long,
-        value_delimiter = ',',
-        default_values_t = [100.0, 250.0, 500.0, 1000.0, 2000.0, 4000.0, 8000.0]
-    )]
-    pub rates: Vec<f64>,
-    /// Length of each `rins up` run (device time), s.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 25.0)]
-    pub duration: f64,
-    /// Configuration file (default: the built-in configuration).
-    #[arg(long)]
-    pub config: Option<PathBuf>,
-    /// One JSON object per rate, one per line, instead of the table.
-    #[arg(long)]
-    pub json: bool,
-}
-
-/// `rins bench ipc`.
-#[derive(Debug, Args)]
-pub struct BenchIpcArgs {
-    /// Length of each measurement (each bare payload, then the pipeline), s.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 10.0)]
-    pub seconds: f64,
-    /// Sample rate of the bare hops and of the pipeline's IMU, Hz.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 1000.0)]
-    pub rate: f64,
-    /// Time the pipeline runs after its first navigation output before it is measured, s.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 5.0)]
-    pub warmup: f64,
-    /// One JSON object as the last line of stdout instead of the table.
-    #[arg(long)]
-    pub json: bool,
 }

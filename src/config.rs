@@ -17,6 +17,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::cli::ScenarioArg;
 
+pub mod resolved;
 mod retired;
 
 /// The IMU rates `device.imu_rate_hz` (and `--imu-rate`) accepts, Hz: from a slow block to what

@@ -135,25 +135,32 @@ fn flag_tables() -> [(&'static str, &'static str, BitNames); 6] {
     ]
 }
 
-/// Every topic name, as the Python constant it becomes.
-const TOPIC_CONSTANTS: [(&str, &str); 16] = [
-    ("RAW_IMU", names::RAW_IMU),
-    ("RAW_BARO", names::RAW_BARO),
-    ("RAW_MAG", names::RAW_MAG),
-    ("RAW_AUX", names::RAW_AUX),
-    ("GNSS", names::GNSS),
-    ("FUSED_IMU", names::FUSED_IMU),
-    ("ALTITUDE", names::ALTITUDE),
-    ("NAV_STATE", names::NAV_LANES[0]),
-    ("NAV_STATE_STANDBY", names::NAV_LANES[1]),
-    ("TRUTH", names::TRUTH),
-    ("HEARTBEAT", names::HEARTBEAT),
-    ("HEALTH", names::HEALTH),
-    ("SIM_CONTROL", names::SIM_CONTROL),
-    ("SIM_FAULT_APPLIED", names::SIM_FAULT_APPLIED),
-    ("FUSION_CONTROL", names::FUSION_CONTROL),
-    ("FUSION_REPLY", names::FUSION_REPLY),
-];
+/// Every topic of the topic table, as the Python constant it becomes: the Rust constant's name.
+macro_rules! topic_constants {
+    ($($payload:ident ($kind:ident) { $(
+        $(#[$meta:meta])*
+        $constant:ident = $topic:literal
+            $(, echo $echo:literal)?
+            $(, record $short:literal at $rank:literal)?;
+    )+ })+) => {
+        vec![$($((stringify!($constant), names::$constant)),+),+]
+    };
+}
+
+/// The Python topic constants in the module's order: the table's, except that the simulator's
+/// commands come before its answers (the reverse of the payload order) as they always have.
+fn topic_constants() -> Vec<(&'static str, &'static str)> {
+    let mut constants = ipc_types::for_each_topic!(topic_constants);
+    let answer = constants
+        .iter()
+        .position(|(c, _)| *c == "SIM_FAULT_APPLIED");
+    let command = constants.iter().position(|(c, _)| *c == "SIM_CONTROL");
+    if let (Some(answer), Some(command)) = (answer, command) {
+        let moved = constants.remove(command);
+        constants.insert(answer, moved);
+    }
+    constants
+}
 
 fn render_struct(out: &mut String, layout: &StructLayout) {
     let _ = writeln!(out, "\n\nclass {}(ctypes.Structure):", layout.ros_name);
@@ -188,7 +195,8 @@ fn render() -> String {
         ipc_types::PAYLOAD_VERSION
     );
     out.push_str("\n# Topic names.\n");
-    for (constant, topic) in TOPIC_CONSTANTS {
+    let constants = topic_constants();
+    for (constant, topic) in &constants {
         let _ = writeln!(out, "{constant} = \"{topic}\"");
     }
     out.push_str("#: Both navigator lanes: primary, hot standby.\n");
@@ -256,7 +264,7 @@ fn render() -> String {
 
     out.push_str("\n\n#: The payload each topic carries.\nTOPIC_PAYLOADS = {\n");
     for (topic, layout) in TOPICS {
-        let constant = TOPIC_CONSTANTS
+        let constant = constants
             .iter()
             .find(|(_, t)| *t == topic)
             .map(|(c, _)| *c)

@@ -25,6 +25,7 @@ mod raw;
 mod truth;
 
 pub mod names;
+mod topic_table;
 
 pub use altitude::Altitude;
 pub use control::{

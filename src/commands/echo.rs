@@ -11,6 +11,7 @@ use ipc_types::{
 };
 use rins_runtime::ipc::{IpcNode, SampleSource, TopicSubscriber};
 use rins_runtime::nav_subscriber::NavSubscriber;
+use rins_runtime::payload::{OtherVersionWarning, Versioned};
 use rins_runtime::setup_guard::SetupGuard;
 use rins_runtime::shutdown::Shutdown;
 use rins_runtime::tool_node::ToolNode;
@@ -86,7 +87,13 @@ struct EchoOptions {
 
 fn echo_topic<T>(name: &'static str, opts: EchoOptions) -> Result<()>
 where
-    T: std::fmt::Debug + Copy + Readable + ReceivedAt + iceoryx2::prelude::ZeroCopySend + 'static,
+    T: std::fmt::Debug
+        + Copy
+        + Readable
+        + ReceivedAt
+        + Versioned
+        + iceoryx2::prelude::ZeroCopySend
+        + 'static,
 {
     echo_from(name, opts, |node| TopicSubscriber::<T>::new(node, name))
 }
@@ -152,6 +159,7 @@ where
         timeout,
     } = opts;
     let mut last_sample = Instant::now();
+    let mut version_warning = OtherVersionWarning::new();
     while !shutdown.requested() && count.is_none_or(|c| printed < c) {
         if let Some(limit) = timeout
             && last_sample.elapsed() > limit
@@ -185,6 +193,7 @@ where
                 break;
             }
         }
+        version_warning.check("echo", sub.rejected());
         out.flush()?;
     }
     Ok(())

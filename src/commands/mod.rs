@@ -19,6 +19,7 @@ mod probe;
 mod progress;
 mod readmit;
 mod record;
+mod record_report;
 mod replay;
 mod service;
 mod sim;
@@ -26,6 +27,7 @@ mod status;
 mod status_link;
 mod sweep;
 mod up;
+mod up_recording;
 
 use std::process::ExitCode;
 
@@ -41,24 +43,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             rins_runtime::logging::init("watchdog");
             up::run(&args)
         }
-        Command::Service {
-            name,
-            config,
-            port,
-            mavlink,
-            gnss,
-            imu_rate,
-            realtime,
-        } => service::run(
-            name,
-            config.as_deref(),
-            port,
-            mavlink,
-            gnss,
-            imu_rate,
-            realtime,
-        )
-        .map(|()| ExitCode::SUCCESS),
+        Command::Service(args) => service::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Sim(args) => {
             rins_runtime::logging::init("sim");
             sim::run(&args).map(|()| ExitCode::SUCCESS)

@@ -1,51 +1,52 @@
 //! `rins service NAME`: run one service in this process until SIGINT/SIGTERM.
 
-use std::path::Path;
-
 use anyhow::Result;
 use rins_runtime::ipc::IpcSettings;
 use rins_runtime::service::{Service, ServiceContext};
 use rins_runtime::shutdown::Shutdown;
 
-use crate::cli::ServiceName;
-use crate::config;
+use crate::cli::{ServiceArgs, ServiceName};
+use crate::config::{self, RinsConfig};
 
-/// Runs service `name` with the configuration at `config_path` (the built-in one when none) and,
-/// for acquisition (or the gnss service), the serial device `port`; for the MAVLink output, the
-/// endpoint `mavlink`; with `gnss`, a GNSS receiver fitted; `imu_rate` the block's sample rate; `realtime` turns `[realtime]` on.
-pub fn run(
-    name: ServiceName,
-    config_path: Option<&Path>,
-    port: Option<String>,
-    mavlink: Option<String>,
-    gnss: bool,
-    imu_rate: Option<f64>,
-    realtime: bool,
-) -> Result<()> {
-    let process = name.kind().name();
-    rins_runtime::logging::init(process);
-    let mut cfg = config::load(config_path)?;
-    if gnss {
+/// The configuration service `args.name` runs with: a deployment's resolved configuration as it
+/// is, or (run by hand) the file given (the built-in one when none) with the command line's
+/// overrides: for acquisition (or the gnss service) the serial device, for the MAVLink output the
+/// endpoint, a GNSS receiver fitted, the block's sample rate and `[realtime]` on.
+fn configuration(args: &ServiceArgs) -> Result<RinsConfig> {
+    if let Some(path) = &args.resolved_config {
+        return config::resolved::load(path);
+    }
+    let mut cfg = config::load(args.config.as_deref())?;
+    if args.gnss {
         cfg.enable_gnss();
     }
-    if let Some(hz) = imu_rate {
+    if let Some(hz) = args.imu_rate {
         cfg.set_imu_rate(hz)?;
     }
-    if realtime {
+    if args.realtime {
         cfg.realtime.enabled = true;
     }
-    // Before any thread or port exists: threads started later inherit the scheduling.
-    rins::realtime_config::apply_for(&cfg.realtime, process);
-    match (name, port) {
-        (ServiceName::Gnss, Some(port)) => cfg.gnss.port = Some(port),
-        (_, Some(port)) => cfg.acquisition.port = Some(port),
+    match (args.name, &args.port) {
+        (ServiceName::Gnss, Some(port)) => cfg.gnss.port = Some(port.clone()),
+        (_, Some(port)) => cfg.acquisition.port = Some(port.clone()),
         (_, None) => {}
     }
-    if let Some(endpoint) = mavlink {
-        cfg.mavlink.endpoints = vec![endpoint];
+    if let Some(endpoint) = &args.mavlink {
+        cfg.mavlink.endpoints = vec![endpoint.clone()];
         cfg.validate()
             .map_err(|e| anyhow::anyhow!("--mavlink: {e}"))?;
     }
+    Ok(cfg)
+}
+
+/// Runs service `args.name` with the configuration [`configuration`] gives.
+pub fn run(args: &ServiceArgs) -> Result<()> {
+    let name = args.name;
+    let process = name.kind().name();
+    rins_runtime::logging::init(process);
+    let cfg = configuration(args)?;
+    // Before any thread or port exists: threads started later inherit the scheduling.
+    rins::realtime_config::apply_for(&cfg.realtime, process);
     if name == ServiceName::Acquisition {
         // The serial protocol carries 12-bit counts.
         cfg.device.check_serial_link()?;

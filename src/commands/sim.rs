@@ -13,7 +13,10 @@ use crate::commands::fault_args;
 use crate::config;
 
 pub fn run(args: &SimArgs) -> Result<()> {
-    let mut cfg = config::load(args.config.as_deref())?;
+    let mut cfg = match &args.resolved_config {
+        Some(path) => config::resolved::load(path)?,
+        None => config::load(args.config.as_deref())?,
+    };
     if let Some(scenario) = args.scenario {
         cfg.set_scenario(scenario);
     }

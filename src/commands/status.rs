@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Result, bail};
 use ipc_types::{HealthReport, ServiceKind, ServiceState, names};
 use rins_runtime::ipc::TopicSubscriber;
+use rins_runtime::payload::OtherVersionWarning;
 use rins_runtime::setup_guard::SetupGuard;
 use rins_runtime::tool_node::ToolNode;
 use rins_watchdog::redundancy_view::{
@@ -160,14 +161,25 @@ pub fn run(json: bool, timeout_s: f64) -> Result<()> {
     let sub = TopicSubscriber::<HealthReport>::new(node, names::HEALTH)?;
     guard.disarm();
     let deadline = Instant::now() + Duration::from_secs_f64(timeout_s);
+    let mut version_warning = OtherVersionWarning::new();
     let report = loop {
         sub.wait(Duration::from_millis(50))?;
         let mut latest = None;
         while let Some(r) = sub.receive()? {
             latest = Some(r);
         }
+        version_warning.check("status", sub.rejected());
         if let Some(r) = latest {
             break r;
+        }
+        if Instant::now() >= deadline && sub.rejected() > 0 {
+            bail!(
+                "no health report of payload version {} within {timeout_s} s: {} of another \
+                 version dropped (is the pipeline on RINS_IPC_PREFIX {} of another build?)",
+                ipc_types::PAYLOAD_VERSION,
+                sub.rejected(),
+                settings.prefix
+            );
         }
         if Instant::now() >= deadline {
             bail!(

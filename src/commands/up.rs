@@ -28,7 +28,8 @@ use rins_watchdog::supervisor::{ChildSpec, Supervisor};
 
 use crate::cli::UpArgs;
 use crate::commands::fault_args;
-use crate::commands::record::{self, RecordingOutcome};
+use crate::commands::record;
+use crate::commands::up_recording::{self, RecordingOutcome};
 use crate::config::{self, RinsConfig};
 
 /// Applies the command line's overrides to the configuration and checks them.
@@ -63,6 +64,9 @@ fn apply_overrides(cfg: &mut RinsConfig, args: &UpArgs) -> Result<()> {
     }
     if args.gnss {
         cfg.enable_gnss();
+    }
+    if args.realtime {
+        cfg.realtime.enabled = true;
     }
     if cfg.gnss.enabled && args.port.is_some() && cfg.gnss.port.is_none() {
         bail!(
@@ -144,12 +148,13 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
             cfg.sim.gnss.enabled = true;
         }
     }
-    // Children read the same file (or the built-in configuration); command-line overrides travel as
-    // arguments.
-    let config_args: Vec<String> = match &args.config {
-        Some(path) => vec!["--config".into(), path.to_string_lossy().into_owned()],
-        None => Vec::new(),
-    };
+    // Resolved once, here: every child reads this file as it is, with nothing applied on top.
+    let resolved = config::resolved::write(&cfg, &run_dir)
+        .inspect_err(|_| settings.remove_iceoryx_config_file())?;
+    let resolved_args = [
+        "--resolved-config".to_string(),
+        resolved.to_string_lossy().into_owned(),
+    ];
     let port = cfg.acquisition.port.clone().unwrap_or_default();
 
     let exe = std::env::current_exe().context("cannot locate the rins executable")?;
@@ -181,27 +186,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
             }
             let name = kind.name();
             let mut child_args = vec!["service".to_string(), name.to_string()];
-            child_args.extend(config_args.iter().cloned());
-            if kind == ServiceKind::Acquisition {
-                child_args.extend(["--port".to_string(), port.clone()]);
-            }
-            if args.gnss {
-                child_args.push("--gnss".to_string());
-            }
-            child_args.extend(imu_rate_args(args));
-            if args.realtime {
-                child_args.push("--realtime".to_string());
-            }
-            if kind == ServiceKind::Gnss
-                && let Some(gnss_port) = &cfg.gnss.port
-            {
-                child_args.extend(["--port".to_string(), gnss_port.clone()]);
-            }
-            if kind == ServiceKind::Mavlink
-                && let Some(endpoint) = &args.mavlink
-            {
-                child_args.extend(["--mavlink".to_string(), endpoint.clone()]);
-            }
+            child_args.extend(resolved_args.iter().cloned());
             supervisor.start(ChildSpec {
                 name: name.to_string(),
                 program: exe.clone(),
@@ -218,7 +203,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
             supervisor.start(ChildSpec {
                 name: ServiceKind::Simulator.name().into(),
                 program: exe.clone(),
-                args: sim_args(&cfg, &config_args, &link, &gnss_link, args),
+                args: sim_args(&cfg, &resolved_args, &link, &gnss_link, args),
                 policy: cfg.watchdog.policy_for(ServiceKind::Simulator.name()),
                 stops_last: true,
             })?;
@@ -251,6 +236,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
         .zip(record_target.as_ref())
         .map(|(child, target)| stop_recorder(child, target.path()));
     settings.remove_iceoryx_config_file();
+    let _ = std::fs::remove_file(&resolved);
     // Drain what the children published while stopping, then release our own ports.
     let _ = monitor.drain();
     let summary = summarise(&monitor, &supervisor, &timing, started.elapsed(), simulate);
@@ -269,7 +255,10 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
         ..summary
     };
     if args.json {
-        println!("{}", record::summary_json(&summary, recording.as_ref())?);
+        println!(
+            "{}",
+            up_recording::summary_json(&summary, recording.as_ref())?
+        );
     } else {
         // A run ends with what it measured, whether its duration ended or it was stopped by a
         // signal (Ctrl-C on an interactive run).
@@ -325,7 +314,7 @@ fn start_recorder(
         .stdout(std::process::Stdio::piped())
         .spawn()
         .with_context(|| format!("cannot start the recorder for {}", file.display()))?;
-    let waited = record::wait_until_ready(&mut child, &ready, file, shutdown, RECORDER_START);
+    let waited = up_recording::wait_until_ready(&mut child, &ready, file, shutdown, RECORDER_START);
     let _ = std::fs::remove_file(&ready);
     if let Err(e) = waited {
         let _ = child.kill();
@@ -347,33 +336,19 @@ fn stop_recorder(child: std::process::Child, file: &Path) -> RecordingOutcome {
     }
 }
 
-/// `--imu-rate HZ` for a child when the run has one: the simulator and every stage agree on it.
-fn imu_rate_args(up: &UpArgs) -> Vec<String> {
-    up.imu_rate
-        .map(|hz| vec!["--imu-rate".to_string(), hz.to_string()])
-        .unwrap_or_default()
-}
-
-/// The simulator's command line: the scenario, seed and faults of this run, and its terminal
-/// links (the GNSS receiver's when one is simulated).
+/// The simulator's command line: the run's resolved configuration (its scenario, seed and rate
+/// included), the faults of this run, and its terminal links (the GNSS receiver's when one is
+/// simulated).
 fn sim_args(
     cfg: &RinsConfig,
-    config_args: &[String],
+    resolved_args: &[String],
     link: &Path,
     gnss_link: &Path,
     up: &UpArgs,
 ) -> Vec<String> {
     let mut args = vec!["sim".to_string()];
-    args.extend(config_args.iter().cloned());
-    args.extend(imu_rate_args(up));
-    args.extend([
-        "--scenario".to_string(),
-        cfg.scenario_name().to_string(),
-        "--seed".to_string(),
-        cfg.sim.seed.to_string(),
-        "--link".to_string(),
-        link.to_string_lossy().into_owned(),
-    ]);
+    args.extend(resolved_args.iter().cloned());
+    args.extend(["--link".to_string(), link.to_string_lossy().into_owned()]);
     if cfg.sim.gnss.enabled {
         args.extend([
             "--gnss-link".to_string(),

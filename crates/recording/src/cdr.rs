@@ -6,11 +6,6 @@
 //! of its size with explicit padding fields in the gaps (the layout tests prove it). So a message
 //! is the header followed by the payload's bytes, copied, with no per-field work on the hot path.
 
-use ipc_types::{
-    Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, GnssFix, Health, HealthReport,
-    NavState, RawAux, RawBaro, RawImu, RawMag, SimControl, Truth,
-};
-
 use crate::schema::{self, StructLayout};
 
 /// The CDR encapsulation header: plain CDR, little endian, no options. Payloads are in the host's
@@ -69,39 +64,26 @@ pub unsafe trait Recordable: Copy + 'static {
     }
 }
 
+/// Makes every payload of the topic table [`Recordable`].
 macro_rules! recordable {
-    ($($ty:ty => $layout:ident),+ $(,)?) => {$(
+    ($($payload:ident ($kind:ident) { $($topics:tt)* })+) => {$(
         // SAFETY: a `#[repr(C)]` payload of `ipc-types` made of integers, floats, arrays and
         // nested structs of those, with explicit padding fields; its layout is tested to have no
         // gap (`schema` tests).
-        unsafe impl Recordable for $ty {
+        unsafe impl Recordable for ipc_types::$payload {
             fn layout() -> &'static StructLayout {
-                &schema::$layout
+                schema::layout_of::<Self>()
             }
         }
     )+};
 }
 
-recordable! {
-    RawImu => RAW_IMU,
-    RawBaro => RAW_BARO,
-    RawMag => RAW_MAG,
-    RawAux => RAW_AUX,
-    GnssFix => GNSS_FIX,
-    FusedImu => FUSED_IMU,
-    Altitude => ALTITUDE,
-    NavState => NAV_STATE,
-    Truth => TRUTH,
-    Health => HEALTH,
-    HealthReport => HEALTH_REPORT,
-    FaultApplied => FAULT_APPLIED,
-    SimControl => SIM_CONTROL,
-    FusionControl => FUSION_CONTROL,
-    FusionReply => FUSION_REPLY,
-}
+ipc_types::for_each_topic!(recordable);
 
 #[cfg(test)]
 mod tests {
+    use ipc_types::Altitude;
+
     use super::*;
 
     #[test]
@@ -126,26 +108,20 @@ mod tests {
         assert_eq!(payload_of(&[0x00, 0x00, 0x00, 0x00, 1]), None);
     }
 
+    /// Checks every payload of the topic table.
+    macro_rules! check_every_payload {
+        ($($payload:ident ($kind:ident) { $($topics:tt)* })+) => {$(
+            check::<ipc_types::$payload>();
+        )+};
+    }
+
+    fn check<T: Recordable>() {
+        assert_eq!(T::layout().size, size_of::<T>());
+        assert_eq!(T::layout().align, align_of::<T>());
+    }
+
     #[test]
     fn every_recordable_has_its_own_layout() {
-        fn check<T: Recordable>() {
-            assert_eq!(T::layout().size, size_of::<T>());
-            assert_eq!(T::layout().align, align_of::<T>());
-        }
-        check::<RawImu>();
-        check::<RawBaro>();
-        check::<RawMag>();
-        check::<GnssFix>();
-        check::<RawAux>();
-        check::<FusedImu>();
-        check::<Altitude>();
-        check::<NavState>();
-        check::<Truth>();
-        check::<Health>();
-        check::<HealthReport>();
-        check::<FaultApplied>();
-        check::<SimControl>();
-        check::<FusionControl>();
-        check::<FusionReply>();
+        ipc_types::for_each_topic!(check_every_payload);
     }
 }

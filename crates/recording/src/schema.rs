@@ -382,25 +382,31 @@ layout! {
     }
 }
 
-/// Every top-level payload (each starts with `version`); the nested structs are reached through
-/// their fields.
-pub static PAYLOADS: [&StructLayout; 15] = [
-    &RAW_IMU,
-    &RAW_BARO,
-    &RAW_MAG,
-    &RAW_AUX,
-    &GNSS_FIX,
-    &FUSED_IMU,
-    &ALTITUDE,
-    &NAV_STATE,
-    &TRUTH,
-    &HEALTH,
-    &HEALTH_REPORT,
-    &FAULT_APPLIED,
-    &SIM_CONTROL,
-    &FUSION_CONTROL,
-    &FUSION_REPLY,
-];
+/// `T`'s layout: the one its [`FieldType`] impl (written by `layout!`) points to. Only for a
+/// struct with a layout; for a primitive it fails to compile where it is evaluated.
+pub const fn layout_of<T: FieldType>() -> &'static StructLayout {
+    match T::KIND {
+        FieldKind::Nested(layout) => layout,
+        FieldKind::Prim(_) => panic!("a primitive has no struct layout"),
+    }
+}
+
+/// Lists every payload of the topic table, in its order.
+macro_rules! payload_lists {
+    ($($payload:ident ($kind:ident) { $($topics:tt)* })+) => {
+        /// Every top-level payload (each starts with `version`); the nested structs are reached
+        /// through their fields.
+        pub static PAYLOADS: [&StructLayout; PAYLOAD_COUNT] = [$(layout_of::<$payload>()),+];
+
+        // A constant cannot read a static's fields, so the sizes are listed again from the types;
+        // a test checks the list against `PAYLOADS`.
+        const PAYLOAD_SIZES: [usize; PAYLOAD_COUNT] = [$(size_of::<$payload>()),+];
+
+        const PAYLOAD_COUNT: usize = [$(stringify!($payload)),+].len();
+    };
+}
+
+ipc_types::for_each_topic!(payload_lists);
 
 /// The largest payload, bytes: what a fixed buffer must hold to carry any of them.
 pub const MAX_PAYLOAD: usize = {
@@ -414,26 +420,6 @@ pub const MAX_PAYLOAD: usize = {
     }
     max
 };
-
-// A constant cannot read a static's fields, so the sizes are listed again from the types; a test
-// checks the list against `PAYLOADS`.
-const PAYLOAD_SIZES: [usize; 15] = [
-    size_of::<RawImu>(),
-    size_of::<RawBaro>(),
-    size_of::<RawMag>(),
-    size_of::<RawAux>(),
-    size_of::<GnssFix>(),
-    size_of::<FusedImu>(),
-    size_of::<Altitude>(),
-    size_of::<NavState>(),
-    size_of::<Truth>(),
-    size_of::<Health>(),
-    size_of::<HealthReport>(),
-    size_of::<FaultApplied>(),
-    size_of::<SimControl>(),
-    size_of::<FusionControl>(),
-    size_of::<FusionReply>(),
-];
 
 /// The top-level payload whose iceoryx2 type name is `type_name` (e.g. `rins::NavState`).
 pub fn payload_by_type_name(type_name: &str) -> Option<&'static StructLayout> {

@@ -4,26 +4,30 @@ use ipc_types::names;
 
 use crate::schema::{self, StructLayout};
 
-/// Every topic a recording may hold, with the layout of the payload it carries: the pipeline's
-/// outputs, both navigator lanes, supervision, and the commands with their answers.
-pub static TOPICS: [(&str, &StructLayout); 16] = [
-    (names::RAW_IMU, &schema::RAW_IMU),
-    (names::RAW_BARO, &schema::RAW_BARO),
-    (names::RAW_MAG, &schema::RAW_MAG),
-    (names::RAW_AUX, &schema::RAW_AUX),
-    (names::GNSS, &schema::GNSS_FIX),
-    (names::FUSED_IMU, &schema::FUSED_IMU),
-    (names::ALTITUDE, &schema::ALTITUDE),
-    (names::NAV_LANES[0], &schema::NAV_STATE),
-    (names::NAV_LANES[1], &schema::NAV_STATE),
-    (names::TRUTH, &schema::TRUTH),
-    (names::HEARTBEAT, &schema::HEALTH),
-    (names::HEALTH, &schema::HEALTH_REPORT),
-    (names::SIM_FAULT_APPLIED, &schema::FAULT_APPLIED),
-    (names::SIM_CONTROL, &schema::SIM_CONTROL),
-    (names::FUSION_CONTROL, &schema::FUSION_CONTROL),
-    (names::FUSION_REPLY, &schema::FUSION_REPLY),
-];
+/// Lists every topic of the topic table with its payload's layout.
+macro_rules! topic_layouts {
+    ($(
+        $payload:ident ($kind:ident) {
+            $(
+                $(#[$meta:meta])*
+                $constant:ident = $topic:literal
+                    $(, echo $echo:literal)?
+                    $(, record $short:literal at $rank:literal)?;
+            )+
+        }
+    )+) => {
+        /// Every topic a recording may hold, with the layout of the payload it carries: the
+        /// pipeline's outputs, both navigator lanes, supervision, and the commands with their
+        /// answers.
+        pub static TOPICS: [(&str, &StructLayout); TOPIC_COUNT] = [$($(
+            (names::$constant, schema::layout_of::<ipc_types::$payload>()),
+        )+)+];
+
+        const TOPIC_COUNT: usize = [$($(names::$constant),+),+].len();
+    };
+}
+
+ipc_types::for_each_topic!(topic_layouts);
 
 /// The layout of the payload published on `topic`, `None` for a topic rins does not publish.
 pub fn layout_of_topic(topic: &str) -> Option<&'static StructLayout> {

@@ -100,6 +100,12 @@ impl NavSubscriber {
         self.selector.selected()
     }
 
+    /// Samples of another payload version dropped from either lane since start (not in
+    /// [`NavSubscriber::lane_totals`]).
+    pub fn rejected(&self) -> u64 {
+        self.lanes.iter().map(TopicSubscriber::rejected).sum()
+    }
+
     /// Samples received from each lane since start.
     pub fn lane_totals(&self) -> [u64; LANES] {
         self.lane_totals
@@ -133,5 +139,9 @@ impl SampleSource<NavState> for NavSubscriber {
 
     fn receive(&mut self) -> Result<Option<NavState>, IpcError> {
         NavSubscriber::receive(self)
+    }
+
+    fn rejected(&self) -> u64 {
+        NavSubscriber::rejected(self)
     }
 }

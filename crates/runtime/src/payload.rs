@@ -1,10 +1,8 @@
-//! What the stage loop needs to know of a payload: the payload version it was written with (checked
-//! once, on receipt), and the header each stage stamps with its publish time.
+//! What the runtime needs to know of a payload: the payload version it was written with (checked
+//! once, on receipt, by every topic subscriber), and the header each stage stamps with its publish
+//! time.
 
-use ipc_types::{
-    Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, GnssFix, Header, NavState,
-    PAYLOAD_VERSION, RawAux, RawBaro, RawImu, RawMag, SimControl, Truth,
-};
+use ipc_types::{Header, PAYLOAD_VERSION};
 
 /// A payload that carries the [`PAYLOAD_VERSION`] of the build that wrote it.
 pub trait Versioned {
@@ -51,13 +49,74 @@ macro_rules! stamped {
     )*};
 }
 
-versioned!(FusionControl, FusionReply, SimControl, FaultApplied);
-stamped!(
-    RawImu, RawBaro, RawMag, RawAux, GnssFix, FusedImu, Altitude, NavState, Truth
-);
+/// A sample as received, told apart by its payload version.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Received<T> {
+    /// Written with this build's payload version.
+    Current(T),
+    /// Written with another payload version: already counted as rejected.
+    OtherVersion(T),
+}
+
+impl<T> Received<T> {
+    /// The sample, whatever its version.
+    pub fn payload(&self) -> &T {
+        match self {
+            Received::Current(s) | Received::OtherVersion(s) => s,
+        }
+    }
+}
+
+/// One warning per consumer the first time it has refused samples of another payload version
+/// (a process of another build on the deployment); the count itself goes with the consumer's
+/// counters. Called where the consumer reports its counters, not per sample.
+#[derive(Debug, Default)]
+pub struct OtherVersionWarning {
+    warned: bool,
+}
+
+impl OtherVersionWarning {
+    /// Nothing warned yet.
+    pub const fn new() -> Self {
+        Self { warned: false }
+    }
+
+    /// Warns once, when `rejected` (the consumer's total of samples of another payload version)
+    /// is first above zero.
+    pub fn check(&mut self, consumer: &str, rejected: u64) {
+        if rejected > 0 && !self.warned {
+            self.warned = true;
+            tracing::warn!(
+                consumer,
+                rejected,
+                expected_version = PAYLOAD_VERSION,
+                "samples of another payload version dropped (a process of another build on the \
+                 deployment?); further ones are counted, not logged"
+            );
+        }
+    }
+}
+
+/// Makes every payload of the topic table [`Versioned`], and those with the common header
+/// [`Stamped`].
+macro_rules! payload_traits {
+    ($($payload:ident ($kind:ident) { $($topics:tt)* })+) => {$(
+        payload_traits!(@$kind $payload);
+    )+};
+    (@stamped $payload:ident) => {
+        stamped!(ipc_types::$payload);
+    };
+    (@unstamped $payload:ident) => {
+        versioned!(ipc_types::$payload);
+    };
+}
+
+ipc_types::for_each_topic!(payload_traits);
 
 #[cfg(test)]
 mod tests {
+    use ipc_types::NavState;
+
     use super::*;
 
     #[test]
@@ -68,5 +127,16 @@ mod tests {
         assert!(!nav.is_current());
         nav.header_mut().origin_seq = 7;
         assert_eq!(nav.header.origin_seq, 7);
+    }
+
+    #[test]
+    fn the_other_version_warning_waits_for_a_refusal_and_comes_once() {
+        let mut warning = OtherVersionWarning::new();
+        warning.check("test", 0);
+        assert!(!warning.warned);
+        warning.check("test", 2);
+        assert!(warning.warned);
+        warning.check("test", 3);
+        assert!(warning.warned);
     }
 }

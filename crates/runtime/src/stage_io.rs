@@ -13,22 +13,7 @@ use crate::ipc::{IpcError, IpcNode, TopicPublisher, TopicSubscriber};
 use crate::payload::{Stamped, Versioned};
 
 /// A sample as [`StageInput::receive`] hands it over.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Received<T> {
-    /// Written with this build's payload version.
-    Current(T),
-    /// Written with another payload version: already counted in [`Health::rejected`].
-    OtherVersion(T),
-}
-
-impl<T> Received<T> {
-    /// The sample, whatever its version.
-    pub fn payload(&self) -> &T {
-        match self {
-            Received::Current(s) | Received::OtherVersion(s) => s,
-        }
-    }
-}
+pub use crate::payload::Received;
 
 /// A topic a stage reads.
 pub struct StageInput<T: Debug + ZeroCopySend + 'static> {
@@ -43,17 +28,15 @@ impl<T: Versioned + Debug + ZeroCopySend + Copy + 'static> StageInput<T> {
         })
     }
 
-    /// The next sample, if one is queued. One written with another payload version is counted in
-    /// `counters.rejected` here, the one place the version is checked.
+    /// The next sample, if one is queued. One written with another payload version (told apart by
+    /// the topic's subscriber) is counted in `counters.rejected` here, and handed over as such so
+    /// that the stage may answer it in its output stream.
     pub fn receive(&self, counters: &mut Health) -> Result<Option<Received<T>>, IpcError> {
-        Ok(self.topic.receive()?.map(|sample| {
-            if sample.is_current() {
-                Received::Current(sample)
-            } else {
-                counters.rejected += 1;
-                Received::OtherVersion(sample)
-            }
-        }))
+        let received = self.topic.receive_any_version()?;
+        if let Some(Received::OtherVersion(_)) = received {
+            counters.rejected += 1;
+        }
+        Ok(received)
     }
 
     /// Hands every queued sample of this build's payload version to `on_sample`, in order; the

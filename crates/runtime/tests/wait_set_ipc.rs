@@ -4,6 +4,7 @@
 
 use std::time::Duration;
 
+use ipc_types::NavState;
 use rins_runtime::ipc::{IpcSettings, TopicPublisher, TopicSubscriber, TopicWaitSet, create_node};
 use rins_runtime::shm_cleanup;
 
@@ -20,28 +21,33 @@ fn a_sample_on_any_of_six_topics_wakes_the_wait_once() {
     );
     {
         let node = create_node("waiter", &settings).expect("node");
-        let subscribers: Vec<TopicSubscriber<u64>> = TOPICS
+        let subscribers: Vec<TopicSubscriber<NavState>> = TOPICS
             .iter()
             .map(|t| TopicSubscriber::new(&node, t).expect("subscriber"))
             .collect();
-        let publishers: Vec<TopicPublisher<u64>> = TOPICS
+        let publishers: Vec<TopicPublisher<NavState>> = TOPICS
             .iter()
             .map(|t| TopicPublisher::new(&node, t).expect("publisher"))
             .collect();
-        let topics: Vec<&TopicSubscriber<u64>> = subscribers.iter().collect();
+        let topics: Vec<&TopicSubscriber<NavState>> = subscribers.iter().collect();
         let waitset = TopicWaitSet::new(&topics).expect("wait set");
         let short = Duration::from_millis(20);
 
         assert!(!waitset.wait(short).expect("wait"), "nothing sent");
         for (i, publisher) in publishers.iter().enumerate().rev() {
-            publisher.publish(100 + i as u64).expect("publish");
+            let mut sample = NavState::default();
+            sample.header.origin_seq = 100 + i as u64;
+            publisher.publish(sample).expect("publish");
             assert!(
                 waitset.wait(Duration::from_secs(30)).expect("wait"),
                 "a sample on {} wakes the wait",
                 TOPICS[i]
             );
             assert_eq!(
-                subscribers[i].receive().expect("receive"),
+                subscribers[i]
+                    .receive()
+                    .expect("receive")
+                    .map(|s| s.header.origin_seq),
                 Some(100 + i as u64)
             );
             // Reported once: the next wait sleeps until its timeout.

@@ -1,5 +1,6 @@
 //! `[acquisition]` configuration.
 
+use rins_serial_reader::line_config::SerialLineConfig;
 use serde::{Deserialize, Serialize};
 
 /// `[acquisition]` of the configuration: the serial device and how it is read.
@@ -31,29 +32,20 @@ impl Default for AcquisitionConfig {
 }
 
 impl AcquisitionConfig {
+    /// The serial line's settings, as the reconnecting reader takes them.
+    pub fn line(&self) -> SerialLineConfig {
+        SerialLineConfig {
+            port: self.port.clone(),
+            baud: self.baud,
+            read_timeout_ms: self.read_timeout_ms,
+            reconnect_initial_ms: self.reconnect_initial_ms,
+            reconnect_max_ms: self.reconnect_max_ms,
+        }
+    }
+
     /// Checks every value's range; the error names the field and the value.
     pub fn validate(&self) -> Result<(), String> {
-        if self.baud == 0 {
-            return Err("acquisition.baud = 0: must be > 0".into());
-        }
-        if !(1..=10_000).contains(&self.read_timeout_ms) {
-            return Err(format!(
-                "acquisition.read_timeout_ms = {}: must be in 1..=10000",
-                self.read_timeout_ms
-            ));
-        }
-        if self.reconnect_initial_ms == 0 || self.reconnect_initial_ms > self.reconnect_max_ms {
-            return Err(format!(
-                "acquisition.reconnect_initial_ms = {}: must be > 0 and <= reconnect_max_ms ({})",
-                self.reconnect_initial_ms, self.reconnect_max_ms
-            ));
-        }
-        if let Some(port) = &self.port
-            && port.is_empty()
-        {
-            return Err("acquisition.port = \"\": must name a device path".into());
-        }
-        Ok(())
+        self.line().validate("acquisition")
     }
 }
 

@@ -2,12 +2,9 @@
 //! file, and the process loop that reads the serial port, decodes it with `rins-protocol` and
 //! publishes raw samples.
 
-pub mod backoff;
 pub mod config;
 pub mod line_watch;
 pub mod listen;
-pub mod port;
-pub mod presence;
 pub mod resume_file;
 pub mod resume_saver;
 pub mod service;

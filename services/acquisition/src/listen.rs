@@ -7,9 +7,8 @@ use std::time::{Duration, Instant};
 use anyhow::{Result, anyhow};
 use rins_protocol::{Decoder, DeviceSpans, LineReport};
 use rins_runtime::clock::monotonic_ns;
+use rins_serial_reader::port;
 use serialport::{ClearBuffer, SerialPort};
-
-use crate::port;
 
 /// Read timeout while listening: short, so a listen ends on time on a silent line.
 const READ_TIMEOUT: Duration = Duration::from_millis(50);

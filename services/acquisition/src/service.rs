@@ -1,8 +1,7 @@
 //! The acquisition process: read the serial port, decode frames, publish raw samples. A device that
 //! is missing at start-up or vanishes later (unplugged, re-enumerated) is waited for with
-//! exponential backoff ([`crate::backoff`]); the process never exits because of it.
+//! exponential backoff ([`rins_serial_reader::backoff`]); the process never exits because of it.
 
-use std::io::Read;
 use std::time::Duration;
 
 use anyhow::{Result, anyhow};
@@ -14,15 +13,14 @@ use rins_runtime::service::{Service, ServiceContext};
 use rins_runtime::shutdown::Shutdown;
 use rins_runtime::stage_io::StagePublisher;
 
-use crate::backoff::Backoff;
 use crate::config::AcquisitionConfig;
 use crate::line_watch::LineWatch;
-use crate::port;
-use crate::presence::{Opened, Presence};
 use crate::resume_file;
 use crate::resume_saver::ResumeSaver;
 use crate::to_ipc;
 use rins_protocol::{DecodedFrame, Decoder, DecoderStats, FrameType, Payload, link_error};
+use rins_serial_reader::presence::{Opened, Presence, Retry};
+use rins_serial_reader::reconnecting::{LineEvents, read_reconnecting};
 
 /// The topics acquisition publishes, one per frame type; each sample leaves stamped with the
 /// acquisition's publish time.
@@ -64,36 +62,8 @@ impl Publishers {
     }
 }
 
-/// Sleeps `total` between attempts to open the device, waking early on shutdown and keeping the
-/// heartbeat going: a process waiting for its device is not hung, and must not be restarted as if
-/// it were, however long the backoff.
-pub fn wait_for_retry(
-    total: Duration,
-    shutdown: &Shutdown,
-    heartbeat: &mut Heartbeat,
-    counters: &Health,
-) -> Result<()> {
-    let step = Duration::from_millis(10);
-    let mut left = total;
-    while !left.is_zero() && !shutdown.requested() {
-        let d = left.min(step);
-        std::thread::sleep(d);
-        left -= d;
-        heartbeat.tick(counters)?;
-    }
-    Ok(())
-}
-
 fn millis(d: Duration) -> u64 {
     u64::try_from(d.as_millis()).unwrap_or(u64::MAX)
-}
-
-fn open_port(path: &str, config: &AcquisitionConfig) -> Result<serialport::TTYPort> {
-    port::open(
-        path,
-        config.baud,
-        Duration::from_millis(config.read_timeout_ms),
-    )
 }
 
 /// The acquisition process: reads the configured serial device until a stop is requested.
@@ -117,7 +87,7 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
     })?;
     let node = create_node(ServiceKind::Acquisition.name(), settings)?;
     let publishers = Publishers::new(&node)?;
-    let mut heartbeat = Heartbeat::new(&node, ServiceKind::Acquisition)?;
+    let heartbeat = Heartbeat::new(&node, ServiceKind::Acquisition)?;
     let mut decoder = Decoder::new();
     // Continue the numbering of the run this one replaces (see `resume_file`), from the verified
     // run directory only.
@@ -142,48 +112,71 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
         }
     }
     // The first frames judge the rest of the point: a part that does not fit them is counted.
-    let mut resume_rejected = decoder.stats().resume_rejected;
+    let resume_rejected = decoder.stats().resume_rejected;
     let resume_saver = ResumeSaver::start(resume_path.clone())?;
-    let mut next_save_ns = 0u64;
-    let mut counters = Health::default();
-    let mut presence = Presence::new(Backoff::new(
-        Duration::from_millis(config.reconnect_initial_ms),
-        Duration::from_millis(config.reconnect_max_ms),
-    ));
+    let mut reader = Reader {
+        path: &path,
+        simulator_link: settings.in_run_dir(std::path::Path::new(&path)),
+        publishers,
+        heartbeat,
+        line: LineWatch::new(monotonic_ns(), &decoder.stats()),
+        decoder,
+        resume_saver,
+        next_save_ns: 0,
+        resume_rejected,
+        counters: Health::default(),
+    };
     let mut buf = [0u8; 4096];
-    let mut line = LineWatch::new(monotonic_ns(), &decoder.stats());
+    read_reconnecting(&path, &config.line(), shutdown, &mut buf, &mut reader)?;
+    reader.resume_saver.finish(reader.decoder.resume_point());
+    tracing::info!(frames = reader.counters.received, "acquisition stopped");
+    Ok(())
+}
 
-    while !shutdown.requested() {
-        let mut port = match open_port(&path, config) {
-            Ok(port) => port,
-            Err(e) => {
-                let retry = presence.open_failed(monotonic_ns());
-                // The simulator's link under `rins up` appears moments after this service
-                // starts: waiting for it is expected, not worth a warning.
-                if retry.first && settings.in_run_dir(std::path::Path::new(&path)) {
-                    tracing::debug!(port = %path, error = %e, "waiting for the simulator's link");
-                } else if retry.first {
-                    let backoff = presence.backoff();
-                    tracing::warn!(
-                        port = %path,
-                        error = %e,
-                        first_retry_ms = millis(backoff.initial()),
-                        max_retry_ms = millis(backoff.max()),
-                        "waiting for serial device {path}: retrying with backoff"
-                    );
-                } else {
-                    tracing::debug!(
-                        port = %path,
-                        error = %e,
-                        retry_ms = millis(retry.delay),
-                        "serial device still unavailable"
-                    );
-                }
-                wait_for_retry(retry.delay, shutdown, &mut heartbeat, &counters)?;
-                continue;
-            }
-        };
-        match presence.opened(monotonic_ns()) {
+/// The loop's state between events of the line.
+struct Reader<'a> {
+    path: &'a str,
+    /// The port is the simulator's link under `rins up`, which appears moments after this
+    /// service starts: waiting for it is expected, not worth a warning.
+    simulator_link: bool,
+    publishers: Publishers,
+    heartbeat: Heartbeat,
+    decoder: Decoder,
+    line: LineWatch,
+    resume_saver: ResumeSaver,
+    next_save_ns: u64,
+    /// Resume-point parts the device's first frames refused, as last reported.
+    resume_rejected: u64,
+    counters: Health,
+}
+
+impl LineEvents for Reader<'_> {
+    fn open_failed(&mut self, e: &anyhow::Error, retry: &Retry, presence: &Presence) {
+        let path = self.path;
+        if retry.first && self.simulator_link {
+            tracing::debug!(port = %path, error = %e, "waiting for the simulator's link");
+        } else if retry.first {
+            let backoff = presence.backoff();
+            tracing::warn!(
+                port = %path,
+                error = %e,
+                first_retry_ms = millis(backoff.initial()),
+                max_retry_ms = millis(backoff.max()),
+                "waiting for serial device {path}: retrying with backoff"
+            );
+        } else {
+            tracing::debug!(
+                port = %path,
+                error = %e,
+                retry_ms = millis(retry.delay),
+                "serial device still unavailable"
+            );
+        }
+    }
+
+    fn opened(&mut self, opened: Opened, presence: &Presence) {
+        let path = self.path;
+        match opened {
             Opened::First { waited, attempts } => {
                 tracing::info!(
                     port = %path,
@@ -193,86 +186,69 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
                 );
             }
             Opened::Reconnected { away, attempts } => {
-                counters.reconnects = presence.reconnects();
+                self.counters.reconnects = presence.reconnects();
                 tracing::info!(
                     port = %path,
                     away_ms = millis(away),
                     attempts,
-                    reconnects = counters.reconnects,
+                    reconnects = self.counters.reconnects,
                     "serial device back: resynchronising"
                 );
             }
         }
         // Bytes of a frame cut by the disconnect must not be glued to the next stream.
-        decoder.reset();
-        line.opened(monotonic_ns(), &decoder.stats());
+        self.decoder.reset();
+        self.line.opened(monotonic_ns(), &self.decoder.stats());
+    }
 
-        // Allocation-free and lock-free until the device is lost.
-        let mut lost = None;
-        while !shutdown.requested() {
-            match port.read(&mut buf) {
-                // End of file: the other end hung up.
-                Ok(0) => {
-                    lost = Some(std::io::Error::from(std::io::ErrorKind::UnexpectedEof));
-                    break;
-                }
-                Ok(n) => {
-                    presence.data_arrived();
-                    // One receive time for every frame this read completed: the moment we had them whole.
-                    let rx_ns = monotonic_ns();
-                    if rx_ns >= next_save_ns {
-                        next_save_ns = rx_ns + resume_file::SAVE_PERIOD_NS;
-                        resume_saver.offer(decoder.resume_point());
-                    }
-                    let mut failed = None;
-                    decoder.push(&buf[..n], rx_ns, |frame| {
-                        if let Err(e) = publishers.publish(&frame, rx_ns) {
-                            counters.rejected += 1;
-                            failed.get_or_insert(e);
-                        } else {
-                            counters.published += 1;
-                        }
-                    });
-                    if let Some(e) = failed {
-                        tracing::error!(error = %e, "publishing a frame failed");
-                    }
-                }
-                Err(e) if e.kind() == std::io::ErrorKind::TimedOut => {}
-                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-                Err(e) => {
-                    lost = Some(e);
-                    break;
-                }
-            }
-            let stats = decoder.stats();
-            if stats.resume_rejected != resume_rejected {
-                resume_rejected = stats.resume_rejected;
-                warn_resume_ignored(&decoder, resume_rejected);
-            }
-            if let Some(warning) = line.observe(monotonic_ns(), &stats) {
-                tracing::warn!(port = %path, "{}", warning.message(&path));
-            }
-            fill_counters(&mut counters, &stats);
-            heartbeat.tick(&counters)?;
+    fn bytes(&mut self, bytes: &[u8]) {
+        // One receive time for every frame this read completed: the moment we had them whole.
+        let rx_ns = monotonic_ns();
+        if rx_ns >= self.next_save_ns {
+            self.next_save_ns = rx_ns + resume_file::SAVE_PERIOD_NS;
+            self.resume_saver.offer(self.decoder.resume_point());
         }
-        drop(port);
-        if let Some(e) = lost
-            && !shutdown.requested()
-        {
-            let delay = presence.lost(monotonic_ns());
-            tracing::warn!(
-                port = %path,
-                error = %e,
-                first_retry_ms = millis(delay),
-                max_retry_ms = millis(presence.backoff().max()),
-                "serial device lost: reopening with backoff"
-            );
-            wait_for_retry(delay, shutdown, &mut heartbeat, &counters)?;
+        let mut failed = None;
+        let (publishers, counters) = (&self.publishers, &mut self.counters);
+        self.decoder.push(bytes, rx_ns, |frame| {
+            if let Err(e) = publishers.publish(&frame, rx_ns) {
+                counters.rejected += 1;
+                failed.get_or_insert(e);
+            } else {
+                counters.published += 1;
+            }
+        });
+        if let Some(e) = failed {
+            tracing::error!(error = %e, "publishing a frame failed");
         }
     }
-    resume_saver.finish(decoder.resume_point());
-    tracing::info!(frames = counters.received, "acquisition stopped");
-    Ok(())
+
+    fn after_read(&mut self) -> Result<()> {
+        let stats = self.decoder.stats();
+        if stats.resume_rejected != self.resume_rejected {
+            self.resume_rejected = stats.resume_rejected;
+            warn_resume_ignored(&self.decoder, self.resume_rejected);
+        }
+        if let Some(warning) = self.line.observe(monotonic_ns(), &stats) {
+            tracing::warn!(port = %self.path, "{}", warning.message(self.path));
+        }
+        fill_counters(&mut self.counters, &stats);
+        Ok(self.heartbeat.tick(&self.counters)?)
+    }
+
+    fn lost(&mut self, e: &std::io::Error, delay: Duration, presence: &Presence) {
+        tracing::warn!(
+            port = %self.path,
+            error = %e,
+            first_retry_ms = millis(delay),
+            max_retry_ms = millis(presence.backoff().max()),
+            "serial device lost: reopening with backoff"
+        );
+    }
+
+    fn waiting(&mut self) -> Result<()> {
+        Ok(self.heartbeat.tick(&self.counters)?)
+    }
 }
 
 /// The decoder's counters in the heartbeat.

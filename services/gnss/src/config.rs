@@ -2,7 +2,7 @@
 
 use std::time::Duration;
 
-use rins_acquisition::config::AcquisitionConfig;
+use rins_serial_reader::line_config::SerialLineConfig;
 use serde::{Deserialize, Serialize};
 
 /// `[gnss]` of the configuration.
@@ -40,9 +40,9 @@ impl Default for GnssConfig {
 }
 
 impl GnssConfig {
-    /// The serial line's settings in the form the acquisition's port and backoff take.
-    pub fn line(&self) -> AcquisitionConfig {
-        AcquisitionConfig {
+    /// The serial line's settings, as the reconnecting reader takes them.
+    pub fn line(&self) -> SerialLineConfig {
+        SerialLineConfig {
             port: self.port.clone(),
             baud: self.baud,
             read_timeout_ms: self.read_timeout_ms,
@@ -58,9 +58,7 @@ impl GnssConfig {
 
     /// Checks every value's range; the error names the field and the value.
     pub fn validate(&self) -> Result<(), String> {
-        self.line()
-            .validate()
-            .map_err(|e| e.replacen("acquisition.", "gnss.", 1))?;
+        self.line().validate("gnss")?;
         if !(100..=60_000).contains(&self.stale_after_ms) {
             return Err(format!(
                 "gnss.stale_after_ms = {}: must be in 100..=60000",

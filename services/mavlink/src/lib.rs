@@ -18,9 +18,11 @@
 //!   [`command_gate`]: from whom it takes commands and how fast it answers them; [`signing`]: the
 //!   MAVLink 2 signing key, signing and verification.
 //! - [`stream`]: all of it as one state machine paced by [`rate_gate`]; [`link`] moves the messages
-//!   to the network on its own threads, [`serial_link`] to and from a serial port; [`service`] is
-//!   the process around them, [`config`] its `[mavlink]` table and [`endpoint`] its addresses;
-//!   [`pipeline_cpu`] measures the pipeline's load for SYS_STATUS.
+//!   to the network on its own threads, [`serial_link`] to and from a serial port (both frame what
+//!   they send alike and act alike on what they receive, and count it in one
+//!   [`link::LinkCounters`]); [`service`] is the process around them, [`config`] its `[mavlink]`
+//!   table and [`endpoint`] its addresses; [`pipeline_cpu`] measures the pipeline's load for
+//!   SYS_STATUS.
 //!
 //! Every message carries the measurement's time, not the send time: the receive time of the serial
 //! frame the solution comes from, on the avionics computer's CLOCK_MONOTONIC (time since boot).
@@ -34,7 +36,9 @@ pub mod endpoint;
 pub mod events;
 pub mod heartbeat;
 pub mod highres_imu;
+mod inbound;
 pub mod link;
+mod link_counters;
 pub mod odometry;
 pub mod origin;
 pub mod pipeline_cpu;
@@ -43,6 +47,7 @@ pub mod rate_gate;
 pub mod serial_link;
 pub mod service;
 pub mod signing;
+mod speaker;
 pub mod status_text;
 pub mod stream;
 pub mod sys_status;

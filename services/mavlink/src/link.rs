@@ -6,121 +6,28 @@
 //! slow or absent network or line never holds up the solution. With a signing key, every frame sent is signed and only
 //! frames signed with the key are acted on.
 
-use std::fmt;
 use std::io;
 use std::net::{SocketAddr, UdpSocket};
-use std::sync::atomic::{AtomicBool, AtomicU8, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
-use std::time::Duration;
 
 use crossbeam_channel::{Receiver, Sender, TrySendError, bounded};
-use mavlink::{
-    MAVLinkMessageRaw, MAVLinkV2MessageRaw, MavHeader, MavlinkReader, MavlinkVersion, Message,
-    SigningData,
-};
+use mavlink::{MAVLinkMessageRaw, MAVLinkV2MessageRaw, MavlinkReader, MavlinkVersion, Message};
 
-use crate::command_gate::{CommandGate, Refusal};
-use crate::dialect::{COMMAND_LONG_DATA, MavMessage};
+use crate::command_gate::CommandGate;
+use crate::dialect::MavMessage;
 use crate::endpoint::Endpoint;
+use crate::inbound::{Inbound, Origin, READ_POLL};
 use crate::serial_link::{self, Frame};
-use crate::signing::{self, KEY_BYTES, SignatureCheck, Verifier};
-use crate::timesync;
+use crate::signing::{self, KEY_BYTES, Verifier};
+use crate::speaker::{MAX_FRAME, Speaker};
 
-/// Largest MAVLink 2 frame (header 10, payload 255, checksum 2, signature 13).
-pub(crate) const MAX_FRAME: usize = 280;
-/// How often a reader looks at the stop flag while nothing arrives.
-pub(crate) const READ_POLL: Duration = Duration::from_millis(100);
+pub use crate::inbound::InboundCommand;
+pub use crate::link_counters::LinkCounters;
+
 /// Commands queued for the navigation loop; a peer flooding commands loses the excess.
 const COMMAND_QUEUE: usize = 16;
-
-/// A command from a peer, with who sent it.
-#[derive(Debug, Clone)]
-pub struct InboundCommand {
-    /// The sender's system and component.
-    pub from: (u8, u8),
-    /// The command.
-    pub command: COMMAND_LONG_DATA,
-}
-
-/// What the link counted since start.
-#[derive(Debug, Default)]
-pub struct LinkCounters {
-    /// Messages handed to the network thread.
-    pub queued: AtomicU64,
-    /// Messages dropped because the queue to the network thread was full.
-    pub dropped: AtomicU64,
-    /// Datagrams sent (one per message and endpoint with a peer), and frames written to serial
-    /// ports.
-    pub sent: AtomicU64,
-    /// Sends the system refused (unreachable peer, no route).
-    pub send_errors: AtomicU64,
-    /// Datagrams received that were not, in whole, MAVLink 2 messages of the common set: one per
-    /// such datagram, whatever it held besides; on a serial port, frames with a valid checksum of
-    /// a message the common set does not know or cannot decode.
-    pub undecodable: AtomicU64,
-    /// Frames not written to a serial port: the port was away (unplugged, not yet reopened), its
-    /// queue was full (a line too slow for the configured rates) or the write failed.
-    pub serial_dropped: AtomicU64,
-    /// Times a serial port was lost (unplugged, hung up, failed reading).
-    pub serial_lost: AtomicU64,
-    /// Times a serial port was opened again after it was lost or could not be opened.
-    pub serial_reopened: AtomicU64,
-    /// TIMESYNC requests answered.
-    pub timesync_answered: AtomicU64,
-    /// Commands dropped because the navigation loop had not taken the earlier ones.
-    pub commands_dropped: AtomicU64,
-    /// Commands and TIMESYNC requests refused because they were not signed (a key is set, or
-    /// commands are accepted without one and unsigned ones are not allowed).
-    pub unsigned_refused: AtomicU64,
-    /// Commands and TIMESYNC requests refused because their signature was not made with the key.
-    pub bad_signature_refused: AtomicU64,
-    /// Commands and TIMESYNC requests refused because, signed with the key, they were not newer
-    /// than their stream's last frame (a replay).
-    pub replay_refused: AtomicU64,
-    /// Commands refused because their sender is not in `command_sources`.
-    pub sender_refused: AtomicU64,
-    /// Commands refused because their address is not in `command_addresses`.
-    pub address_refused: AtomicU64,
-    /// COMMAND_ACKs not sent because they exceeded `command_ack_rate_hz`.
-    pub acks_dropped: AtomicU64,
-}
-
-impl LinkCounters {
-    /// Counts `refusal`; the first of each kind is logged, with who sent it, so that a link set up
-    /// wrongly (a ground station not signing) shows at once without a flood of log lines.
-    fn refused(&self, refusal: Refusal, sender: (u32, u8), from: Origin<'_>) {
-        let (counter, why) = match refusal {
-            Refusal::Unsigned => (&self.unsigned_refused, "not signed"),
-            Refusal::BadSignature => (&self.bad_signature_refused, "not signed with the key"),
-            Refusal::Replayed => (&self.replay_refused, "a replayed signature"),
-            Refusal::Sender => (&self.sender_refused, "sender not in command_sources"),
-            Refusal::Address => (&self.address_refused, "address not in command_addresses"),
-        };
-        if counter.fetch_add(1, Ordering::Relaxed) == 0 {
-            tracing::warn!(
-                %from,
-                system = sender.0,
-                component = sender.1,
-                "MAVLink message refused: {why} (further ones are only counted)"
-            );
-        }
-    }
-
-    /// The refusals of every kind.
-    pub fn refused_total(&self) -> u64 {
-        [
-            &self.unsigned_refused,
-            &self.bad_signature_refused,
-            &self.replay_refused,
-            &self.sender_refused,
-            &self.address_refused,
-        ]
-        .iter()
-        .map(|c| c.load(Ordering::Relaxed))
-        .sum()
-    }
-}
 
 /// How the link is secured: the signing key and who may send commands.
 pub struct LinkSecurity {
@@ -132,52 +39,12 @@ pub struct LinkSecurity {
     pub gate: CommandGate,
 }
 
-/// Where an inbound message came from.
-#[derive(Debug, Clone, Copy)]
-pub(crate) enum Origin<'a> {
-    /// A UDP peer.
-    Peer(SocketAddr),
-    /// A serial port, by its device path.
-    Port(&'a str),
-}
-
-impl fmt::Display for Origin<'_> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::Peer(addr) => write!(f, "{addr}"),
-            Self::Port(path) => write!(f, "{path}"),
-        }
-    }
-}
-
 /// One socket and where its stream goes.
 struct Socket {
     socket: UdpSocket,
     /// The peer: fixed for `udpout`, the last sender for `udpin` (none until one spoke).
     peer: Arc<Mutex<Option<SocketAddr>>>,
     listening: bool,
-}
-
-/// Who rins speaks as, the sequence number every frame it sends shares, and its signer.
-pub(crate) struct Speaker {
-    system: u8,
-    component: u8,
-    sequence: AtomicU8,
-    signer: Option<SigningData>,
-}
-
-impl Speaker {
-    /// `msg` framed as MAVLink 2 into `buf`, signed when a key is set; the frame's length.
-    pub(crate) fn frame(&self, msg: &MavMessage, buf: &mut [u8; MAX_FRAME]) -> Option<usize> {
-        let header = MavHeader {
-            system_id: u32::from(self.system),
-            component_id: self.component,
-            sequence: self.sequence.fetch_add(1, Ordering::Relaxed),
-        };
-        let mut cursor = io::Cursor::new(&mut buf[..]);
-        mavlink::write_v2_msg_signed(&mut cursor, header, msg, self.signer.as_ref()).ok()?;
-        Some(cursor.position() as usize)
-    }
 }
 
 /// Every MAVLink 2 message of the common set in `datagram`, in order, handed to `on_message`
@@ -269,14 +136,13 @@ impl Link {
             let s = open(e).map_err(|err| io::Error::new(err.kind(), format!("{e}: {err}")))?;
             sockets.push(s);
         }
-        let speaker = Arc::new(Speaker {
-            system: speaker.0,
-            component: speaker.1,
-            sequence: AtomicU8::new(0),
-            signer: security
+        let speaker = Arc::new(Speaker::new(
+            speaker.0,
+            speaker.1,
+            security
                 .key
                 .map(|key| signing::outgoing(key, security.link_id)),
-        });
+        ));
         // One verifier for every socket: a frame replayed onto another endpoint is still a replay.
         let verifier = security
             .key
@@ -394,18 +260,6 @@ fn send_loop(
     }
 }
 
-/// What every reader, of a socket or of a serial port, acts on messages with.
-#[derive(Clone)]
-pub(crate) struct Inbound {
-    speaker: Arc<Speaker>,
-    pub(crate) counters: Arc<LinkCounters>,
-    commands: Sender<InboundCommand>,
-    /// The signature check, when a key is set; one for every endpoint: a frame replayed onto
-    /// another endpoint is still a replay.
-    verifier: Option<Arc<Mutex<Verifier>>>,
-    gate: Arc<CommandGate>,
-}
-
 /// Reads one socket: answers TIMESYNC, forwards admitted commands, learns a listening socket's
 /// peer.
 struct ReaderThread {
@@ -460,94 +314,12 @@ impl ReaderThread {
     }
 }
 
-impl Inbound {
-    /// What `raw`'s signature shows.
-    fn signature(&self, raw: &MAVLinkV2MessageRaw) -> SignatureCheck {
-        match &self.verifier {
-            Some(v) => v
-                .lock()
-                .unwrap_or_else(PoisonError::into_inner)
-                .check(raw, signing::timestamp_now()),
-            None => SignatureCheck::NotChecked,
-        }
-    }
-
-    /// Acts on one message from `from`; `reply` sends a frame back there and says whether it
-    /// went. Returns whether the message is authentic (signed with the key, or no key set).
-    pub(crate) fn on_message(
-        &self,
-        raw: &MAVLinkV2MessageRaw,
-        msg: MavMessage,
-        from: Origin<'_>,
-        frame: &mut [u8; MAX_FRAME],
-        reply: impl FnOnce(&[u8]) -> bool,
-    ) -> bool {
-        let signature = self.signature(raw);
-        let authentic = matches!(
-            signature,
-            SignatureCheck::Valid | SignatureCheck::NotChecked
-        );
-        let header = MavHeader {
-            system_id: raw.system_id(),
-            component_id: raw.component_id(),
-            sequence: raw.sequence(),
-        };
-        let sender = (header.system_id, header.component_id);
-        match msg {
-            MavMessage::TIMESYNC(_) if !authentic => {
-                let refusal = match signature {
-                    SignatureCheck::BadSignature => Refusal::BadSignature,
-                    SignatureCheck::Replayed => Refusal::Replayed,
-                    _ => Refusal::Unsigned,
-                };
-                self.counters.refused(refusal, sender, from);
-            }
-            MavMessage::TIMESYNC(request) => {
-                let now = rins_runtime::clock::monotonic_ns();
-                if let Some(mut answer) = timesync::answer(&request, now, self.speaker.system) {
-                    answer.target_system = u8::try_from(header.system_id).unwrap_or(0);
-                    answer.target_component = header.component_id;
-                    if let Some(len) = self.speaker.frame(&MavMessage::TIMESYNC(answer), frame)
-                        && reply(&frame[..len])
-                    {
-                        self.counters
-                            .timesync_answered
-                            .fetch_add(1, Ordering::Relaxed);
-                    }
-                }
-            }
-            MavMessage::COMMAND_LONG(command) => {
-                let admitted = match from {
-                    Origin::Peer(addr) => self.gate.admit(signature, sender, addr),
-                    Origin::Port(_) => self.gate.admit_wired(signature, sender),
-                };
-                if let Err(refusal) = admitted {
-                    self.counters.refused(refusal, sender, from);
-                    return authentic;
-                }
-                let inbound = InboundCommand {
-                    // A system id beyond 255 (a MAVLink 2 extension) cannot be answered in kind.
-                    from: (
-                        u8::try_from(header.system_id).unwrap_or(0),
-                        header.component_id,
-                    ),
-                    command,
-                };
-                if self.commands.try_send(inbound).is_err() {
-                    self.counters
-                        .commands_dropped
-                        .fetch_add(1, Ordering::Relaxed);
-                }
-            }
-            _ => {}
-        }
-        authentic
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::dialect::COMMAND_LONG_DATA;
+    use crate::signing::SignatureCheck;
+    use mavlink::{MavHeader, SigningData};
 
     /// A signed COMMAND_LONG frame.
     fn signed_command(signer: &SigningData) -> Vec<u8> {

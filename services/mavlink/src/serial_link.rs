@@ -17,7 +17,8 @@ use mavlink::{MAVLinkMessageRaw, MavlinkReader, MavlinkVersion, Message};
 use serialport::{SerialPort, TTYPort};
 
 use crate::dialect::MavMessage;
-use crate::link::{Inbound, MAX_FRAME, Origin, READ_POLL};
+use crate::inbound::{Inbound, Origin, READ_POLL};
+use crate::speaker::MAX_FRAME;
 
 /// The first wait before opening a lost port again; it doubles after each failure.
 const REOPEN_FIRST: Duration = Duration::from_millis(100);

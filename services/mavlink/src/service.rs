@@ -11,6 +11,7 @@ use ipc_types::{FusedImu, FusionControl, FusionReply, HealthReport, ServiceKind,
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{TopicPublisher, TopicSubscriber};
 use rins_runtime::nav_subscriber::NavSubscriber;
+use rins_runtime::payload::OtherVersionWarning;
 use rins_runtime::service::{Service, ServiceContext};
 use rins_runtime::service_loop::ServiceLoop;
 
@@ -196,6 +197,11 @@ impl Service for MavlinkService {
         let load_stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
         let (load, load_thread) =
             crate::pipeline_cpu::start(config.rates.sys_status_hz, load_stop.clone());
+        let mut version_warning = OtherVersionWarning::new();
+        // Samples of another payload version the readers dropped count as rejected too.
+        let other_version = |nav: &NavSubscriber, replies: &TopicSubscriber<FusionReply>| {
+            nav.rejected() + fused.rejected() + health.rejected() + replies.rejected()
+        };
         while lp.running() {
             nav.wait(WAIT)?;
             let mut emit = |m: MavMessage| link.queue(m);
@@ -217,9 +223,13 @@ impl Service for MavlinkService {
             }
             commands.on_replies(&link)?;
             copy_counters(&link.counters, &mut lp.counters);
+            let refused = other_version(&nav, &commands.replies);
+            lp.counters.rejected += refused;
+            version_warning.check("mavlink", refused);
             lp.beat()?;
         }
         copy_counters(&link.counters, &mut lp.counters);
+        lp.counters.rejected += other_version(&nav, &commands.replies);
         load_stop.store(true, std::sync::atomic::Ordering::Relaxed);
         if let Some(t) = load_thread {
             let _ = t.join();
@@ -244,6 +254,7 @@ impl Service for MavlinkService {
             serial_lost = c.serial_lost.load(Relaxed),
             serial_reopened = c.serial_reopened.load(Relaxed),
             load_unreadable = load.unreadable.load(Relaxed),
+            other_version = other_version(&nav, &commands.replies),
             "MAVLink output stopped"
         );
         Ok(())

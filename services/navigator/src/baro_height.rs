@@ -1,5 +1,5 @@
 //! Settings of the barometric height aiding (`[navigator.baro]`) and the variance a height update
-//! takes from them; the updates themselves are in [`crate::baro_mag_updates`].
+//! takes from them; the updates themselves are in [`crate::aiding`].
 
 use serde::{Deserialize, Serialize};
 

@@ -1,5 +1,7 @@
 //! Range checks shared by the settings structs: each returns the offending `(field, value)` so
-//! the configuration layer can name it.
+//! the configuration layer can name it, or the configuration error itself.
+
+use rins_runtime::config_error::ConfigError;
 
 /// `Ok` when `value` is finite and positive, else `Err((name, value))` (NaN included).
 pub(crate) fn positive(name: &'static str, value: f64) -> Result<(), (&'static str, f64)> {
@@ -7,5 +9,22 @@ pub(crate) fn positive(name: &'static str, value: f64) -> Result<(), (&'static s
         Ok(())
     } else {
         Err((name, value))
+    }
+}
+
+/// `value` of `table.field` is finite and passes `ok`; otherwise the error names the key, the
+/// value and `reason`.
+pub(crate) fn check_in(
+    table: &str,
+    field: &'static str,
+    value: f64,
+    ok: impl Fn(f64) -> bool,
+    reason: &'static str,
+) -> Result<(), ConfigError> {
+    // `is_finite` first so that NaN and infinities are always rejected whatever the range test says.
+    if value.is_finite() && ok(value) {
+        Ok(())
+    } else {
+        Err(ConfigError::new(field, value, reason).within(table))
     }
 }

@@ -4,6 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::alignment::AlignConfig;
 use crate::baro_height::BaroAidingConfig;
+use crate::checks::check_in;
 use crate::ekf::EkfNoise;
 use crate::gnss_config::GnssAidingConfig;
 use crate::inertial_core::{AidedConfig, ZuptConfig};
@@ -115,23 +116,6 @@ fn check(
     reason: &'static str,
 ) -> Result<(), ConfigError> {
     check_in("navigator", field, value, ok, reason)
-}
-
-/// `value` of `table.field` is finite and passes `ok`; otherwise the error names the key, the
-/// value and `reason`.
-pub(crate) fn check_in(
-    table: &str,
-    field: &'static str,
-    value: f64,
-    ok: impl Fn(f64) -> bool,
-    reason: &'static str,
-) -> Result<(), ConfigError> {
-    // `is_finite` first so that NaN and infinities are always rejected whatever the range test says.
-    if value.is_finite() && ok(value) {
-        Ok(())
-    } else {
-        Err(ConfigError::new(field, value, reason).within(table))
-    }
 }
 
 impl NavigatorConfig {

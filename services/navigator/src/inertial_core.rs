@@ -1,21 +1,24 @@
 //! The aided navigator's inertial core: static alignment, then the error-state EKF predicted on
 //! every IMU sample, with the zero-velocity update whenever the stance detector fires; barometric
 //! height and magnetometer heading updates arrive through [`AidedNavigator::on_baro`] and
-//! [`AidedNavigator::on_mag`] (see [`crate::baro_mag_updates`]).
+//! [`AidedNavigator::on_mag`] (see [`crate::aiding`]).
 //!
 //! Both profiles run it — a foot-mounted unit (pedestrian) and the airframe (uav); the offline
 //! evaluations and the live navigator share this one code path, so what the real recordings
 //! measure is what flies.
 
 use nalgebra::Vector3;
-use serde::{Deserialize, Serialize};
 
+use crate::aiding::booking::record_update;
+use crate::aiding::gnss_state::GnssAidingState;
+use crate::aiding::source::AidingSensor;
+pub use crate::aiding::zupt::ZuptConfig;
 use crate::alignment::{AlignConfig, AlignError, Alignment, StaticAligner};
 use crate::attitude_recovery::AttitudeRecovery;
 use crate::baro_height::BaroAidingConfig;
-use crate::ekf::{AidingSource, EkfNoise, ErrorStateEkf, UpdateOutcome};
+use crate::ekf::{AidingSource, EkfNoise, ErrorStateEkf};
 use crate::gnss_config::GnssAidingConfig;
-use crate::gnss_updates::GnssAidingState;
+pub use crate::imu_step::ImuStep;
 use crate::integrity::{IntegrityConfig, IntegrityMonitor};
 use crate::mag_calibration::MagCalibration;
 use crate::mag_heading::{FieldReference, MagAidingConfig};
@@ -24,28 +27,6 @@ use crate::stance::{StanceConfig, StanceDetector};
 use crate::tilt_aiding::{TiltAiding, TiltAidingConfig};
 use crate::unisolated_fault::{FusionFault, UnisolatedFaultBound};
 use ipc_types::Integrity;
-
-/// Settings of the zero-velocity aiding (`[navigator.zupt]`).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct ZuptConfig {
-    /// Apply a zero-velocity update whenever the stance detector fires (`[navigator.stance]`).
-    pub enabled: bool,
-    /// Velocity σ of the zero-velocity pseudo-measurement, m/s per axis.
-    pub sigma_mps: f64,
-    /// Innovation gate: largest accepted Mahalanobis distance of the velocity innovation.
-    pub gate: f64,
-}
-
-impl Default for ZuptConfig {
-    fn default() -> Self {
-        Self {
-            enabled: false,
-            sigma_mps: 0.01,
-            gate: 1e3,
-        }
-    }
-}
 
 /// Settings of the inertial core.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -88,12 +69,18 @@ impl AidedConfig {
     /// The aiding sources this profile uses, indexed by [`AidingSource`].
     pub fn configured_sources(&self) -> [bool; AidingSource::COUNT] {
         let mut on = [false; AidingSource::COUNT];
-        on[AidingSource::Baro as usize] = self.baro.enabled;
-        on[AidingSource::Mag as usize] = self.mag.enabled && !self.mag.stance_only;
-        on[AidingSource::Zupt as usize] = self.zupt.enabled;
-        on[AidingSource::Hupt as usize] = self.mag.enabled && self.mag.stance_only;
-        on[AidingSource::Gnss as usize] = self.gnss.enabled;
+        for sensor in self.sensors() {
+            if sensor.enabled() {
+                on[sensor.source() as usize] = true;
+            }
+        }
         on
+    }
+
+    /// The settings of every aiding source that has some of its own (the tilt updates from the
+    /// specific force are booked by the inertial core itself).
+    fn sensors(&self) -> [&dyn AidingSensor; 4] {
+        [&self.baro, &self.mag, &self.zupt, &self.gnss]
     }
 }
 
@@ -104,30 +91,6 @@ impl AidedConfig {
 enum Phase {
     Aligning(StaticAligner),
     Navigating(ErrorStateEkf),
-}
-
-/// What one IMU sample did.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ImuStep {
-    /// The propagation (while aligning: `None`).
-    pub propagated: Option<StepOutcome>,
-    /// The stance detector fired on this sample.
-    pub stance: bool,
-    /// The zero-velocity update, when one was attempted.
-    pub zupt: Option<UpdateOutcome>,
-}
-
-/// Books a tilt update from the specific force (recovery or AHRS) for the integrity monitor.
-fn record_gravity_update(
-    last_accepted_us: &mut [Option<u64>; AidingSource::COUNT],
-    integrity: &mut IntegrityMonitor,
-    t_us: u64,
-    result: UpdateOutcome,
-) {
-    if result.is_accepted() {
-        last_accepted_us[AidingSource::Gravity as usize] = Some(t_us);
-    }
-    integrity.on_update(AidingSource::Gravity, t_us, result, 2);
 }
 
 /// Alignment followed by the EKF with zero-velocity updates. Allocation-free per sample once
@@ -255,12 +218,9 @@ impl AidedNavigator {
     /// (counted from the start of navigation when it never reported). Always false while
     /// aligning and for a disabled source.
     pub fn is_stale(&self, source: AidingSource) -> bool {
-        let enabled = match source {
-            AidingSource::Baro => self.config.baro.enabled,
-            AidingSource::Mag => self.config.mag.enabled && !self.config.mag.stance_only,
-            AidingSource::Zupt | AidingSource::Hupt | AidingSource::Gravity => false,
-            AidingSource::Gnss => self.config.gnss.enabled,
-        };
+        let enabled = self.config.sensors().iter().any(|sensor| {
+            sensor.source() == source && sensor.enabled() && sensor.watched_for_staleness()
+        });
         let (Some(now), Some(since)) = (self.last_time_us, self.navigating_since_us) else {
             return false;
         };
@@ -403,11 +363,13 @@ impl AidedNavigator {
                         &rate,
                     )
                 {
-                    record_gravity_update(
+                    record_update(
                         &mut self.last_accepted_us,
                         &mut self.integrity,
+                        AidingSource::Gravity,
                         t_us,
                         result,
+                        2,
                     );
                 }
                 let tilt = &self.config.tilt;
@@ -416,11 +378,13 @@ impl AidedNavigator {
                     && !self.attitude_recovery.is_lost()
                     && let Some(result) = self.tilt.push(ekf, tilt, t_us, specific_force, &rate)
                 {
-                    record_gravity_update(
+                    record_update(
                         &mut self.last_accepted_us,
                         &mut self.integrity,
+                        AidingSource::Gravity,
                         t_us,
                         result,
+                        2,
                     );
                 }
                 let g = ekf.strapdown().gravity();
@@ -429,11 +393,14 @@ impl AidedNavigator {
                 let z = self.config.zupt;
                 if z.enabled && step.stance && outcome.is_applied() {
                     let result = ekf.zupt(z.sigma_mps, z.gate);
-                    if result.is_accepted() {
-                        self.last_accepted_us[AidingSource::Zupt as usize] = Some(t_us);
-                    }
-                    self.integrity
-                        .on_update(AidingSource::Zupt, t_us, result, 3);
+                    record_update(
+                        &mut self.last_accepted_us,
+                        &mut self.integrity,
+                        AidingSource::Zupt,
+                        t_us,
+                        result,
+                        3,
+                    );
                     step.zupt = Some(result);
                 }
                 if self.config.gnss.enabled && outcome.is_applied() {

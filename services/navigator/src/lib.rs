@@ -5,12 +5,12 @@
 //! Pure functions and small structs, no I/O. Frames: NED navigation, FRD body; quaternions rotate
 //! body → NED (Hamilton, scalar first); SI units inside, degrees only in [`NavigatorConfig`].
 
+pub mod aiding;
 pub mod aiding_queue;
 pub mod alignment;
 pub mod attitude;
 pub mod attitude_recovery;
 pub mod baro_height;
-pub mod baro_mag_updates;
 mod checks;
 pub mod config;
 pub mod ekf;
@@ -20,6 +20,7 @@ pub mod gnss_displacement;
 pub mod gnss_hold;
 pub mod gnss_monitor;
 pub mod gnss_updates;
+mod imu_step;
 pub mod inertial_core;
 pub mod integrity;
 pub mod mag_calibration;

@@ -20,9 +20,9 @@
 
 use ipc_types::{Integrity, NAV_STATES, NavMode, NavState, aiding, integrity_reason};
 
+use crate::aiding::outcome::AidingOutcome;
 use crate::alignment::{AlignError, Alignment};
 use crate::attitude::quaternion_to_array;
-use crate::baro_mag_updates::AidingOutcome;
 use crate::config::{ConfigError, NavigatorConfig};
 use crate::ekf::{AidingCounts, AidingSource, ErrorStateEkf};
 use crate::gnss_updates::{GnssMeasurement, GnssOutcome};

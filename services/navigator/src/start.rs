@@ -6,10 +6,11 @@
 //! navigator and the in-process evaluations start from the same code.
 
 use nalgebra::Vector3;
+use rins_runtime::config_error::ConfigError;
 use serde::{Deserialize, Serialize};
 
 use crate::attitude::quaternion_from_euler;
-use crate::config::{ConfigError, check_in};
+use crate::checks::check_in;
 use crate::ekf::STATES;
 use crate::inertial_core::AidedConfig;
 use crate::mechanisation::{ImuBias, NominalState};

@@ -3,39 +3,8 @@
 
 use nalgebra::{Quaternion, UnitQuaternion};
 
+use crate::error_stats::ErrorStats;
 use crate::horizontal::{HorizontalTrack, Position};
-
-/// RMS and largest of a stream of errors.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct ErrorStats {
-    n: u64,
-    sum_sq: f64,
-    max: f64,
-}
-
-impl ErrorStats {
-    /// Adds one error sample.
-    pub fn push(&mut self, error: f64) {
-        self.n += 1;
-        self.sum_sq += error * error;
-        self.max = self.max.max(error.abs());
-    }
-
-    /// Samples added so far.
-    pub fn count(&self) -> u64 {
-        self.n
-    }
-
-    /// Root mean square; `None` before the first sample.
-    pub fn rms(&self) -> Option<f64> {
-        (self.n > 0).then(|| (self.sum_sq / self.n as f64).sqrt())
-    }
-
-    /// The largest error, once there is a sample.
-    pub fn max(&self) -> Option<f64> {
-        (self.n > 0).then_some(self.max)
-    }
-}
 
 /// Angle in degrees of the rotation between two attitudes given as [w, x, y, z].
 pub fn attitude_error_deg(truth: [f64; 4], estimate: [f64; 4]) -> f64 {
@@ -177,16 +146,5 @@ mod tests {
         assert!(acc.horizontal.errors().max().unwrap() < 1.1);
         assert!(acc.horizontal_m_while_ok.max().unwrap() < 1.1);
         assert_eq!(acc.attitude_deg.count(), 2);
-    }
-
-    #[test]
-    fn rms_and_max() {
-        let mut s = ErrorStats::default();
-        assert_eq!(s.rms(), None);
-        for e in [3.0, -4.0] {
-            s.push(e);
-        }
-        assert!((s.rms().unwrap() - (12.5f64).sqrt()).abs() < 1e-12);
-        assert_eq!(s.max(), Some(4.0));
     }
 }

@@ -9,8 +9,7 @@ use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{IpcNode, TopicPublisher};
 
 use crate::health_report::{ProcessView, build_report};
-use crate::link::link_report;
-use crate::monitor::{HeartbeatSeen, Monitor};
+use crate::monitor::{HeartbeatSeen, Monitor, link_report};
 use crate::supervisor::Supervisor;
 
 /// Report period.

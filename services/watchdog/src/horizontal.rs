@@ -2,6 +2,8 @@
 //! how far the navigation solution ended from it, the figure of a pedestrian walk (end-point
 //! error, also as a share of the distance walked).
 
+use crate::error_stats::ErrorStats;
+
 /// A horizontal position, latitude and longitude in radians (WGS84), height in metres.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Position {
@@ -38,7 +40,7 @@ pub struct HorizontalTrack {
     last_truth: Option<Position>,
     distance_m: f64,
     end_error_m: Option<f64>,
-    errors: crate::accuracy::ErrorStats,
+    errors: ErrorStats,
     /// North/east error of the last sample, m.
     last_error_ne: Option<[f64; 2]>,
     /// Largest change of the north/east error from one sample to the next, m.
@@ -70,7 +72,7 @@ impl HorizontalTrack {
     }
 
     /// RMS and largest horizontal error over every sample added.
-    pub fn errors(&self) -> &crate::accuracy::ErrorStats {
+    pub fn errors(&self) -> &ErrorStats {
         &self.errors
     }
 

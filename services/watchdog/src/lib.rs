@@ -4,6 +4,8 @@
 pub mod accuracy;
 pub mod config;
 pub mod deployment_checks;
+pub mod device_counters;
+pub mod error_stats;
 pub mod fault_tracking;
 pub mod health_publisher;
 pub mod health_report;

@@ -2,20 +2,14 @@
 //! `link`, the status line's note when bytes arrive without frames or nothing arrives, and the
 //! verdict of a timed run in which no valid frame arrived.
 
-use ipc_types::{LinkError, LinkReport, ServiceKind};
+use ipc_types::{LinkError, LinkReport};
 use rins_protocol::likely_cause;
 
-use crate::monitor::{DeviceCounters, Monitor};
+use crate::device_counters::DeviceCounters;
 use crate::summary::Summary;
 
-/// The health report's `link`: acquisition's counters (summed over its restarts), or nothing
-/// heard while no heartbeat of acquisition has arrived.
-pub fn link_report(monitor: &Monitor) -> LinkReport {
-    let heard = monitor.heartbeats[ServiceKind::Acquisition as usize].is_some();
-    report_of(&monitor.device_counters(), heard)
-}
-
-/// [`link_report`] from the counters themselves.
+/// The health report's `link` from acquisition's counters (summed over its restarts); `heard`:
+/// a heartbeat of acquisition has arrived.
 pub fn report_of(c: &DeviceCounters, heard: bool) -> LinkReport {
     LinkReport {
         heard: u8::from(heard),

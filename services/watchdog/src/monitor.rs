@@ -3,17 +3,18 @@
 
 use anyhow::Result;
 use ipc_types::{
-    Altitude, FaultApplied, FusedImu, Health, Integrity, NavMode, NavReport, NavState, RawBaro,
-    RawImu, RawMag, RedundancyReport, ServiceKind, Truth, names,
+    Altitude, FaultApplied, FusedImu, Health, Integrity, LinkReport, NavMode, NavReport, NavState,
+    RawBaro, RawImu, RawMag, RedundancyReport, ServiceKind, Truth, names,
 };
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{IpcNode, TopicSubscriber};
 use rins_runtime::nav_subscriber::NavSubscriber;
 
 use crate::accuracy::{Accuracy, ScoredSample};
+use crate::device_counters::DeviceCounters;
 use crate::fault_tracking::FaultTracker;
 use crate::horizontal::Position;
-use crate::link::LinkRate;
+use crate::link::{LinkRate, report_of};
 use crate::redundancy_view::{nav_of, redundancy_of};
 use crate::seq_gaps::SeqGaps;
 
@@ -32,78 +33,6 @@ pub struct HeartbeatSeen {
     pub at_ns: u64,
     /// The sender said its input is quiet.
     pub input_stale: bool,
-}
-
-/// The serial device's counters, as acquisition reports them (see the decoder's `DecoderStats`).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct DeviceCounters {
-    /// Serial frames with a bad CRC.
-    pub crc_errors: u64,
-    /// Valid CRC, malformed content.
-    pub malformed_frames: u64,
-    /// Frames missing from the device's sequence.
-    pub lost_frames: u64,
-    /// Repeated sequence numbers, not published.
-    pub duplicate_frames: u64,
-    /// Reordered frames that came after a later one, not published, not lost.
-    pub late_frames: u64,
-    /// Device sequence-counter discontinuities.
-    pub seq_jumps: u64,
-    /// Device-clock discontinuities.
-    pub time_rebases: u64,
-    /// Bytes skipped while resynchronising.
-    pub resync_bytes: u64,
-    /// Times the device was reopened.
-    pub reconnects: u64,
-    /// Bytes read from the device.
-    pub bytes_received: u64,
-    /// Frames with a valid CRC and sane content (published, or withheld as duplicate or late).
-    pub valid_frames: u64,
-    /// [`ipc_types::LinkError`] as u8 of the last refusal.
-    pub last_decode_error: u8,
-}
-
-impl DeviceCounters {
-    /// The counters a heartbeat of acquisition carries.
-    pub fn from_heartbeat(h: &Health) -> Self {
-        Self {
-            crc_errors: h.crc_errors,
-            malformed_frames: h.malformed,
-            lost_frames: h.lost,
-            duplicate_frames: h.duplicates,
-            late_frames: h.late,
-            seq_jumps: h.seq_jumps,
-            time_rebases: h.time_rebases,
-            resync_bytes: h.resync_bytes,
-            reconnects: h.reconnects,
-            bytes_received: h.bytes_received,
-            valid_frames: h.valid_frames,
-            last_decode_error: h.last_decode_error,
-        }
-    }
-
-    /// The sum of two processes' counters; the last refusal is `o`'s (the later process) when it
-    /// has one.
-    pub fn plus(&self, o: &Self) -> Self {
-        Self {
-            crc_errors: self.crc_errors + o.crc_errors,
-            malformed_frames: self.malformed_frames + o.malformed_frames,
-            lost_frames: self.lost_frames + o.lost_frames,
-            duplicate_frames: self.duplicate_frames + o.duplicate_frames,
-            late_frames: self.late_frames + o.late_frames,
-            seq_jumps: self.seq_jumps + o.seq_jumps,
-            time_rebases: self.time_rebases + o.time_rebases,
-            resync_bytes: self.resync_bytes + o.resync_bytes,
-            reconnects: self.reconnects + o.reconnects,
-            bytes_received: self.bytes_received + o.bytes_received,
-            valid_frames: self.valid_frames + o.valid_frames,
-            last_decode_error: if o.last_decode_error != 0 {
-                o.last_decode_error
-            } else {
-                self.last_decode_error
-            },
-        }
-    }
 }
 
 /// Every topic the watchdog reads, and what it counted of them.
@@ -226,6 +155,19 @@ impl Monitor {
     /// The navigation stream's reader: lane totals and switches.
     pub fn nav_lanes(&self) -> &NavSubscriber {
         &self.nav
+    }
+
+    /// Samples of another payload version the readers dropped since start, every topic together.
+    pub fn other_version(&self) -> u64 {
+        self.imu.rejected()
+            + self.baro.rejected()
+            + self.mag.rejected()
+            + self.fused.rejected()
+            + self.alt.rejected()
+            + self.nav.rejected()
+            + self.truth.rejected()
+            + self.health.rejected()
+            + self.fault_events.rejected()
     }
 
     /// Takes everything queued on every topic.
@@ -357,12 +299,21 @@ impl Monitor {
     }
 }
 
+/// The health report's `link`: acquisition's counters (summed over its restarts), or nothing
+/// heard while no heartbeat of acquisition has arrived.
+pub fn link_report(monitor: &Monitor) -> LinkReport {
+    let heard = monitor.heartbeats[ServiceKind::Acquisition as usize].is_some();
+    report_of(&monitor.device_counters(), heard)
+}
+
 /// Milliseconds from `then_ns` to `now_ns`, saturating.
 fn age_ms(now_ns: u64, then_ns: u64) -> u32 {
     u32::try_from(now_ns.saturating_sub(then_ns) / 1_000_000).unwrap_or(u32::MAX)
 }
 
-fn drain_count<T: std::fmt::Debug + Copy + iceoryx2::prelude::ZeroCopySend>(
+fn drain_count<
+    T: rins_runtime::payload::Versioned + std::fmt::Debug + Copy + iceoryx2::prelude::ZeroCopySend,
+>(
     sub: &TopicSubscriber<T>,
 ) -> Result<u64> {
     let mut n = 0;

@@ -3,7 +3,8 @@
 use ipc_types::{Integrity, NavMode, NavState, RedundancyReport, integrity_reason};
 pub use rins_earth::euler_deg;
 
-use crate::monitor::{COUNTED, DeviceCounters};
+use crate::device_counters::DeviceCounters;
+use crate::monitor::COUNTED;
 use crate::redundancy_view::{nav_of, nav_summary, redundancy_summary};
 
 /// One status line: per-topic rates over the last period, losses, the redundant channels in use

@@ -8,6 +8,7 @@ use anyhow::{Result, bail};
 use ipc_types::ServiceKind;
 use rins_runtime::error_chain::ErrorChain;
 use rins_runtime::ipc::IpcSettings;
+use rins_runtime::payload::OtherVersionWarning;
 use rins_runtime::shutdown::Shutdown;
 
 use crate::config::WatchdogConfig;
@@ -70,8 +71,10 @@ pub fn supervise(run: &Supervision<'_>, watch: Watch<'_>) -> Result<()> {
         .then(|| OutputDeadline::new(Duration::from_secs_f64(cfg.output_deadline_s)));
     let mut status = StatusLines::new(cfg.status_period_s, monitor, run.status_on_stderr);
     let mut events = Vec::new();
+    let mut version_warning = OtherVersionWarning::new();
     while !run.shutdown.requested() && run.end.is_none_or(|e| Instant::now() < e) {
         monitor.drain()?;
+        version_warning.check("watchdog", monitor.other_version());
         timing.observe(Instant::now(), |kind| monitor.output_count(kind));
         supervisor.poll(&mut events);
         if let Some(deadline) = deadline.as_mut() {

@@ -2,6 +2,7 @@
 //! sleeps until data arrives instead of polling. Every process opens a topic with the same
 //! settings, so whoever comes first creates it.
 
+use std::cell::Cell;
 use std::fmt::Debug;
 use std::rc::Rc;
 use std::time::Duration;
@@ -15,6 +16,7 @@ use iceoryx2::service::port_factory::{event, publish_subscribe};
 
 use super::error::IpcError;
 use super::node::IpcNode;
+use crate::payload::{Received, Versioned};
 
 /// Queue depth of every subscriber: a consumer may sleep up to this many samples of a 1 kHz topic
 /// (plus margin at 8 kHz) before the oldest is overwritten.
@@ -125,13 +127,18 @@ impl<T: Debug + ZeroCopySend + 'static> TopicPublisher<T> {
     }
 }
 
-/// Receiving end of a topic.
+/// Receiving end of a topic. It hands over only samples written with this build's payload version:
+/// the others are dropped and counted ([`TopicSubscriber::rejected`]), since their layout may differ
+/// from the one this build would read them with.
 pub struct TopicSubscriber<T: Debug + ZeroCopySend + 'static> {
     subscriber: Subscriber<ipc::Service, T, ()>,
     /// Shared with a [`super::TopicWaitSet`] that waits on this topic among others: the wait set
     /// keeps the listener attached for as long as it lives.
     listener: Rc<Listener<ipc::Service>>,
     name: &'static str,
+    /// Samples of another payload version received since start. A `Cell`: receiving takes `&self`
+    /// (the port is not shared between threads).
+    rejected: Cell<u64>,
 }
 
 impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
@@ -156,19 +163,8 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
             subscriber,
             listener: Rc::new(listener),
             name,
+            rejected: Cell::new(0),
         })
-    }
-
-    /// Next queued sample, copied out of shared memory (payloads are small and `Copy`).
-    pub fn receive(&self) -> Result<Option<T>, IpcError> {
-        let sample = self
-            .subscriber
-            .receive()
-            .map_err(|source| IpcError::Receive {
-                topic: self.name,
-                source,
-            })?;
-        Ok(sample.map(|s| *s.payload()))
     }
 
     /// Sleeps until a publisher signals new data or `timeout` passes. Returns whether a signal came.
@@ -216,20 +212,66 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
     }
 }
 
+impl<T: Versioned + Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
+    /// Next queued sample of this build's payload version, copied out of shared memory (payloads
+    /// are small and `Copy`). Samples of another version before it are dropped and counted.
+    pub fn receive(&self) -> Result<Option<T>, IpcError> {
+        loop {
+            match self.receive_any_version()? {
+                Some(Received::Current(sample)) => return Ok(Some(sample)),
+                Some(Received::OtherVersion(_)) => {}
+                None => return Ok(None),
+            }
+        }
+    }
+
+    /// Next queued sample whatever its payload version, told apart (and one of another version
+    /// counted): for the stage loop, which answers such a sample in its output stream.
+    pub(crate) fn receive_any_version(&self) -> Result<Option<Received<T>>, IpcError> {
+        let sample = self
+            .subscriber
+            .receive()
+            .map_err(|source| IpcError::Receive {
+                topic: self.name,
+                source,
+            })?;
+        Ok(sample.map(|s| {
+            let payload = *s.payload();
+            if payload.is_current() {
+                Received::Current(payload)
+            } else {
+                self.rejected.set(self.rejected.get() + 1);
+                Received::OtherVersion(payload)
+            }
+        }))
+    }
+
+    /// Samples of another payload version received (and dropped) since start.
+    pub fn rejected(&self) -> u64 {
+        self.rejected.get()
+    }
+}
+
 /// Something samples of `T` come from: one topic, or a merged stream such as the navigator lanes.
 pub trait SampleSource<T> {
     /// Sleeps until data may be there or `timeout` passes.
     fn wait(&self, timeout: Duration) -> Result<bool, IpcError>;
-    /// The next sample, if one is there.
+    /// The next sample of this build's payload version, if one is there.
     fn receive(&mut self) -> Result<Option<T>, IpcError>;
+    /// Samples of another payload version dropped since start.
+    fn rejected(&self) -> u64;
 }
 
-impl<T: Debug + ZeroCopySend + Copy + 'static> SampleSource<T> for TopicSubscriber<T> {
+impl<T: Versioned + Debug + ZeroCopySend + Copy + 'static> SampleSource<T> for TopicSubscriber<T> {
     fn wait(&self, timeout: Duration) -> Result<bool, IpcError> {
         TopicSubscriber::wait(self, timeout)
     }
 
     fn receive(&mut self) -> Result<Option<T>, IpcError> {
         TopicSubscriber::receive(self)
+    }
+
+    fn rejected(&self) -> u64 {
+        TopicSubscriber::rejected(self)
     }
 }

@@ -142,7 +142,7 @@ pub(crate) fn leave_one_out(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fdi::report::Tally;
+    use crate::fdi::tally::Tally;
 
     /// A flight outcome with `fa` false alarms and, per fault kind of [`kinds`], `detected` of
     /// 10 injected.

@@ -53,15 +53,17 @@ pub mod roc;
 mod runs;
 mod summary;
 mod table;
+mod tally;
 
 pub use candidates::DetectorSetting;
 pub use episodes::AlarmEpisode;
 pub use layout::NoiseFit;
 pub use plot::draw_roc;
 pub use report::{
-    ConfigurationSummary, FaultBreakdown, FdiReport, OperatingPoint, Tally, TrialReport, to_table,
+    ConfigurationSummary, FaultBreakdown, FdiReport, OperatingPoint, TrialReport, to_table,
 };
 pub use roc::RocPoint;
+pub use tally::Tally;
 
 /// What to evaluate: the data set, an optional trial filter, the fault detection settings and
 /// the converter resolution of the product.

@@ -7,11 +7,10 @@ use super::cross_validation::{choose, leave_one_out};
 use super::episodes::{self, AlarmEpisode};
 use super::faults::FaultKind;
 use super::layout::{Layout, Sensor};
-use super::report::{
-    ConfigurationSummary, FaultBreakdown, FdiReport, OperatingPoint, Tally, TrialReport,
-};
+use super::report::{ConfigurationSummary, FaultBreakdown, FdiReport, OperatingPoint, TrialReport};
 use super::roc::{curve, operating_probability};
 use super::table::{FlightOutcome, PreparedFlight};
+use super::tally::Tally;
 use crate::datasets::quadrotor::{IMU_RATE_HZ, Repairs, SkippedTrial};
 
 /// Everything the report is made from.

@@ -11,8 +11,8 @@ use super::candidates::{DetectorSetting, fusion_config};
 use super::faults::FaultKind;
 use super::layout::{Layout, Sensor};
 use super::prepare::Prepared;
-use super::report::Tally;
 use super::runs::{FaultRun, run_clean, run_fault};
+use super::tally::Tally;
 
 /// One flight's channels in one layout.
 pub(crate) struct PreparedFlight {

@@ -1,5 +1,5 @@
-//! Opening the serial device, for acquisition and for `rins probe`: one place that knows the
-//! driver's options and how its errors are worded.
+//! Opening the serial device, for every reader of a serial line and for `rins probe`: one place
+//! that knows the driver's options and how its errors are worded.
 
 use std::os::fd::AsRawFd;
 use std::time::Duration;

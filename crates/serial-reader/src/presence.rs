@@ -1,4 +1,4 @@
-//! Whether the serial device is there, as the acquisition loop sees it: since when it is away, how
+//! Whether the serial device is there, as the reading loop sees it: since when it is away, how
 //! many reopen attempts it took, how many times it came back. Pure (the caller passes the clock and
 //! does the logging), so that the decisions are tested without a device: an absent device is
 //! logged once per episode rather than at every retry, and only a device that came back after
