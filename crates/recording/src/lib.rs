@@ -21,8 +21,10 @@
 //! never misreads a recording made by another build.
 
 pub mod cdr;
+mod channel_check;
 mod error;
 mod reader;
+mod recorded;
 mod scan;
 pub mod schema;
 mod threaded;
@@ -31,9 +33,9 @@ mod writer;
 
 pub use cdr::Recordable;
 pub use error::{DecodeError, ReadError, RecordError};
-pub use reader::{
-    DamagedChunk, MAX_SKIP_DETAILS, Messages, RecordedMessage, Recording, SkipReason, Skipped,
-    decode, read_bytes, read_file, read_file_bytes,
+pub use reader::{Messages, read_bytes, read_file, read_file_bytes};
+pub use recorded::{
+    DamagedChunk, MAX_SKIP_DETAILS, RecordedMessage, Recording, SkipReason, Skipped, decode,
 };
 pub use scan::{MAX_CHUNK_BYTES, MAX_RECORDING_BYTES};
 pub use schema::{MAX_PAYLOAD, StructLayout};
