@@ -1,7 +1,7 @@
 """Choosing between the two navigator lanes: one contiguous navigation stream out of two.
 
-The same rule as the Rust `LaneSelector` (crates/runtime/src/lane_selector.rs), which rins's own
-consumers use. Both lanes run the same filter on the same fused IMU samples and stamp each
+The same rule as the Rust `LaneSelector` (services/navigator/src/lanes/selector.rs), which rins's
+own consumers use. Both lanes run the same filter on the same fused IMU samples and stamp each
 solution with the sequence number of its IMU sample (`header.origin_seq`), so their outputs are
 interchangeable sample by sample. The selector delivers every sequence number once, in order, from
 the lane it has selected, and keeps the other lane's samples that are ahead of the output so that

@@ -238,7 +238,7 @@ def subscribe_nav(node, timeout_s: float = 0.0, config: "SelectorConfig | None" 
 # --- generated from the Rust layouts: do not edit ---
 
 #: Layout version every payload carries in `version`.
-PAYLOAD_VERSION = 7
+PAYLOAD_VERSION = 8
 
 # Topic names.
 RAW_IMU = "rins/raw/imu"
@@ -257,6 +257,7 @@ SIM_CONTROL = "rins/control/sim"
 SIM_FAULT_APPLIED = "rins/sim/fault"
 FUSION_CONTROL = "rins/control/fusion"
 FUSION_REPLY = "rins/control/fusion/reply"
+RAW_AIRSPEED = "rins/raw/airspeed"
 #: Both navigator lanes: primary, hot standby.
 NAV_LANES = (NAV_STATE, NAV_STATE_STANDBY)
 #: The short names `rins echo` accepts.
@@ -272,6 +273,7 @@ SHORT_NAMES = {
     "truth": "rins/sim/truth",
     "heartbeat": "rins/heartbeat",
     "health": "rins/health",
+    "raw-airspeed": "rins/raw/airspeed",
 }
 
 # Limits every rins process opens a topic with; a subscriber asks for the same, since
@@ -512,6 +514,7 @@ INTEGRITY_REASONS = {
     0x400: "gnss-inconsistent",
     0x800: "sensor-fault-unisolated",
     0x1000: "position-unknown",
+    0x2000: "airspeed-inconsistent",
 }
 
 #: Bits of NavState.aiding (accepted sources), with their names.
@@ -522,6 +525,7 @@ AIDING_SOURCES = {
     0x8: "hupt",
     0x10: "gravity",
     0x20: "gnss",
+    0x40: "airspeed",
 }
 
 #: Bits of NavState.aiding (stale sources), with their names.
@@ -722,7 +726,7 @@ class Altitude(ctypes.Structure):
 
 
 class NavState(ctypes.Structure):
-    """`rins::NavState`: 376 bytes, aligned to 8."""
+    """`rins::NavState`: 384 bytes, aligned to 8."""
 
     _fields_ = [
         ("version", ctypes.c_uint16),
@@ -736,8 +740,8 @@ class NavState(ctypes.Structure):
         ("longitude_rad", ctypes.c_double),
         ("altitude_m", ctypes.c_double),
         ("covariance_diag", ctypes.c_double * 15),
-        ("aiding_accepted", ctypes.c_uint32 * 6),
-        ("aiding_rejected", ctypes.c_uint32 * 6),
+        ("aiding_accepted", ctypes.c_uint32 * 7),
+        ("aiding_rejected", ctypes.c_uint32 * 7),
         ("solution_start_seq", ctypes.c_uint64),
         ("gyro_bias_rps", ctypes.c_double * 3),
         ("accel_bias_mps2", ctypes.c_double * 3),
@@ -988,6 +992,23 @@ class FusionReply(ctypes.Structure):
         return "rins::FusionReply"
 
 
+class RawAirspeed(ctypes.Structure):
+    """`rins::RawAirspeed`: 72 bytes, aligned to 8."""
+
+    _fields_ = [
+        ("version", ctypes.c_uint16),
+        ("_pad", ctypes.c_uint8 * 6),
+        ("header", Header),
+        ("diff_pressure_pa", ctypes.c_float),
+        ("temperature_c", ctypes.c_float),
+    ]
+
+    @staticmethod
+    def type_name() -> str:
+        """The iceoryx2 type name of the Rust payload."""
+        return "rins::RawAirspeed"
+
+
 #: The payload each topic carries.
 TOPIC_PAYLOADS = {
     RAW_IMU: RawImu,
@@ -1006,5 +1027,6 @@ TOPIC_PAYLOADS = {
     SIM_CONTROL: SimControl,
     FUSION_CONTROL: FusionControl,
     FUSION_REPLY: FusionReply,
+    RAW_AIRSPEED: RawAirspeed,
 }
 # --- end of generated section ---

@@ -92,8 +92,8 @@ pub enum Command {
     Probe(ProbeArgs),
     /// Print every sample of a topic.
     Echo {
-        /// Topic: raw-imu, raw-baro, raw-mag, raw-aux, fused-imu, altitude, nav, truth, heartbeat,
-        /// health.
+        /// Topic: raw-imu, raw-baro, raw-mag, raw-aux, raw-airspeed, gnss, fused-imu, altitude, nav,
+        /// truth, heartbeat, health.
         topic: String,
         /// Stop after this many samples.
         #[arg(long)]

@@ -347,6 +347,14 @@ pub fn load(path: Option<&Path>) -> Result<RinsConfig> {
 mod tests {
     use super::*;
 
+    /// Asserts that the configuration `text` (from file `file`) is refused with an error that
+    /// says `what`.
+    #[track_caller]
+    fn assert_refused(text: &str, file: &str, what: &str) {
+        let err = RinsConfig::parse(text, file).unwrap_err();
+        assert!(format!("{err}").contains(what), "{err}");
+    }
+
     #[test]
     fn built_in_pedestrian_profile_is_valid() {
         let cfg = load_pedestrian(None).unwrap();
@@ -396,24 +404,20 @@ mod tests {
 
     #[test]
     fn bad_values_name_field_and_value() {
-        let err = RinsConfig::parse("[device]\ngyro_full_scale_dps = -5\n", "t").unwrap_err();
-        assert!(
-            format!("{err}").contains("device.gyro_full_scale_dps = -5"),
-            "{err}"
+        assert_refused(
+            "[device]\ngyro_full_scale_dps = -5\n",
+            "t",
+            "device.gyro_full_scale_dps = -5",
         );
-        let err = RinsConfig::parse(
+        assert_refused(
             "[fusion.geometry.gyro]\nkind = \"pyramid\"\nn = 4\nalpha_deg = 95\nbeta0_deg = 45\n",
             "t",
-        )
-        .unwrap_err();
-        assert!(
-            format!("{err}").contains("fusion.geometry.gyro.alpha_deg = 95"),
-            "{err}"
+            "fusion.geometry.gyro.alpha_deg = 95",
         );
-        let err = RinsConfig::parse("[deployment]\nnavigator_lanes = 3\n", "t").unwrap_err();
-        assert!(
-            format!("{err}").contains("deployment.navigator_lanes = 3: must be 1 or 2"),
-            "{err}"
+        assert_refused(
+            "[deployment]\nnavigator_lanes = 3\n",
+            "t",
+            "deployment.navigator_lanes = 3: must be 1 or 2",
         );
     }
 
@@ -431,10 +435,10 @@ mod tests {
         let twelve = load(None).unwrap();
         twelve.device.check_serial_link().unwrap();
         assert!((twelve.device.accel_lsb_mps2() - 8.0 * STANDARD_GRAVITY / 2048.0).abs() < 1e-15);
-        let err = RinsConfig::parse("[device]\nconverter_bits = 17\n", "t").unwrap_err();
-        assert!(
-            format!("{err}").contains("device.converter_bits = 17: must be 8..=16"),
-            "{err}"
+        assert_refused(
+            "[device]\nconverter_bits = 17\n",
+            "t",
+            "device.converter_bits = 17: must be 8..=16",
         );
     }
 
@@ -453,23 +457,20 @@ mod tests {
             ),
             (4000.0, 4000.0, 4000.0)
         );
-        let err = RinsConfig::parse("[fusion]\nsample_rate_hz = 500\n", "f.toml").unwrap_err();
-        assert!(
-            format!("{err}").contains(
-                "f.toml: fusion.sample_rate_hz is no longer read: the IMU rate is one key, device.imu_rate_hz"
-            ),
-            "{err}"
+        assert_refused(
+            "[fusion]\nsample_rate_hz = 500\n",
+            "f.toml",
+            "f.toml: fusion.sample_rate_hz is no longer read: the IMU rate is one key, device.imu_rate_hz",
         );
-        let err = RinsConfig::parse("[device]\nimu_rate_hz = 20000\n", "t").unwrap_err();
-        assert!(
-            format!("{err}").contains("device.imu_rate_hz = 20000"),
-            "{err}"
+        assert_refused(
+            "[device]\nimu_rate_hz = 20000\n",
+            "t",
+            "device.imu_rate_hz = 20000",
         );
     }
 
     #[test]
     fn wrong_types_are_reported_with_the_key() {
-        let err = RinsConfig::parse("[acquisition]\nbaud = \"fast\"\n", "t").unwrap_err();
-        assert!(format!("{err}").contains("baud"), "{err}");
+        assert_refused("[acquisition]\nbaud = \"fast\"\n", "t", "baud");
     }
 }

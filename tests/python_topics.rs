@@ -23,7 +23,7 @@ use std::time::{Duration, Instant};
 use common::python::{interpreter, run_script};
 use common::{Isolated, PipelineSlot, TempFile, spawn_up_navigating, stop_up};
 use ipc_types::{NavMode, Stage};
-use rins_runtime::lane_selector::{LANES, PENDING, SelectorConfig};
+use rins_navigator::lanes::{LANES, PENDING, SelectorConfig};
 use rins_test_support::signal::{Signal, send_signal};
 use serde_json::{Value, json};
 

@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
 use ipc_types::{NavMode, PAYLOAD_VERSION};
-use rins_runtime::nav_subscriber::NavSubscriber;
+use rins_navigator::lanes::NavSubscriber;
 use rins_runtime::tool_node::ToolNode;
 
 /// How long to wait for a sample before giving up: no pipeline is navigating.

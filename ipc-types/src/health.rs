@@ -67,7 +67,8 @@ pub struct Health {
     pub duplicates: u64,
     /// Serial frames that arrived after a later one of their type (reordered), not published and
     /// not counted in `lost` (acquisition); aiding readings that arrived after their place in the
-    /// IMU stream had passed (navigator).
+    /// IMU stream had passed (navigator); ticks run a period or more behind their time, caught up
+    /// (simulator).
     pub late: u64,
     /// Device sequence-counter discontinuities, re-based without counting losses (acquisition).
     pub seq_jumps: u64,

@@ -40,11 +40,11 @@ pub use health::{
     ServiceHealth, ServiceKind, ServiceState,
 };
 pub use nav::{AIDING_SOURCES, Integrity, NAV_STATES, NavMode, NavState, aiding, integrity_reason};
-pub use raw::{MAX_TEMPERATURES, RawAux, RawBaro, RawImu, RawMag, status};
+pub use raw::{MAX_TEMPERATURES, RawAirspeed, RawAux, RawBaro, RawImu, RawMag, status};
 pub use truth::Truth;
 
 /// Version of every payload layout in this crate. Bump it on any layout change.
-pub const PAYLOAD_VERSION: u16 = 7;
+pub const PAYLOAD_VERSION: u16 = 8;
 
 /// Up to this many single-axis channels per sensor type (gyro, accelerometer).
 pub const MAX_CHANNELS: usize = 16;

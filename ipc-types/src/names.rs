@@ -31,7 +31,7 @@ crate::for_each_topic!(topic_names);
 
 /// Output topic of each navigator lane: lane 0 (primary) publishes on [`NAV_STATE`], so a
 /// single-lane deployment needs nothing else; lane 1 is the hot standby. Consumers that want the
-/// contiguous stream read both through the runtime's lane selector.
+/// contiguous stream read both through the navigator's lane selector (`rins_navigator::lanes`).
 pub const NAV_LANES: [&str; 2] = [NAV_STATE, NAV_STATE_STANDBY];
 
 const ECHO_COUNT: usize = {
@@ -81,7 +81,8 @@ mod tests {
                 "nav",
                 "truth",
                 "heartbeat",
-                "health"
+                "health",
+                "raw-airspeed"
             ]
         );
         assert_eq!(TOPICS[7], ("nav", "rins/nav/state"));

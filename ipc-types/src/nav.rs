@@ -80,9 +80,12 @@ pub mod integrity_reason {
     /// No initial position was configured and no absolute fix has set one yet: the horizontal
     /// position is unknown (latitude and longitude are placeholders).
     pub const POSITION_UNKNOWN: u32 = 1 << 12;
+    /// Airspeeds persistently rejected, or their normalised innovations too large (in wind, the
+    /// zero-wind airspeed aid disagrees with the velocity over the ground).
+    pub const AIRSPEED_INCONSISTENT: u32 = 1 << 13;
 
     /// Every reason with its name, in bit order.
-    pub const NAMES: [(u32, &str); 13] = [
+    pub const NAMES: [(u32, &str); 14] = [
         (IMU_UNUSABLE, "imu-unusable"),
         (TIME_NOT_ADVANCING, "time-not-advancing"),
         (ALL_AIDING_REJECTED, "all-aiding-rejected"),
@@ -96,6 +99,7 @@ pub mod integrity_reason {
         (GNSS_INCONSISTENT, "gnss-inconsistent"),
         (SENSOR_FAULT_UNISOLATED, "sensor-fault-unisolated"),
         (POSITION_UNKNOWN, "position-unknown"),
+        (AIRSPEED_INCONSISTENT, "airspeed-inconsistent"),
     ];
 
     /// The names of the bits set in `reasons`, comma-separated (empty for none).
@@ -121,6 +125,8 @@ pub mod aiding {
     pub const GRAVITY: u32 = 1 << 4;
     /// GNSS position and velocity updates.
     pub const GNSS: u32 = 1 << 5;
+    /// Pitot airspeed updates.
+    pub const AIRSPEED: u32 = 1 << 6;
     /// Baro aiding is configured but no reading arrived within the aiding timeout: the altitude
     /// coasts on the inertial solution.
     pub const BARO_STALE: u32 = 1 << 8;
@@ -135,13 +141,14 @@ pub mod aiding {
     pub const GNSS_REJECTED: u32 = 1 << 11;
 
     /// Every source with its name, in bit order.
-    pub const SOURCE_NAMES: [(u32, &str); 6] = [
+    pub const SOURCE_NAMES: [(u32, &str); 7] = [
         (BARO, "baro"),
         (MAG, "mag"),
         (ZUPT, "zupt"),
         (HUPT, "hupt"),
         (GRAVITY, "gravity"),
         (GNSS, "gnss"),
+        (AIRSPEED, "airspeed"),
     ];
 
     /// Every stale-source bit with the source's name.
@@ -164,8 +171,9 @@ pub mod aiding {
 }
 
 /// Aiding sources counted in [`NavState::aiding_accepted`] / [`NavState::aiding_rejected`], in
-/// this order: baro, mag, zupt, hupt, gravity, gnss.
-pub const AIDING_SOURCES: usize = 6;
+/// this order: baro, mag, zupt, hupt, gravity, gnss, airspeed (the navigator's source index; a
+/// new source goes last).
+pub const AIDING_SOURCES: usize = 7;
 
 /// Length of [`NavState::covariance_diag`]: attitude error, velocity, position, gyro bias, accel bias.
 pub const NAV_STATES: usize = 15;
@@ -200,7 +208,8 @@ pub struct NavState {
     /// (3, (m/s)²), position NED (3, m²), gyro bias (3, (rad/s)²), accelerometer bias (3,
     /// (m/s²)²). Zero while aligning.
     pub covariance_diag: [f64; NAV_STATES],
-    /// Updates accepted per aiding source since alignment (baro, mag, zupt, hupt, gravity, gnss).
+    /// Updates accepted per aiding source since alignment (baro, mag, zupt, hupt, gravity, gnss,
+    /// airspeed).
     pub aiding_accepted: [u32; AIDING_SOURCES],
     /// Updates rejected by the innovation gate per aiding source since alignment.
     pub aiding_rejected: [u32; AIDING_SOURCES],

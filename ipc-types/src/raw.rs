@@ -1,5 +1,5 @@
 //! Raw samples as the sensor block sent them: what acquisition publishes for every serial frame
-//! it decodes (IMU, barometer, magnetometer, auxiliary), with the device status bits.
+//! it decodes (IMU, barometer, magnetometer, auxiliary, airspeed), with the device status bits.
 
 use iceoryx2::prelude::ZeroCopySend;
 use serde::Serialize;
@@ -124,4 +124,23 @@ pub struct RawAux {
     pub foot_pressure: f32,
     /// Zero; makes the padding explicit so that the layout has no hidden bytes.
     pub _pad2: u32,
+}
+
+/// One raw airspeed sample, published by acquisition: the pitot-static differential pressure as
+/// the sensor block measured it. The navigator turns it into true airspeed with the density of
+/// the standard atmosphere at its altitude.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, ZeroCopySend)]
+#[type_name("rins::RawAirspeed")]
+pub struct RawAirspeed {
+    /// Layout version, [`PAYLOAD_VERSION`].
+    pub version: u16,
+    /// Zero; makes the padding explicit so that the layout has no hidden bytes.
+    pub _pad: [u8; 6],
+    /// Origin of the frame and publish times, see [`Header`].
+    pub header: Header,
+    /// Differential (total minus static) pressure, pascal, offset and noise included.
+    pub diff_pressure_pa: f32,
+    /// The sensor's own temperature, degrees Celsius.
+    pub temperature_c: f32,
 }

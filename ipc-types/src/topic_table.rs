@@ -92,6 +92,12 @@ macro_rules! for_each_topic {
                 /// Fusion's answers to [`FUSION_CONTROL`] requests ([`crate::FusionReply`]).
                 FUSION_REPLY = "rins/control/fusion/reply", record "fusion-reply" at 14;
             }
+            RawAirspeed (stamped) {
+                /// Raw airspeed (pitot differential pressure) samples ([`crate::RawAirspeed`]),
+                /// from acquisition.
+                RAW_AIRSPEED = "rins/raw/airspeed", echo "raw-airspeed",
+                    record "raw-airspeed" at 15;
+            }
         }
     };
 }

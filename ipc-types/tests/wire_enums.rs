@@ -289,6 +289,7 @@ fn every_aiding_bit_has_a_name() {
         HUPT,
         GRAVITY,
         GNSS,
+        AIRSPEED,
         BARO_STALE,
         MAG_STALE,
         GNSS_STALE,

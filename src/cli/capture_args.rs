@@ -23,7 +23,7 @@ pub struct RecordArgs {
     pub max_total_mb: Option<u64>,
     /// Comma-separated short names of the topics to record (default: all): raw-imu, raw-baro,
     /// raw-mag, raw-aux, fused-imu, altitude, nav, nav-standby, truth, health, heartbeat, fault,
-    /// sim-control, fusion-control, fusion-reply.
+    /// sim-control, fusion-control, fusion-reply, raw-airspeed.
     #[arg(long, value_delimiter = ',')]
     pub topics: Vec<String>,
     /// Stop after this many seconds.

@@ -6,11 +6,11 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Result, bail};
 use ipc_types::{
-    Altitude, FusedImu, GnssFix, Health, HealthReport, NavState, RawAux, RawBaro, RawImu, RawMag,
-    Truth, names,
+    Altitude, FusedImu, GnssFix, Health, HealthReport, NavState, RawAirspeed, RawAux, RawBaro,
+    RawImu, RawMag, Truth, names,
 };
+use rins_navigator::lanes::NavSubscriber;
 use rins_runtime::ipc::{IpcNode, SampleSource, TopicSubscriber};
-use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::payload::{OtherVersionWarning, Versioned};
 use rins_runtime::setup_guard::SetupGuard;
 use rins_runtime::shutdown::Shutdown;
@@ -119,7 +119,8 @@ macro_rules! received_at {
 }
 
 received_at!(
-    with header: RawImu, RawBaro, RawMag, RawAux, GnssFix, FusedImu, Altitude, NavState;
+    with header: RawImu, RawBaro, RawMag, RawAux, RawAirspeed, GnssFix, FusedImu, Altitude,
+        NavState;
     // Truth comes from the simulator, not from a received frame: no receive time.
     without: Truth, Health, HealthReport
 );
@@ -225,6 +226,7 @@ pub fn run(topic: &str, count: Option<u64>, csv: bool, raw: bool, timeout_s: f64
         names::RAW_BARO => echo_topic::<RawBaro>(names::RAW_BARO, opts),
         names::RAW_MAG => echo_topic::<RawMag>(names::RAW_MAG, opts),
         names::RAW_AUX => echo_topic::<RawAux>(names::RAW_AUX, opts),
+        names::RAW_AIRSPEED => echo_topic::<RawAirspeed>(names::RAW_AIRSPEED, opts),
         names::GNSS => echo_topic::<GnssFix>(names::GNSS, opts),
         names::FUSED_IMU => echo_topic::<FusedImu>(names::FUSED_IMU, opts),
         names::ALTITUDE => echo_topic::<Altitude>(names::ALTITUDE, opts),
@@ -232,7 +234,10 @@ pub fn run(topic: &str, count: Option<u64>, csv: bool, raw: bool, timeout_s: f64
         names::NAV_STATE => echo_from::<NavState, _>(names::NAV_STATE, opts, NavSubscriber::new),
         names::TRUTH => echo_topic::<Truth>(names::TRUTH, opts),
         names::HEARTBEAT => echo_topic::<Health>(names::HEARTBEAT, opts),
-        _ => echo_topic::<HealthReport>(names::HEALTH, opts),
+        names::HEALTH => echo_topic::<HealthReport>(names::HEALTH, opts),
+        // A topic given an echo name in the table but no payload here: refused, never shown
+        // as another payload.
+        other => bail!("topic {topic:?} ({other}) cannot be echoed"),
     }
 }
 

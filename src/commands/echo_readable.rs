@@ -8,8 +8,8 @@
 
 use ipc_types::{
     Altitude, ChannelState, FaultReason, FusedImu, GnssFix, Health, HealthReport, Integrity,
-    LinkError, NavMode, NavState, RawAux, RawBaro, RawImu, RawMag, ServiceKind, ServiceState,
-    Stage, Truth, aiding, fused_flags, integrity_reason, status,
+    LinkError, NavMode, NavState, RawAirspeed, RawAux, RawBaro, RawImu, RawMag, ServiceKind,
+    ServiceState, Stage, Truth, aiding, fused_flags, integrity_reason, status,
 };
 use serde::Serialize;
 use serde_json::{Map, Value};
@@ -296,7 +296,7 @@ macro_rules! plain_readable {
     };
 }
 
-plain_readable!(RawBaro, RawMag, RawAux, GnssFix, Altitude);
+plain_readable!(RawBaro, RawMag, RawAux, RawAirspeed, GnssFix, Altitude);
 
 #[cfg(test)]
 mod tests {
@@ -405,6 +405,21 @@ mod tests {
             v["valid_mask"],
             serde_json::json!(["gyro0", "gyro1", "gyro3", "accel0"])
         );
+    }
+
+    #[test]
+    fn raw_airspeed_shows_the_differential_pressure_and_temperature() {
+        let raw = RawAirspeed {
+            diff_pressure_pa: 612.5,
+            temperature_c: -12.25,
+            ..RawAirspeed::default()
+        };
+        let v = raw.readable().unwrap();
+        // Both values are exact in f32, so they print as written.
+        assert_eq!(v["diff_pressure_pa"], serde_json::json!(612.5));
+        assert_eq!(v["temperature_c"], serde_json::json!(-12.25));
+        assert_eq!(v["header"]["stage_pub_ns"]["acquisition"], 0);
+        assert!(!v.to_string().contains("_pad"));
     }
 
     #[test]

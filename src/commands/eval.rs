@@ -31,12 +31,7 @@ pub fn run_fdi(args: &EvalFdiArgs) -> Result<()> {
         draw_roc(path, &report.roc, &report.operating_points)?;
         eprintln!("eval fdi: ROC drawn in {}", path.display());
     }
-    if args.json {
-        println!("{}", serde_json::to_string(&report)?);
-    } else {
-        print!("{}", to_table(&report));
-    }
-    Ok(())
+    super::report_out::print_report(args.json, &report, to_table)
 }
 
 fn pedestrian(args: &EvalProfileArgs) -> Result<rins_navigator::inertial_core::AidedConfig> {

@@ -55,10 +55,5 @@ pub fn run(args: &McArgs) -> Result<()> {
     let report =
         run_monte_carlo(&mc, |done, total| bar.set(done, total)).map_err(|e| anyhow!("mc: {e}"))?;
     bar.finish();
-    if args.json {
-        println!("{}", serde_json::to_string(&report)?);
-    } else {
-        print!("{}", report.to_table());
-    }
-    Ok(())
+    super::report_out::print_report(args.json, &report, |r| r.to_table())
 }

@@ -21,6 +21,7 @@ mod readmit;
 mod record;
 mod record_report;
 mod replay;
+mod report_out;
 mod service;
 mod sim;
 mod status;

@@ -125,10 +125,10 @@ macro_rules! record_choices {
 }
 
 /// Every topic a recording can hold, in the order they are written to the file.
-fn all_choices() -> [TopicChoice; 15] {
+fn all_choices() -> Vec<TopicChoice> {
     let mut ranked = ipc_types::for_each_topic!(record_choices);
     ranked.sort_by_key(|(rank, _)| *rank);
-    ranked.map(|(_, choice)| choice)
+    ranked.into_iter().map(|(_, choice)| choice).collect()
 }
 
 /// The short names `--topics` accepts.
@@ -410,7 +410,8 @@ mod tests {
                 "fault",
                 "sim-control",
                 "fusion-control",
-                "fusion-reply"
+                "fusion-reply",
+                "raw-airspeed"
             ]
         );
         let choices = all_choices();

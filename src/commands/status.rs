@@ -190,12 +190,7 @@ pub fn run(json: bool, timeout_s: f64) -> Result<()> {
         }
     };
     let report = rows(&report);
-    if json {
-        println!("{}", serde_json::to_string(&report)?);
-    } else {
-        print!("{}", table(&report));
-    }
-    Ok(())
+    super::report_out::print_report(json, &report, table)
 }
 
 #[cfg(test)]

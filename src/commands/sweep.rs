@@ -54,10 +54,5 @@ pub fn run(args: &SweepArgs) -> Result<()> {
     let report = run_fault_sweep(&sweep, |done, total| bar.set(done, total))
         .map_err(|e| anyhow!("sweep: {e}"))?;
     bar.finish();
-    if args.json {
-        println!("{}", serde_json::to_string(&report)?);
-    } else {
-        print!("{}", report.to_table());
-    }
-    Ok(())
+    super::report_out::print_report(args.json, &report, |r| r.to_table())
 }

@@ -14,7 +14,7 @@ use ipc_types::{
     Altitude, ChannelState, FusedImu, Health, NavState, RawAux, RawBaro, RawImu, RawMag,
     ServiceKind, names,
 };
-use rins_navigator::aiding_queue::HOLD_US;
+use rins_navigator::aiding::hold::HOLD_US;
 use rins_runtime::ipc::{
     IpcSettings, PREFIX_ENV, ROOT_ENV, SUBSCRIBER_BUFFER, TopicPublisher, TopicSubscriber,
 };

@@ -10,7 +10,7 @@ use rins_altimeter::service::altitude_message;
 use rins_fusion::ImuFuser;
 use rins_fusion::service::{fused_message, rejected_message};
 use rins_navigator::Navigator;
-use rins_navigator::aiding_queue::{AidingQueue, Reading};
+use rins_navigator::aiding::readings::{AidingQueue, Reading};
 use rins_navigator::service::step;
 
 use super::input::{RawSample, ReplayInput};

@@ -44,6 +44,12 @@ pub fn temperature_k(h_m: f64) -> f64 {
     T0_K - LAPSE_K_PER_M * h_m
 }
 
+/// Dry-air density at altitude `h_m` above the QNH reference, kg/m³ (`ρ = p·M / (R·T)`, 1.225 at
+/// standard sea level): what turns a pitot's dynamic pressure ½ρV² into airspeed.
+pub fn density_kg_m3(h_m: f64, qnh_pa: f64) -> f64 {
+    altitude_to_pressure(h_m, qnh_pa) * MOLAR_MASS_KG_PER_MOL / (GAS_CONSTANT * temperature_k(h_m))
+}
+
 /// dh/dp at `p_pa` in m/Pa (negative: height falls as pressure rises). Converts a pressure noise
 /// σ_p into a height noise |dh/dp|·σ_p.
 pub fn altitude_per_pascal(p_pa: f64, qnh_pa: f64) -> f64 {

@@ -64,3 +64,13 @@ proptest! {
         prop_assert!((d - fd).abs() < 1e-6 * fd.abs(), "{} vs {}", d, fd);
     }
 }
+
+#[test]
+fn density_is_the_standard_one_at_sea_level_and_thinner_aloft() {
+    use rins_earth::isa::density_kg_m3;
+    // U.S. Standard Atmosphere 1976: 1.2250 kg/m³ at sea level, 1.1117 at 1 km, 0.9093 at 3 km.
+    for (h, rho) in [(0.0, 1.2250), (1000.0, 1.1117), (3000.0, 0.9093)] {
+        let got = density_kg_m3(h, 101_325.0);
+        assert!((got - rho).abs() < 5e-4, "{h} m: {got}");
+    }
+}

@@ -3,11 +3,14 @@
 
 use ipc_types::{MAX_CHANNELS, MAX_TEMPERATURES};
 
-use super::error::{DecodeError, EncodeError, ImuContentError};
-use super::frame::{AuxFrame, BaroFrame, Frame, FrameType, ImuFrame, MagFrame, Payload};
+use super::error::{DecodeError, EncodeError, ImuContentError, ValueOutOfRange};
+use super::frame::{
+    AirspeedFrame, AuxFrame, BaroFrame, Frame, FrameType, ImuFrame, MagFrame, Payload,
+};
 use super::layout::{
-    AUX_PAYLOAD_LEN, BARO_PAYLOAD_LEN, CRC_LEN, CRC32C, FRAME_OVERHEAD, HEADER_LEN, LEN_OFFSET,
-    MAG_PAYLOAD_LEN, SYNC, TYPE_OFFSET, count_in_range, imu_payload_len, payload_len_plausible,
+    AIRSPEED_MAX_ABS_PA, AIRSPEED_PAYLOAD_LEN, AIRSPEED_TEMPERATURE_CENTI_C, AUX_PAYLOAD_LEN,
+    BARO_PAYLOAD_LEN, CRC_LEN, CRC32C, FRAME_OVERHEAD, HEADER_LEN, LEN_OFFSET, MAG_PAYLOAD_LEN,
+    SYNC, TYPE_OFFSET, count_in_range, imu_payload_len, payload_len_plausible,
 };
 
 impl Payload {
@@ -23,6 +26,7 @@ impl Payload {
             Payload::Baro(_) => BARO_PAYLOAD_LEN,
             Payload::Mag(_) => MAG_PAYLOAD_LEN,
             Payload::Aux(_) => AUX_PAYLOAD_LEN,
+            Payload::Airspeed(_) => AIRSPEED_PAYLOAD_LEN,
         }
     }
 }
@@ -37,11 +41,13 @@ impl Frame {
 /// Encodes `frame` into the start of `out` and returns the number of bytes written.
 ///
 /// Fails if `out` is too short, if an IMU channel count exceeds `MAX_CHANNELS` /
-/// `MAX_TEMPERATURES`, or if a gyro/accel count is outside -2048..=2047. Array entries past the
-/// channel counts are not sent.
+/// `MAX_TEMPERATURES`, if a gyro/accel count is outside -2048..=2047, or if an airspeed value is
+/// not sane ([`airspeed_sane`]). Array entries past the channel counts are not sent.
 pub fn encode(frame: &Frame, out: &mut [u8]) -> Result<usize, EncodeError> {
-    if let Payload::Imu(imu) = &frame.payload {
-        validate_imu(imu)?;
+    match &frame.payload {
+        Payload::Imu(imu) => validate_imu(imu)?,
+        Payload::Airspeed(a) => airspeed_sane(a)?,
+        Payload::Baro(_) | Payload::Mag(_) | Payload::Aux(_) => {}
     }
     let payload_len = frame.payload.wire_len();
     let total = FRAME_OVERHEAD + payload_len;
@@ -81,6 +87,10 @@ pub fn encode(frame: &Frame, out: &mut [u8]) -> Result<usize, EncodeError> {
             }
         }
         Payload::Aux(a) => w.bytes(&a.foot_pressure.to_le_bytes()),
+        Payload::Airspeed(a) => {
+            w.bytes(&a.diff_pressure_pa.to_le_bytes());
+            w.bytes(&a.temperature_centi_c.to_le_bytes());
+        }
     }
     let body_end = total - CRC_LEN;
     let crc = CRC32C.checksum(&w.buf[TYPE_OFFSET..body_end]);
@@ -130,6 +140,27 @@ fn validate_imu(imu: &ImuFrame) -> Result<(), EncodeError> {
     Ok(())
 }
 
+/// Refuses an airspeed frame with a value its sensor class cannot produce: a differential
+/// pressure that is not finite or beyond ±[`AIRSPEED_MAX_ABS_PA`], a temperature outside
+/// [`AIRSPEED_TEMPERATURE_CENTI_C`].
+pub fn airspeed_sane(a: &AirspeedFrame) -> Result<(), ValueOutOfRange> {
+    let max_pa = f64::from(AIRSPEED_MAX_ABS_PA);
+    ValueOutOfRange::check(
+        FrameType::Airspeed,
+        "diff_pressure_pa",
+        f64::from(a.diff_pressure_pa),
+        -max_pa,
+        max_pa,
+    )?;
+    ValueOutOfRange::check(
+        FrameType::Airspeed,
+        "temperature_centi_c",
+        f64::from(a.temperature_centi_c),
+        f64::from(*AIRSPEED_TEMPERATURE_CENTI_C.start()),
+        f64::from(*AIRSPEED_TEMPERATURE_CENTI_C.end()),
+    )
+}
+
 /// Total frame length announced by the header at the start of `bytes`, validated as far as the
 /// bytes present allow: sync word, frame type, and a payload length plausible for that type.
 ///
@@ -156,7 +187,7 @@ pub fn peek_frame_len(bytes: &[u8]) -> Result<usize, DecodeError> {
 /// Bytes after the frame are ignored.
 ///
 /// The order of checks is: header (sync, type, length), CRC, then payload contents (channel
-/// counts, 12-bit range). A frame is returned only if its CRC matched.
+/// counts, 12-bit range, sane airspeed values). A frame is returned only if its CRC matched.
 pub fn decode_frame(bytes: &[u8]) -> Result<(Frame, usize), DecodeError> {
     let frame_len = peek_frame_len(bytes)?;
     let incomplete = DecodeError::Incomplete { needed: frame_len };
@@ -213,6 +244,14 @@ fn decode_payload(frame_type: FrameType, bytes: &[u8]) -> Result<Payload, Decode
         FrameType::Aux => Payload::Aux(AuxFrame {
             foot_pressure: r.u16().ok_or(short)?,
         }),
+        FrameType::Airspeed => {
+            let a = AirspeedFrame {
+                diff_pressure_pa: r.f32().ok_or(short)?,
+                temperature_centi_c: r.i16().ok_or(short)?,
+            };
+            airspeed_sane(&a)?;
+            Payload::Airspeed(a)
+        }
     };
     Ok(payload)
 }

@@ -14,7 +14,7 @@ pub fn link_error(e: Option<&DecodeError>) -> LinkError {
         Some(DecodeError::UnknownFrameType { .. }) => LinkError::UnknownFrameType,
         Some(DecodeError::BadPayloadLength { .. }) => LinkError::BadLength,
         Some(DecodeError::CrcMismatch { .. }) => LinkError::CrcMismatch,
-        Some(DecodeError::Content(_)) => LinkError::BadContent,
+        Some(DecodeError::Content(_) | DecodeError::OutOfRange(_)) => LinkError::BadContent,
     }
 }
 
@@ -34,8 +34,8 @@ pub fn likely_cause(last: LinkError, discarded: u64) -> String {
                 .into()
         }
         LinkError::BadContent => {
-            "frames with impossible content (channel counts, samples beyond 12 bits): device \
-             firmware fault or another protocol version?"
+            "frames with impossible content (channel counts, samples beyond 12 bits, values \
+             beyond a sensor's range): device firmware fault or another protocol version?"
                 .into()
         }
         LinkError::None => format!(

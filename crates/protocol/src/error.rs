@@ -48,6 +48,87 @@ impl fmt::Display for ImuContentError {
 
 impl std::error::Error for ImuContentError {}
 
+/// A field of a fixed-size frame (not the IMU's, see [`ImuContentError`]) whose value no working
+/// sensor of its kind can produce: a valid CRC does not make a value sane. The same limits bind
+/// what is encoded and what is decoded.
+#[derive(Debug, Clone, Copy)]
+pub struct ValueOutOfRange {
+    /// The frame type that carried the value.
+    pub frame_type: FrameType,
+    /// The field's name (e.g. `diff_pressure_pa`).
+    pub field: &'static str,
+    /// The value given or received (NaN and infinities included).
+    pub value: f64,
+    /// Lowest sane value.
+    pub min: f64,
+    /// Highest sane value.
+    pub max: f64,
+}
+
+impl ValueOutOfRange {
+    /// `Ok` when `value` is finite and within `min..=max`, else the error naming `field`.
+    pub fn check(
+        frame_type: FrameType,
+        field: &'static str,
+        value: f64,
+        min: f64,
+        max: f64,
+    ) -> Result<(), Self> {
+        if value.is_finite() && (min..=max).contains(&value) {
+            Ok(())
+        } else {
+            Err(Self {
+                frame_type,
+                field,
+                value,
+                min,
+                max,
+            })
+        }
+    }
+}
+
+// Compared bit for bit so that a NaN value equals itself: the error is a record of what arrived.
+impl PartialEq for ValueOutOfRange {
+    fn eq(&self, other: &Self) -> bool {
+        self.frame_type == other.frame_type
+            && self.field == other.field
+            && self.value.to_bits() == other.value.to_bits()
+            && self.min.to_bits() == other.min.to_bits()
+            && self.max.to_bits() == other.max.to_bits()
+    }
+}
+
+impl Eq for ValueOutOfRange {}
+
+impl fmt::Display for ValueOutOfRange {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} frame: {} = {} is outside {}..={}",
+            self.frame_type.name(),
+            self.field,
+            self.value,
+            self.min,
+            self.max
+        )
+    }
+}
+
+impl std::error::Error for ValueOutOfRange {}
+
+impl From<ValueOutOfRange> for EncodeError {
+    fn from(e: ValueOutOfRange) -> Self {
+        EncodeError::OutOfRange(e)
+    }
+}
+
+impl From<ValueOutOfRange> for DecodeError {
+    fn from(e: ValueOutOfRange) -> Self {
+        DecodeError::OutOfRange(e)
+    }
+}
+
 impl From<ImuContentError> for EncodeError {
     fn from(e: ImuContentError) -> Self {
         EncodeError::Content(e)
@@ -72,6 +153,8 @@ pub enum EncodeError {
     },
     /// The IMU frame's content breaks the format's limits.
     Content(ImuContentError),
+    /// A fixed-size frame carries a value no working sensor produces.
+    OutOfRange(ValueOutOfRange),
 }
 
 impl fmt::Display for EncodeError {
@@ -82,6 +165,7 @@ impl fmt::Display for EncodeError {
                 "output buffer too small: frame needs {needed} bytes, buffer has {available}"
             ),
             EncodeError::Content(e) => e.fmt(f),
+            EncodeError::OutOfRange(e) => e.fmt(f),
         }
     }
 }
@@ -120,6 +204,8 @@ pub enum DecodeError {
     },
     /// The IMU frame's content breaks the format's limits (valid CRC, insane values).
     Content(ImuContentError),
+    /// A fixed-size frame's value no working sensor produces (valid CRC, insane value).
+    OutOfRange(ValueOutOfRange),
 }
 
 impl DecodeError {
@@ -150,6 +236,7 @@ impl fmt::Display for DecodeError {
                 "crc = {received:#010x} does not match the computed {computed:#010x}"
             ),
             DecodeError::Content(e) => e.fmt(f),
+            DecodeError::OutOfRange(e) => e.fmt(f),
         }
     }
 }

@@ -15,11 +15,13 @@ pub enum FrameType {
     Mag = 3,
     /// Foot-pressure sensor ([`AuxFrame`]).
     Aux = 4,
+    /// Pitot differential pressure and temperature ([`AirspeedFrame`]).
+    Airspeed = 5,
 }
 
 impl FrameType {
     /// Number of frame types: the length of per-type arrays.
-    pub const COUNT: usize = 4;
+    pub const COUNT: usize = 5;
 
     /// Every type, in [`FrameType::index`] order.
     pub const ALL: [FrameType; Self::COUNT] = [
@@ -27,6 +29,7 @@ impl FrameType {
         FrameType::Baro,
         FrameType::Mag,
         FrameType::Aux,
+        FrameType::Airspeed,
     ];
 
     /// The type a wire type byte names; `None` for a byte that names none.
@@ -36,6 +39,7 @@ impl FrameType {
             2 => Some(FrameType::Baro),
             3 => Some(FrameType::Mag),
             4 => Some(FrameType::Aux),
+            5 => Some(FrameType::Airspeed),
             _ => None,
         }
     }
@@ -52,6 +56,7 @@ impl FrameType {
             FrameType::Baro => "baro",
             FrameType::Mag => "mag",
             FrameType::Aux => "aux",
+            FrameType::Airspeed => "airspeed",
         }
     }
 }
@@ -118,6 +123,17 @@ pub struct AuxFrame {
     pub foot_pressure: u16,
 }
 
+/// Airspeed frame: a pitot-static differential pressure sensor (MS4525DO class), already
+/// converted from its bridge counts by the device.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct AirspeedFrame {
+    /// Differential (total minus static) pressure, pascal: the dynamic pressure ½ρV² plus the
+    /// sensor's offset and noise. Slightly negative values are normal at rest.
+    pub diff_pressure_pa: f32,
+    /// Sensor temperature, hundredths of a degree Celsius.
+    pub temperature_centi_c: i16,
+}
+
 /// A frame's contents, by frame type.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Payload {
@@ -129,6 +145,8 @@ pub enum Payload {
     Mag(MagFrame),
     /// An auxiliary frame's contents.
     Aux(AuxFrame),
+    /// An airspeed frame's contents.
+    Airspeed(AirspeedFrame),
 }
 
 impl Payload {
@@ -139,6 +157,7 @@ impl Payload {
             Payload::Baro(_) => FrameType::Baro,
             Payload::Mag(_) => FrameType::Mag,
             Payload::Aux(_) => FrameType::Aux,
+            Payload::Airspeed(_) => FrameType::Airspeed,
         }
     }
 }

@@ -46,6 +46,17 @@ pub const MAG_PAYLOAD_LEN: usize = 12;
 /// Auxiliary payload: u16 foot pressure.
 pub const AUX_PAYLOAD_LEN: usize = 2;
 
+/// Airspeed payload: f32 differential pressure + i16 temperature.
+pub const AIRSPEED_PAYLOAD_LEN: usize = 6;
+
+/// Largest differential pressure an airspeed frame may carry, Pa, either sign: the ±1 psi range of
+/// the sensor class (dynamic pressure of about 105 m/s at sea level), rounded up. A value beyond
+/// it, or not finite, is refused even under a valid CRC.
+pub const AIRSPEED_MAX_ABS_PA: f32 = 7000.0;
+/// Temperature range an airspeed frame may carry, hundredths of a °C: the sensor class's
+/// operating range, -50 ..= 150 °C.
+pub const AIRSPEED_TEMPERATURE_CENTI_C: core::ops::RangeInclusive<i16> = -5000..=15000;
+
 /// Lowest gyro or accelerometer count: channels are signed 12-bit ADC counts.
 pub const COUNT_MIN: i16 = -2048;
 /// Highest gyro or accelerometer count (the positive converter rail).
@@ -73,6 +84,7 @@ pub fn payload_len_plausible(frame_type: FrameType, len: usize) -> bool {
         FrameType::Baro => len == BARO_PAYLOAD_LEN,
         FrameType::Mag => len == MAG_PAYLOAD_LEN,
         FrameType::Aux => len == AUX_PAYLOAD_LEN,
+        FrameType::Airspeed => len == AIRSPEED_PAYLOAD_LEN,
     }
 }
 

@@ -213,10 +213,13 @@ mod tests {
     use super::*;
     use crate::{DecodeError, Decoder};
 
+    /// Counters with `by_type` frames of the first types (the others none).
     fn stats(by_type: [u64; 4], bytes: u64, resync: u64) -> DecoderStats {
+        let mut frames_by_type = [0; FrameType::COUNT];
+        frames_by_type[..by_type.len()].copy_from_slice(&by_type);
         DecoderStats {
             frames: by_type.iter().sum(),
-            frames_by_type: by_type,
+            frames_by_type,
             bytes,
             resync_bytes: resync,
             ..DecoderStats::default()

@@ -87,13 +87,13 @@ mod tests {
     #[test]
     fn values_beyond_the_bounds_are_named() {
         let good = ResumePoint {
-            seq: [Some(MAX_RESUME_SEQ - 1), None, Some(0), None],
+            seq: [Some(MAX_RESUME_SEQ - 1), None, Some(0), None, None],
             time_us: Some(MAX_RESUME_TIME_US - 1),
             ..ResumePoint::default()
         };
         assert_eq!(good.check(), Ok(()));
         let seq = ResumePoint {
-            seq: [None, None, Some(MAX_RESUME_SEQ), None],
+            seq: [None, None, Some(MAX_RESUME_SEQ), None, None],
             ..good
         };
         let e = seq.check().unwrap_err();

@@ -9,7 +9,9 @@ mod common;
 use common::encode_one;
 use proptest::collection::vec;
 use proptest::prelude::*;
-use rins_protocol::{AuxFrame, BaroFrame, Decoder, Frame, FrameType, ImuFrame, MagFrame, Payload};
+use rins_protocol::{
+    AirspeedFrame, AuxFrame, BaroFrame, Decoder, Frame, FrameType, ImuFrame, MagFrame, Payload,
+};
 
 const MS: u64 = 1_000_000;
 /// Largest delay of a frame or of a copy, in frame periods: well within the 1024-number window.
@@ -23,6 +25,7 @@ fn payload(type_index: usize) -> Payload {
         FrameType::Baro => Payload::Baro(BaroFrame::default()),
         FrameType::Mag => Payload::Mag(MagFrame::default()),
         FrameType::Aux => Payload::Aux(AuxFrame::default()),
+        FrameType::Airspeed => Payload::Airspeed(AirspeedFrame::default()),
     }
 }
 
@@ -56,7 +59,7 @@ proptest! {
 
     #[test]
     fn delivered_late_and_lost_add_up_and_copies_are_duplicates(
-        start in any::<[u16; 4]>(),
+        start in any::<[u16; FrameType::COUNT]>(),
         mut fates in vec(arb_fate(), 2..6_000),
     ) {
         // The first frame of each type arrives first of its type and the last one arrives: the

@@ -297,7 +297,7 @@ fn device_time_jumps_are_re_based_on_the_receive_clock() {
 fn a_resume_point_out_of_bounds_is_rejected_whole() {
     let mut decoder = Decoder::new();
     let point = ResumePoint {
-        seq: [Some(1 << 48), Some(5), None, None],
+        seq: [Some(1 << 48), Some(5), None, None, None],
         time_us: Some(10),
         ..ResumePoint::default()
     };
@@ -309,7 +309,7 @@ fn a_resume_point_out_of_bounds_is_rejected_whole() {
         })
     );
     let point = ResumePoint {
-        seq: [Some(7), None, None, None],
+        seq: [Some(7), None, None, None, None],
         time_us: Some(u64::MAX),
         ..ResumePoint::default()
     };
@@ -327,7 +327,7 @@ fn a_resume_point_far_from_the_first_frame_is_ignored_part_by_part() {
     let point = ResumePoint {
         // IMU 65 546 (wire 10): a first IMU frame at wire 5 is behind it, 2^16 − 5 steps ahead.
         // Baro 1 000: wire 1 003 is 3 ahead, continued.
-        seq: [Some(65_546), Some(1_000), None, None],
+        seq: [Some(65_546), Some(1_000), None, None, None],
         // A planted time 2^40 µs; the device's first frame is 11 min past it on the wire.
         time_us: Some(1 << 40),
         ..ResumePoint::default()
@@ -358,7 +358,7 @@ proptest! {
     /// numbers advance by the steps.
     #[test]
     fn lost_frames_equal_the_sum_of_gaps(
-        start in any::<[u16; 4]>(),
+        start in any::<[u16; FrameType::COUNT]>(),
         items in vec((arb_payload(), prop_oneof![3 => 1u16..=3, 1 => 1u16..=32_767]), 1..60),
     ) {
         let mut wire = start;

@@ -34,7 +34,7 @@ mod tests {
     use super::*;
     use ipc_types::{
         Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, GnssFix, Health,
-        HealthReport, NavState, RawAux, RawBaro, RawImu, RawMag, SimControl, Truth,
+        HealthReport, NavState, RawAirspeed, RawAux, RawBaro, RawImu, RawMag, SimControl, Truth,
     };
 
     /// Every layout described, nested ones included.
@@ -148,6 +148,7 @@ mod tests {
             name::<SimControl>(),
             name::<FusionControl>(),
             name::<FusionReply>(),
+            name::<RawAirspeed>(),
         ];
         let ours: Vec<&str> = PAYLOADS.iter().map(|l| l.type_name).collect();
         assert_eq!(ours, expected);
@@ -183,7 +184,9 @@ mod tests {
         let sizes: Vec<usize> = PAYLOADS.iter().map(|l| l.size).collect();
         assert_eq!(sizes, PAYLOAD_SIZES);
         assert_eq!(Some(MAX_PAYLOAD), sizes.iter().copied().max());
-        assert_eq!(MAX_PAYLOAD, size_of::<HealthReport>());
+        // The navigation state, with a count pair per aiding source, outgrew the health report.
+        assert_eq!(MAX_PAYLOAD, size_of::<NavState>());
+        assert!(size_of::<NavState>() > size_of::<HealthReport>());
     }
 
     #[test]

@@ -48,8 +48,8 @@ fn nav(seq: u64, lane: u8) -> NavState {
     for (i, c) in nav.covariance_diag.iter_mut().enumerate() {
         *c = 1e-6 * (i as f64 + 1.0);
     }
-    nav.aiding_accepted = [1, 2, 3, 4, 5, 6];
-    nav.aiding_rejected = [9, 8, 7, 6, 5, u32::MAX];
+    nav.aiding_accepted = [1, 2, 3, 4, 5, 6, 7];
+    nav.aiding_rejected = [9, 8, 7, 6, 5, 4, u32::MAX];
     nav.gyro_bias_rps = [1e-5, -2e-5, 3e-5];
     nav.accel_bias_mps2 = [0.01, -0.02, 0.03];
     nav

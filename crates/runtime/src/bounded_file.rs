@@ -34,11 +34,7 @@ mod tests {
     use super::*;
 
     fn scratch(name: &str) -> std::path::PathBuf {
-        let dir =
-            std::env::temp_dir().join(format!("rins-bounded-file-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir(&dir).unwrap();
-        dir
+        rins_test_support::scratch::scratch_dir("bounded-file", name)
     }
 
     fn error(path: &Path, limit: u64) -> String {

@@ -11,6 +11,25 @@ pub fn monotonic_ns() -> u64 {
     ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64
 }
 
+/// Sleeps until CLOCK_MONOTONIC reaches `deadline_ns` (at once when it has); a signal may end the
+/// sleep early, so a caller that must not act before the deadline reads the clock again.
+pub fn sleep_until(deadline_ns: u64) {
+    let ts = libc::timespec {
+        tv_sec: (deadline_ns / 1_000_000_000) as libc::time_t,
+        tv_nsec: (deadline_ns % 1_000_000_000) as libc::c_long,
+    };
+    // SAFETY: an absolute sleep on the monotonic clock with a timespec we own; no remainder is
+    // written for an absolute sleep.
+    unsafe {
+        libc::clock_nanosleep(
+            libc::CLOCK_MONOTONIC,
+            libc::TIMER_ABSTIME,
+            &ts,
+            std::ptr::null_mut(),
+        );
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -23,5 +42,16 @@ mod tests {
             assert!(now >= last);
             last = now;
         }
+    }
+
+    #[test]
+    fn a_sleep_lasts_until_its_deadline_and_a_past_one_returns_at_once() {
+        let deadline = monotonic_ns() + 2_000_000;
+        sleep_until(deadline);
+        assert!(monotonic_ns() >= deadline);
+        let before = monotonic_ns();
+        sleep_until(before.saturating_sub(1_000_000_000));
+        // A deadline in the past does not sleep (a generous bound for a loaded machine).
+        assert!(monotonic_ns() - before < 500_000_000);
     }
 }

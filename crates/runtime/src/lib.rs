@@ -1,6 +1,7 @@
 //! Runtime shared by every rins process: iceoryx2 node and topic set-up on an isolated prefix,
-//! the monotonic clock, termination signals, heartbeats and log set-up, and the checks that keep
-//! another local user's files out of a deployment (private directories, owners, bounded files).
+//! the monotonic clock, termination signals, heartbeats and log set-up, the loops the processes
+//! run (topic-driven stages, clock-paced sources), and the checks that keep another local user's
+//! files out of a deployment (private directories, owners, bounded files).
 
 pub mod bounded_file;
 pub mod clock;
@@ -10,9 +11,8 @@ pub mod heartbeat;
 pub mod input_watch;
 pub mod ipc;
 pub mod join_check;
-pub mod lane_selector;
 pub mod logging;
-pub mod nav_subscriber;
+pub mod paced_loop;
 pub mod payload;
 pub mod private_dir;
 pub mod realtime;

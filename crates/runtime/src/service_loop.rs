@@ -30,6 +30,11 @@ impl ServiceLoop {
         !self.shutdown.requested()
     }
 
+    /// The stop flag, for waits that poll it while beating (a clone shares the flag).
+    pub fn shutdown(&self) -> &Shutdown {
+        &self.shutdown
+    }
+
     /// Publishes the counters when a heartbeat is due (once a second); cheap otherwise.
     pub fn beat(&mut self) -> Result<(), IpcError> {
         self.heartbeat.tick(&self.counters)

@@ -1,18 +1,19 @@
 //! The payload version check over real iceoryx2 shared memory, for every kind of consumer: a sample
 //! written with another payload version, on any topic a consumer reads, never reaches it and is
 //! counted by the reader that dropped it, while the samples of this build around it come through.
+//! The merged navigation stream (both navigator lanes) is checked with its subscriber, in
+//! rins-navigator's `nav_subscriber_payload_version_ipc` tests.
 
 use std::fmt::Debug;
 
 use iceoryx2::prelude::ZeroCopySend;
 use ipc_types::{
     Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, GnssFix, Health, HealthReport,
-    NavMode, NavState, PAYLOAD_VERSION, RawAux, RawBaro, RawImu, RawMag, SimControl, Truth, names,
+    NavState, PAYLOAD_VERSION, RawAux, RawBaro, RawImu, RawMag, SimControl, Truth, names,
 };
 use rins_runtime::ipc::{
     IpcNode, IpcSettings, SampleSource, TopicPublisher, TopicSubscriber, create_node,
 };
-use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::payload::{Received, Versioned};
 use rins_runtime::shm_cleanup;
 use rins_runtime::stage_io::StageInput;
@@ -138,48 +139,6 @@ fn stage_input_rejects<T: TestPayload>(node: &IpcNode, topic: &'static str) {
     assert_eq!(counters.rejected, 4, "{topic}");
 }
 
-fn nav(lane: u8, version: u16, seq: u64) -> NavState {
-    let mut s = NavState {
-        version,
-        mode: NavMode::Navigating as u8,
-        lane,
-        solution_start_seq: 1,
-        ..NavState::default()
-    };
-    s.header.origin_seq = seq;
-    s
-}
-
-/// The merged navigation stream drops another version on either lane (in between a contiguous
-/// sequence of this build's, so that no lane looks late); the lane totals count only what was
-/// taken in.
-fn nav_subscriber_rejects(node: &IpcNode) {
-    let mut sub = NavSubscriber::new(node).expect("subscriber");
-    let lanes = names::NAV_LANES.map(|t| TopicPublisher::<NavState>::new(node, t).expect("lane"));
-    for (lane, publisher) in (0u8..).zip(&lanes) {
-        for (seq, other) in (1..=3).zip(OTHER_VERSIONS) {
-            publisher
-                .publish(nav(lane, PAYLOAD_VERSION, seq))
-                .expect("publish");
-            publisher
-                .publish(nav(lane, other, 100 + seq))
-                .expect("publish");
-        }
-        publisher
-            .publish(nav(lane, PAYLOAD_VERSION, 3))
-            .expect("publish");
-    }
-    let mut got = Vec::new();
-    while let Some(s) = sub.receive().expect("receive") {
-        assert!(s.is_current(), "{s:?}");
-        got.push((s.header.origin_seq, s.lane));
-    }
-    assert_eq!(got, [(1, 0), (2, 0), (3, 0)]);
-    assert_eq!(sub.rejected(), 4);
-    assert_eq!(SampleSource::rejected(&sub), 4);
-    assert_eq!(sub.lane_totals(), [3, 3]);
-}
-
 fn settings(tag: &str) -> IpcSettings {
     let pid = std::process::id();
     IpcSettings::new(
@@ -221,23 +180,15 @@ fn stage_inputs_count_and_set_apart_another_version() {
 }
 
 #[test]
-fn the_navigation_stream_drops_another_version_on_either_lane() {
-    on_private_node("nv", |node| {
-        nav_subscriber_rejects(node);
-    });
-}
-
-#[test]
 fn the_mavlink_readers_drop_another_version() {
     on_private_node("mv", |node| {
         plain_reader_rejects::<FusedImu>(node, names::FUSED_IMU);
         plain_reader_rejects::<HealthReport>(node, names::HEALTH);
         plain_reader_rejects::<FusionReply>(node, names::FUSION_REPLY);
-        nav_subscriber_rejects(node);
     });
 }
 
-/// What the watchdog's monitor reads: every topic it watches, and the navigation stream.
+/// What the watchdog's monitor reads besides the navigation stream: every topic it watches.
 fn watchdog_readers_reject(node: &IpcNode) {
     plain_reader_rejects::<RawImu>(node, names::RAW_IMU);
     plain_reader_rejects::<RawBaro>(node, names::RAW_BARO);
@@ -247,7 +198,6 @@ fn watchdog_readers_reject(node: &IpcNode) {
     plain_reader_rejects::<Truth>(node, names::TRUTH);
     plain_reader_rejects::<Health>(node, names::HEARTBEAT);
     plain_reader_rejects::<FaultApplied>(node, names::SIM_FAULT_APPLIED);
-    nav_subscriber_rejects(node);
 }
 
 #[test]

@@ -1,13 +1,17 @@
 //! The one loop every serial reader runs: open the device, read it until it is lost, wait with
 //! backoff, open it again, until a stop is requested. The loop owns the decisions (when to retry,
-//! how long to wait, what counts as lost); the reader's [`LineEvents`] say what each event means
-//! to it (logging, decoding, counters, heartbeats).
+//! how long to wait, what counts as lost) and the process's share of them: the stop flag, the
+//! reconnect count and the heartbeat of its [`ServiceLoop`], sent after every read and through
+//! every wait, so that a process waiting for its device is never taken for hung. The reader's
+//! [`LineEvents`] say what each event means to it (logging, decoding, its own counters).
 
 use std::io::Read;
 use std::time::Duration;
 
 use anyhow::Result;
+use ipc_types::Health;
 use rins_runtime::clock::monotonic_ns;
+use rins_runtime::service_loop::ServiceLoop;
 use rins_runtime::shutdown::Shutdown;
 
 use crate::line_config::SerialLineConfig;
@@ -20,29 +24,61 @@ use crate::wait::wait_for_retry;
 pub trait LineEvents {
     /// An attempt to open the device failed with `error`; the loop waits `retry.delay` next.
     fn open_failed(&mut self, error: &anyhow::Error, retry: &Retry, presence: &Presence);
-    /// The device opened: the first time, or back after an absence.
+    /// The device opened: the first time, or back after an absence (already counted in
+    /// [`Health::reconnects`]).
     fn opened(&mut self, opened: Opened, presence: &Presence);
     /// A read returned `bytes` (never empty).
-    fn bytes(&mut self, bytes: &[u8]);
-    /// After every read that did not lose the device, bytes or timeout: the place for statistics
-    /// and the heartbeat. An error ends the loop.
-    fn after_read(&mut self) -> Result<()>;
+    fn bytes(&mut self, bytes: &[u8], counters: &mut Health);
+    /// After every read that did not lose the device, bytes or timeout, before the heartbeat:
+    /// the place for statistics.
+    fn after_read(&mut self, counters: &mut Health);
     /// The open device was lost with `error`; the loop waits `delay` before reopening it.
     fn lost(&mut self, error: &std::io::Error, delay: Duration, presence: &Presence);
-    /// Every step of a wait between attempts (the heartbeat). An error ends the loop.
-    fn waiting(&mut self) -> Result<()>;
 }
 
-/// Reads the device at `path` with the settings of `line` into `events` until `shutdown` is
-/// requested, reading at most `buf.len()` bytes at a time. A missing or lost device is retried
-/// with the line's backoff, never given up on. Returns the first error of `events`.
+/// What the loop needs of the process around it: [`ServiceLoop`] in a service.
+trait Process {
+    fn shutdown(&self) -> &Shutdown;
+    fn counters(&mut self) -> &mut Health;
+    fn beat(&mut self) -> Result<()>;
+}
+
+impl Process for ServiceLoop {
+    fn shutdown(&self) -> &Shutdown {
+        ServiceLoop::shutdown(self)
+    }
+    fn counters(&mut self) -> &mut Health {
+        &mut self.counters
+    }
+    fn beat(&mut self) -> Result<()> {
+        Ok(ServiceLoop::beat(self)?)
+    }
+}
+
+/// Reads the device at `path` with the settings of `line` into `events` until the stop of
+/// `service` is requested, reading at most `buf.len()` bytes at a time. A missing or lost device is
+/// retried with the line's backoff, never given up on. Returns the final counters, or the first
+/// error of the heartbeat.
 pub fn read_reconnecting(
     path: &str,
     line: &SerialLineConfig,
-    shutdown: &Shutdown,
+    mut service: ServiceLoop,
+    buf: &mut [u8],
+    events: &mut impl LineEvents,
+) -> Result<Health> {
+    reconnect_loop(path, line, &mut service, buf, events)?;
+    Ok(service.counters)
+}
+
+fn reconnect_loop(
+    path: &str,
+    line: &SerialLineConfig,
+    process: &mut impl Process,
     buf: &mut [u8],
     events: &mut impl LineEvents,
 ) -> Result<()> {
+    // The waits poll the flag while the process beats; a clone shares it.
+    let shutdown = process.shutdown().clone();
     let mut presence = Presence::new(line.backoff());
     while !shutdown.requested() {
         let port = match port::open(path, line.baud, line.read_timeout()) {
@@ -50,19 +86,22 @@ pub fn read_reconnecting(
             Err(e) => {
                 let retry = presence.open_failed(monotonic_ns());
                 events.open_failed(&e, &retry, &presence);
-                wait_for_retry(retry.delay, shutdown, || events.waiting())?;
+                wait_for_retry(retry.delay, &shutdown, || process.beat())?;
                 continue;
             }
         };
         let opened = presence.opened(monotonic_ns());
+        if let Opened::Reconnected { .. } = opened {
+            process.counters().reconnects = presence.reconnects();
+        }
         events.opened(opened, &presence);
-        let lost = read_until_lost(port, shutdown, buf, &mut presence, events)?;
+        let lost = read_until_lost(port, &shutdown, buf, &mut presence, process, events)?;
         if let Some(e) = lost
             && !shutdown.requested()
         {
             let delay = presence.lost(monotonic_ns());
             events.lost(&e, delay, &presence);
-            wait_for_retry(delay, shutdown, || events.waiting())?;
+            wait_for_retry(delay, &shutdown, || process.beat())?;
         }
     }
     Ok(())
@@ -75,6 +114,7 @@ fn read_until_lost(
     shutdown: &Shutdown,
     buf: &mut [u8],
     presence: &mut Presence,
+    process: &mut impl Process,
     events: &mut impl LineEvents,
 ) -> Result<Option<std::io::Error>> {
     while !shutdown.requested() {
@@ -83,7 +123,7 @@ fn read_until_lost(
             Ok(0) => return Ok(Some(std::io::ErrorKind::UnexpectedEof.into())),
             Ok(n) => {
                 presence.data_arrived();
-                events.bytes(&buf[..n]);
+                events.bytes(&buf[..n], process.counters());
             }
             Err(e)
                 if matches!(
@@ -92,7 +132,8 @@ fn read_until_lost(
                 ) => {}
             Err(e) => return Ok(Some(e)),
         }
-        events.after_read()?;
+        events.after_read(process.counters());
+        process.beat()?;
     }
     Ok(None)
 }
@@ -118,6 +159,36 @@ mod tests {
         }
     }
 
+    /// The process around the loop, without IPC: its beats are counted.
+    struct Fake {
+        shutdown: Shutdown,
+        counters: Health,
+        beats: usize,
+    }
+
+    impl Fake {
+        fn new(shutdown: Shutdown) -> Self {
+            Self {
+                shutdown,
+                counters: Health::default(),
+                beats: 0,
+            }
+        }
+    }
+
+    impl Process for Fake {
+        fn shutdown(&self) -> &Shutdown {
+            &self.shutdown
+        }
+        fn counters(&mut self) -> &mut Health {
+            &mut self.counters
+        }
+        fn beat(&mut self) -> Result<()> {
+            self.beats += 1;
+            Ok(())
+        }
+    }
+
     #[derive(Default)]
     struct Log {
         bytes: Vec<u8>,
@@ -127,17 +198,14 @@ mod tests {
     impl LineEvents for Log {
         fn open_failed(&mut self, _: &anyhow::Error, _: &Retry, _: &Presence) {}
         fn opened(&mut self, _: Opened, _: &Presence) {}
-        fn bytes(&mut self, bytes: &[u8]) {
+        fn bytes(&mut self, bytes: &[u8], counters: &mut Health) {
             self.bytes.extend_from_slice(bytes);
+            counters.bytes_received += bytes.len() as u64;
         }
-        fn after_read(&mut self) -> Result<()> {
+        fn after_read(&mut self, _: &mut Health) {
             self.after_reads += 1;
-            Ok(())
         }
         fn lost(&mut self, _: &std::io::Error, _: Duration, _: &Presence) {}
-        fn waiting(&mut self) -> Result<()> {
-            Ok(())
-        }
     }
 
     fn presence() -> Presence {
@@ -161,20 +229,48 @@ mod tests {
         let mut log = Log::default();
         let mut p = presence();
         p.opened(0);
-        let lost = read_until_lost(script, &Shutdown::manual(), &mut [0; 8], &mut p, &mut log)
-            .unwrap()
-            .expect("the end of the script is a hang-up");
+        let shutdown = Shutdown::manual();
+        let mut process = Fake::new(shutdown.clone());
+        let lost = read_until_lost(
+            script,
+            &shutdown,
+            &mut [0; 8],
+            &mut p,
+            &mut process,
+            &mut log,
+        )
+        .unwrap()
+        .expect("the end of the script is a hang-up");
         assert_eq!(lost.kind(), ErrorKind::UnexpectedEof);
-        // Four reads before the hang-up, each followed by `after_read`; the hang-up is not.
+        // Four reads before the hang-up, each followed by `after_read` and a heartbeat; the
+        // hang-up is not. The reader's counters are the process's.
         assert_eq!((log.bytes.as_slice(), log.after_reads), (&b"abc"[..], 4));
+        assert_eq!((process.beats, process.counters.bytes_received), (4, 3));
         // The device delivered data: its loss starts the shortest backoff.
         assert_eq!(p.lost(1), Duration::from_millis(10));
 
         let script = Script(vec![Err(ErrorKind::BrokenPipe.into())].into_iter());
-        let lost = read_until_lost(script, &Shutdown::manual(), &mut [0; 8], &mut p, &mut log)
-            .unwrap()
-            .expect("an I/O error is a loss");
+        let lost = read_until_lost(
+            script,
+            &shutdown,
+            &mut [0; 8],
+            &mut p,
+            &mut process,
+            &mut log,
+        )
+        .unwrap()
+        .expect("an I/O error is a loss");
         assert_eq!(lost.kind(), ErrorKind::BrokenPipe);
+    }
+
+    fn line() -> SerialLineConfig {
+        SerialLineConfig {
+            port: None,
+            baud: 9600,
+            read_timeout_ms: 50,
+            reconnect_initial_ms: 10,
+            reconnect_max_ms: 1000,
+        }
     }
 
     #[test]
@@ -182,17 +278,45 @@ mod tests {
         let shutdown = Shutdown::manual();
         shutdown.request();
         let mut log = Log::default();
+        let mut process = Fake::new(shutdown.clone());
         let script = Script(vec![Ok(b"x".to_vec())].into_iter());
-        let lost = read_until_lost(script, &shutdown, &mut [0; 8], &mut presence(), &mut log);
+        let lost = read_until_lost(
+            script,
+            &shutdown,
+            &mut [0; 8],
+            &mut presence(),
+            &mut process,
+            &mut log,
+        );
         assert!(lost.unwrap().is_none());
-        let line = SerialLineConfig {
-            port: None,
-            baud: 9600,
-            read_timeout_ms: 50,
-            reconnect_initial_ms: 10,
-            reconnect_max_ms: 1000,
-        };
-        read_reconnecting("/nonexistent", &line, &shutdown, &mut [0; 8], &mut log).unwrap();
-        assert_eq!(log.after_reads, 0);
+        reconnect_loop("/nonexistent", &line(), &mut process, &mut [0; 8], &mut log).unwrap();
+        assert_eq!((log.after_reads, process.beats), (0, 0));
+    }
+
+    #[test]
+    fn a_missing_device_keeps_the_heartbeat_going() {
+        let shutdown = Shutdown::manual();
+        let mut process = Fake::new(shutdown.clone());
+        let mut log = Log::default();
+        // A stop arrives while the loop waits for a device that is not there.
+        let stop = std::thread::spawn({
+            let shutdown = shutdown.clone();
+            move || {
+                std::thread::sleep(Duration::from_millis(100));
+                shutdown.request();
+            }
+        });
+        reconnect_loop(
+            "/nonexistent/tty",
+            &line(),
+            &mut process,
+            &mut [0; 8],
+            &mut log,
+        )
+        .unwrap();
+        stop.join().unwrap();
+        // The waits of 100 ms beat every 10 ms step; nothing was read, nothing reconnected.
+        assert!(process.beats >= 5, "{} beats", process.beats);
+        assert_eq!((log.after_reads, process.counters.reconnects), (0, 0));
     }
 }

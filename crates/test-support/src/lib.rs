@@ -4,8 +4,10 @@
 //! - [`counting_alloc`]: a global allocator that counts this thread's allocations, for the
 //!   allocation-free checks of the per-sample paths.
 //! - [`pyramid`]: sensitive axes of the skewed pyramid layouts.
+//! - [`scratch`]: a fresh, empty directory per test.
 //! - [`signal`]: sending a signal to a child process (or any process a test started).
 
 pub mod counting_alloc;
 pub mod pyramid;
+pub mod scratch;
 pub mod signal;

@@ -23,8 +23,8 @@ const FIELDS: usize = FrameType::COUNT + 1;
 /// How often the running acquisition saves its point.
 pub const SAVE_PERIOD_NS: u64 = 1_000_000_000;
 
-/// Largest file taken for a point: five numbers of at most 20 digits and their separators are
-/// about a hundred bytes.
+/// Largest file taken for a point: six numbers of at most 20 digits, their wire values and
+/// separators are under two hundred bytes.
 pub const MAX_FILE_BYTES: u64 = 512;
 
 /// The file of the deployment on `settings`, in its run directory: removed with the deployment's
@@ -33,7 +33,7 @@ pub fn path_for(settings: &rins_runtime::ipc::IpcSettings) -> PathBuf {
     settings.run_dir().join("acquisition.resume")
 }
 
-/// `imu baro mag aux time_us`, each `EXTENDED/WIRE` (the wire value it was given to; `EXTENDED`
+/// `imu baro mag aux airspeed time_us` (one sequence per [`FrameType`], then the time), each `EXTENDED/WIRE` (the wire value it was given to; `EXTENDED`
 /// alone when that is not known), `-` for a value not known yet.
 pub fn format(point: &ResumePoint) -> String {
     let field = |v: Option<u64>, wire: Option<u64>| match (v, wire) {
@@ -175,14 +175,14 @@ mod tests {
     #[test]
     fn round_trip_and_rejects() {
         let point = ResumePoint {
-            seq: [Some(65_547), None, Some(3), Some(u64::MAX)],
-            seq_wire: [Some(11), None, None, Some(65_535)],
+            seq: [Some(65_547), None, Some(3), Some(u64::MAX), Some(4)],
+            seq_wire: [Some(11), None, None, Some(65_535), Some(4)],
             time_us: Some(1 << 40),
             time_wire: Some(7),
         };
         assert_eq!(
             format(&point),
-            "65547/11 - 3 18446744073709551615/65535 1099511627776/7"
+            "65547/11 - 3 18446744073709551615/65535 4/4 1099511627776/7"
         );
         assert_eq!(parse(&format(&point)), Some(point));
         assert_eq!(
@@ -191,29 +191,26 @@ mod tests {
         );
         for bad in [
             "",
-            "1 2 3 4",
-            "1 2 3 4 5 6",
-            "1 2 x 4 5",
-            "-1 2 3 4 5",
-            "1/65536 2 3 4 5",
-            "1 2 3 4 5/4294967296",
-            "1/ 2 3 4 5",
-            "1/2/3 2 3 4 5",
+            "1 2 3 4 5",
+            "1 2 3 4 5 6 7",
+            "1 2 x 4 5 6",
+            "-1 2 3 4 5 6",
+            "1/65536 2 3 4 5 6",
+            "1 2 3 4 5 6/4294967296",
+            "1/ 2 3 4 5 6",
+            "1/2/3 2 3 4 5 6",
         ] {
             assert_eq!(parse(bad), None, "{bad:?}");
         }
     }
 
     fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("rins-resume-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+        rins_test_support::scratch::scratch_dir("resume", name)
     }
 
     fn point() -> ResumePoint {
         ResumePoint {
-            seq: [Some(7), Some(8), Some(9), None],
+            seq: [Some(7), Some(8), Some(9), None, Some(11)],
             time_us: Some(10),
             ..ResumePoint::default()
         }

@@ -5,11 +5,11 @@
 use std::time::Duration;
 
 use anyhow::{Result, anyhow};
-use ipc_types::{Health, RawAux, RawBaro, RawImu, RawMag, ServiceKind, Stage, names};
+use ipc_types::{Health, RawAirspeed, RawAux, RawBaro, RawImu, RawMag, ServiceKind, Stage, names};
 use rins_runtime::clock::monotonic_ns;
-use rins_runtime::heartbeat::Heartbeat;
 use rins_runtime::ipc::{IpcNode, IpcSettings, create_node};
 use rins_runtime::service::{Service, ServiceContext};
+use rins_runtime::service_loop::ServiceLoop;
 use rins_runtime::shutdown::Shutdown;
 use rins_runtime::stage_io::StagePublisher;
 
@@ -29,6 +29,7 @@ struct Publishers {
     baro: StagePublisher<RawBaro>,
     mag: StagePublisher<RawMag>,
     aux: StagePublisher<RawAux>,
+    airspeed: StagePublisher<RawAirspeed>,
 }
 
 impl Publishers {
@@ -39,6 +40,7 @@ impl Publishers {
             baro: StagePublisher::new(node, names::RAW_BARO, stage)?,
             mag: StagePublisher::new(node, names::RAW_MAG, stage)?,
             aux: StagePublisher::new(node, names::RAW_AUX, stage)?,
+            airspeed: StagePublisher::new(node, names::RAW_AIRSPEED, stage)?,
         })
     }
 
@@ -56,6 +58,9 @@ impl Publishers {
             }
             Payload::Aux(f) => {
                 self.aux.publish(to_ipc::raw_aux(f, header))?;
+            }
+            Payload::Airspeed(f) => {
+                self.airspeed.publish(to_ipc::raw_airspeed(f, header))?;
             }
         }
         Ok(())
@@ -87,7 +92,7 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
     })?;
     let node = create_node(ServiceKind::Acquisition.name(), settings)?;
     let publishers = Publishers::new(&node)?;
-    let heartbeat = Heartbeat::new(&node, ServiceKind::Acquisition)?;
+    let service = ServiceLoop::new(&node, ServiceKind::Acquisition, shutdown)?;
     let mut decoder = Decoder::new();
     // Continue the numbering of the run this one replaces (see `resume_file`), from the verified
     // run directory only.
@@ -118,18 +123,16 @@ pub fn run(config: &AcquisitionConfig, settings: &IpcSettings, shutdown: &Shutdo
         path: &path,
         simulator_link: settings.in_run_dir(std::path::Path::new(&path)),
         publishers,
-        heartbeat,
         line: LineWatch::new(monotonic_ns(), &decoder.stats()),
         decoder,
         resume_saver,
         next_save_ns: 0,
         resume_rejected,
-        counters: Health::default(),
     };
     let mut buf = [0u8; 4096];
-    read_reconnecting(&path, &config.line(), shutdown, &mut buf, &mut reader)?;
+    let counters = read_reconnecting(&path, &config.line(), service, &mut buf, &mut reader)?;
     reader.resume_saver.finish(reader.decoder.resume_point());
-    tracing::info!(frames = reader.counters.received, "acquisition stopped");
+    tracing::info!(frames = counters.received, "acquisition stopped");
     Ok(())
 }
 
@@ -140,14 +143,12 @@ struct Reader<'a> {
     /// service starts: waiting for it is expected, not worth a warning.
     simulator_link: bool,
     publishers: Publishers,
-    heartbeat: Heartbeat,
     decoder: Decoder,
     line: LineWatch,
     resume_saver: ResumeSaver,
     next_save_ns: u64,
     /// Resume-point parts the device's first frames refused, as last reported.
     resume_rejected: u64,
-    counters: Health,
 }
 
 impl LineEvents for Reader<'_> {
@@ -186,12 +187,11 @@ impl LineEvents for Reader<'_> {
                 );
             }
             Opened::Reconnected { away, attempts } => {
-                self.counters.reconnects = presence.reconnects();
                 tracing::info!(
                     port = %path,
                     away_ms = millis(away),
                     attempts,
-                    reconnects = self.counters.reconnects,
+                    reconnects = presence.reconnects(),
                     "serial device back: resynchronising"
                 );
             }
@@ -201,7 +201,7 @@ impl LineEvents for Reader<'_> {
         self.line.opened(monotonic_ns(), &self.decoder.stats());
     }
 
-    fn bytes(&mut self, bytes: &[u8]) {
+    fn bytes(&mut self, bytes: &[u8], counters: &mut Health) {
         // One receive time for every frame this read completed: the moment we had them whole.
         let rx_ns = monotonic_ns();
         if rx_ns >= self.next_save_ns {
@@ -209,7 +209,7 @@ impl LineEvents for Reader<'_> {
             self.resume_saver.offer(self.decoder.resume_point());
         }
         let mut failed = None;
-        let (publishers, counters) = (&self.publishers, &mut self.counters);
+        let publishers = &self.publishers;
         self.decoder.push(bytes, rx_ns, |frame| {
             if let Err(e) = publishers.publish(&frame, rx_ns) {
                 counters.rejected += 1;
@@ -223,7 +223,7 @@ impl LineEvents for Reader<'_> {
         }
     }
 
-    fn after_read(&mut self) -> Result<()> {
+    fn after_read(&mut self, counters: &mut Health) {
         let stats = self.decoder.stats();
         if stats.resume_rejected != self.resume_rejected {
             self.resume_rejected = stats.resume_rejected;
@@ -232,8 +232,7 @@ impl LineEvents for Reader<'_> {
         if let Some(warning) = self.line.observe(monotonic_ns(), &stats) {
             tracing::warn!(port = %self.path, "{}", warning.message(self.path));
         }
-        fill_counters(&mut self.counters, &stats);
-        Ok(self.heartbeat.tick(&self.counters)?)
+        fill_counters(counters, &stats);
     }
 
     fn lost(&mut self, e: &std::io::Error, delay: Duration, presence: &Presence) {
@@ -244,10 +243,6 @@ impl LineEvents for Reader<'_> {
             max_retry_ms = millis(presence.backoff().max()),
             "serial device lost: reopening with backoff"
         );
-    }
-
-    fn waiting(&mut self) -> Result<()> {
-        Ok(self.heartbeat.tick(&self.counters)?)
     }
 }
 

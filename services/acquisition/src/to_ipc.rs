@@ -1,8 +1,8 @@
 //! Decoded frames → IPC payloads, with the origin header stamped.
 
-use ipc_types::{Header, PAYLOAD_VERSION, RawAux, RawBaro, RawImu, RawMag};
+use ipc_types::{Header, PAYLOAD_VERSION, RawAirspeed, RawAux, RawBaro, RawImu, RawMag};
 
-use rins_protocol::{AuxFrame, BaroFrame, DecodedFrame, ImuFrame, MagFrame};
+use rins_protocol::{AirspeedFrame, AuxFrame, BaroFrame, DecodedFrame, ImuFrame, MagFrame};
 
 /// The header of a decoded frame: its device sequence and time, and when it was received (`rx_ns`).
 pub fn origin_header(frame: &DecodedFrame, rx_ns: u64) -> Header {
@@ -67,6 +67,17 @@ pub fn raw_aux(f: &AuxFrame, header: Header) -> RawAux {
     }
 }
 
+/// The raw airspeed message of an airspeed frame.
+pub fn raw_airspeed(f: &AirspeedFrame, header: Header) -> RawAirspeed {
+    RawAirspeed {
+        version: PAYLOAD_VERSION,
+        header,
+        diff_pressure_pa: f.diff_pressure_pa,
+        temperature_c: f32::from(f.temperature_centi_c) / 100.0,
+        ..RawAirspeed::default()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -106,5 +117,15 @@ mod tests {
             h,
         );
         assert_eq!(aux.foot_pressure, 1.0);
+        let airspeed = raw_airspeed(
+            &AirspeedFrame {
+                diff_pressure_pa: 612.5,
+                temperature_centi_c: -250,
+            },
+            h,
+        );
+        assert_eq!(airspeed.diff_pressure_pa, 612.5);
+        assert!((airspeed.temperature_c + 2.5).abs() < 1e-6);
+        assert_eq!(airspeed.header, h);
     }
 }

@@ -310,6 +310,22 @@ impl Geometry {
     pub fn full_mask(&self) -> u32 {
         channel_mask(self.n)
     }
+
+    /// The channels selected by `mask` (bits at or above N ignored) in ascending order, and how
+    /// many they are; their count as the error when fewer than [`MIN_CHANNELS`] (nothing to
+    /// solve for).
+    pub fn active_channels(&self, mask: u32) -> Result<([u8; MAX_CHANNELS], usize), usize> {
+        let mut active = [0u8; MAX_CHANNELS];
+        let mut n_active = 0;
+        for i in (0..self.n).filter(|i| mask & (1 << i) != 0) {
+            active[n_active] = i as u8;
+            n_active += 1;
+        }
+        if n_active < MIN_CHANNELS {
+            return Err(n_active);
+        }
+        Ok((active, n_active))
+    }
 }
 
 /// Mask with the low `n` bits set.

@@ -4,7 +4,7 @@
 //! The gain G = (HᵀWH)⁻¹HᵀW is computed once per channel set so that a sample costs 3·N
 //! multiply-adds and no allocation.
 
-use crate::geometry::{Geometry, MAX_CHANNELS, MIN_CHANNELS, MIN_RECIPROCAL_CONDITION};
+use crate::geometry::{Geometry, MAX_CHANNELS, MIN_RECIPROCAL_CONDITION};
 use crate::linalg::{normal_matrix, reciprocal_condition};
 use nalgebra::Matrix3;
 
@@ -81,18 +81,9 @@ impl WlsSolver {
         }
         let mask = mask & geometry.full_mask();
         let axes = geometry.axes();
-        let mut active = [0u8; MAX_CHANNELS];
-        let mut n_active = 0;
-        for i in (0..n).filter(|i| mask & (1 << i) != 0) {
-            active[n_active] = i as u8;
-            n_active += 1;
-        }
-        if n_active < MIN_CHANNELS {
-            return Err(WlsError::InsufficientChannels {
-                mask,
-                active: n_active,
-            });
-        }
+        let (active, n_active) = geometry
+            .active_channels(mask)
+            .map_err(|active| WlsError::InsufficientChannels { mask, active })?;
         let active_rows = || active[..n_active].iter().map(|&i| usize::from(i));
 
         // Conditioning is judged on the unweighted rows so that it means the same as for the

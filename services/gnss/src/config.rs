@@ -73,27 +73,30 @@ impl GnssConfig {
 mod tests {
     use super::*;
 
+    /// The serial line's ranges are `SerialLineConfig`'s (and tested there): here, that its
+    /// errors are named under `gnss`, and the receiver's own staleness bound.
     #[test]
     fn defaults_are_valid_and_bad_values_are_named_under_gnss() {
-        assert!(GnssConfig::default().validate().is_ok());
-        let bad = GnssConfig {
+        let refusal = |c: GnssConfig| c.validate().err();
+        assert_eq!(refusal(GnssConfig::default()), None);
+        let no_baud = GnssConfig {
             baud: 0,
             ..Default::default()
         };
-        assert_eq!(bad.validate().unwrap_err(), "gnss.baud = 0: must be > 0");
-        let bad = GnssConfig {
+        let empty_port = GnssConfig {
             port: Some(String::new()),
             ..Default::default()
         };
-        assert!(bad.validate().unwrap_err().starts_with("gnss.port = \"\""));
-        let bad = GnssConfig {
+        let hasty = GnssConfig {
             stale_after_ms: 5,
             ..Default::default()
         };
-        assert!(
-            bad.validate()
-                .unwrap_err()
-                .contains("gnss.stale_after_ms = 5")
-        );
+        for (config, message) in [
+            (no_baud, "gnss.baud = 0: must be > 0"),
+            (empty_port, "gnss.port = \"\": must name a device path"),
+            (hasty, "gnss.stale_after_ms = 5: must be in 100..=60000"),
+        ] {
+            assert_eq!(refusal(config).as_deref(), Some(message));
+        }
     }
 }

@@ -8,9 +8,9 @@ use anyhow::{Result, anyhow};
 use ipc_types::{GnssFix, Health, ServiceKind, Stage, names};
 use rins_gnss_protocol::decode::GnssDecoder;
 use rins_runtime::clock::monotonic_ns;
-use rins_runtime::heartbeat::Heartbeat;
 use rins_runtime::ipc::create_node;
 use rins_runtime::service::{Service, ServiceContext};
+use rins_runtime::service_loop::ServiceLoop;
 use rins_runtime::stage_io::StagePublisher;
 use rins_serial_reader::presence::{Opened, Presence, Retry};
 use rins_serial_reader::reconnecting::{LineEvents, read_reconnecting};
@@ -31,26 +31,18 @@ impl Service for GnssService {
         })?;
         let node = create_node(ServiceKind::Gnss.name(), &ctx.settings)?;
         let publisher = StagePublisher::<GnssFix>::new(&node, names::GNSS, Stage::Acquisition)?;
-        let heartbeat = Heartbeat::new(&node, ServiceKind::Gnss)?;
+        let service = ServiceLoop::new(&node, ServiceKind::Gnss, &ctx.shutdown)?;
         let mut reader = Reader {
             simulator_link: ctx.settings.in_run_dir(std::path::Path::new(&path)),
             path: &path,
             stale_ns: u64::try_from(self.config.stale_after().as_nanos()).unwrap_or(u64::MAX),
             last_byte_ns: monotonic_ns(),
             publisher,
-            heartbeat,
-            counters: Health::default(),
             decoder: GnssDecoder::new(),
             published: 0,
         };
         let mut buf = [0u8; 1024];
-        read_reconnecting(
-            &path,
-            &self.config.line(),
-            &ctx.shutdown,
-            &mut buf,
-            &mut reader,
-        )?;
+        read_reconnecting(&path, &self.config.line(), service, &mut buf, &mut reader)?;
         tracing::info!(epochs = reader.published, "gnss stopped");
         Ok(())
     }
@@ -67,8 +59,6 @@ struct Reader<'a> {
     /// The last byte's arrival, or the opening of the port if none came since.
     last_byte_ns: u64,
     publisher: StagePublisher<GnssFix>,
-    heartbeat: Heartbeat,
-    counters: Health,
     decoder: GnssDecoder,
     published: u64,
 }
@@ -82,22 +72,20 @@ impl LineEvents for Reader<'_> {
         }
     }
 
-    fn opened(&mut self, opened: Opened, presence: &Presence) {
+    fn opened(&mut self, opened: Opened, _: &Presence) {
         match opened {
             Opened::First { .. } => tracing::info!(port = %self.path, "GNSS receiver open"),
             Opened::Reconnected { away, .. } => {
-                self.counters.reconnects = presence.reconnects();
                 tracing::info!(port = %self.path, away_ms = away.as_millis() as u64, "GNSS receiver back");
             }
         }
         self.last_byte_ns = monotonic_ns();
     }
 
-    fn bytes(&mut self, bytes: &[u8]) {
+    fn bytes(&mut self, bytes: &[u8], counters: &mut Health) {
         let rx_ns = monotonic_ns();
         self.last_byte_ns = rx_ns;
-        let (publisher, published, counters) =
-            (&self.publisher, &mut self.published, &mut self.counters);
+        let (publisher, published) = (&self.publisher, &mut self.published);
         self.decoder
             .push(bytes, rx_ns, |fix| match publisher.publish(fix) {
                 Ok(_) => *published += 1,
@@ -105,22 +93,17 @@ impl LineEvents for Reader<'_> {
             });
     }
 
-    fn after_read(&mut self) -> Result<()> {
+    fn after_read(&mut self, counters: &mut Health) {
         let quiet = monotonic_ns().saturating_sub(self.last_byte_ns) > self.stale_ns;
-        if quiet && self.counters.input_stale == 0 {
-            self.counters.stale_input_episodes += 1;
+        if quiet && counters.input_stale == 0 {
+            counters.stale_input_episodes += 1;
             tracing::warn!(port = %self.path, "the GNSS receiver went quiet");
         }
-        self.counters.input_stale = u8::from(quiet);
-        counters::fill(&mut self.counters, &self.decoder.stats(), self.published);
-        Ok(self.heartbeat.tick(&self.counters)?)
+        counters.input_stale = u8::from(quiet);
+        counters::fill(counters, &self.decoder.stats(), self.published);
     }
 
     fn lost(&mut self, e: &std::io::Error, _: Duration, _: &Presence) {
         tracing::warn!(port = %self.path, error = %e, "GNSS receiver lost: reopening with backoff");
-    }
-
-    fn waiting(&mut self) -> Result<()> {
-        Ok(self.heartbeat.tick(&self.counters)?)
     }
 }

@@ -378,6 +378,13 @@ impl MavlinkConfig {
 mod tests {
     use super::*;
 
+    /// Asserts that `c` is refused with an error that starts with `start`.
+    #[track_caller]
+    fn assert_refused(c: &MavlinkConfig, start: &str) {
+        let e = c.validate().unwrap_err();
+        assert!(e.starts_with(start), "{e}");
+    }
+
     #[test]
     fn defaults_are_valid_and_off() {
         let c = MavlinkConfig::default();
@@ -407,10 +414,9 @@ mod tests {
             autopilot: "px4".into(),
             ..MavlinkConfig::default()
         };
-        let e = display.validate().unwrap_err();
-        assert!(
-            e.starts_with("mavlink.autopilot = \"px4\" with mavlink.profile = \"display\""),
-            "{e}"
+        assert_refused(
+            &display,
+            "mavlink.autopilot = \"px4\" with mavlink.profile = \"display\"",
         );
     }
 
@@ -458,11 +464,7 @@ mod tests {
                 odometry_quality_sigma_m: sigma,
                 ..MavlinkConfig::default()
             };
-            let e = c.validate().unwrap_err();
-            assert!(
-                e.starts_with(&format!("mavlink.odometry_quality_sigma_m = {sigma}:")),
-                "{e}"
-            );
+            assert_refused(&c, &format!("mavlink.odometry_quality_sigma_m = {sigma}:"));
         }
         assert!(
             bad(|c| {
@@ -479,10 +481,9 @@ mod tests {
             accept_commands: true,
             ..MavlinkConfig::default()
         };
-        let e = accepting.validate().unwrap_err();
-        assert!(
-            e.starts_with("mavlink.accept_commands = true without mavlink.signing_key_file"),
-            "{e}"
+        assert_refused(
+            &accepting,
+            "mavlink.accept_commands = true without mavlink.signing_key_file",
         );
         let unsigned = MavlinkConfig {
             allow_unsigned_commands: true,
@@ -498,10 +499,9 @@ mod tests {
             allow_unsigned_commands: true,
             ..signed.clone()
         };
-        let e = both.validate().unwrap_err();
-        assert!(
-            e.starts_with("mavlink.allow_unsigned_commands = true with mavlink.signing_key_file = \"/etc/rins/mavlink.key\""),
-            "{e}"
+        assert_refused(
+            &both,
+            "mavlink.allow_unsigned_commands = true with mavlink.signing_key_file = \"/etc/rins/mavlink.key\"",
         );
     }
 

@@ -6,7 +6,7 @@ use ipc_types::{
     ChannelState, FaultReason, FusedImu, HealthReport, MAX_SUPERVISED, SensorType, ServiceKind,
 };
 
-use rins_runtime::lane_selector::Switch;
+use rins_navigator::lanes::Switch;
 
 use crate::dialect::STATUSTEXT_DATA;
 use crate::status_text::{channel_event, lane_switch, service_restarted};
@@ -101,7 +101,7 @@ impl EventWatch {
 mod tests {
     use super::*;
     use ipc_types::ServiceHealth;
-    use rins_runtime::lane_selector::{Distrust, SwitchReason};
+    use rins_navigator::lanes::{Distrust, SwitchReason};
 
     fn texts(run: impl FnOnce(&mut dyn FnMut(STATUSTEXT_DATA))) -> Vec<String> {
         let mut out = Vec::new();

@@ -8,9 +8,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use ipc_types::{FusedImu, FusionControl, FusionReply, HealthReport, ServiceKind, names};
+use rins_navigator::lanes::NavSubscriber;
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{TopicPublisher, TopicSubscriber};
-use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::payload::OtherVersionWarning;
 use rins_runtime::service::{Service, ServiceContext};
 use rins_runtime::service_loop::ServiceLoop;

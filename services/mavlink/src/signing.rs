@@ -287,10 +287,7 @@ mod tests {
     }
 
     fn scratch(name: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("rins-mavkey-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir(&dir).unwrap();
-        dir
+        rins_test_support::scratch::scratch_dir("mavkey", name)
     }
 
     fn write_key(path: &Path, text: &str, mode: u32) {

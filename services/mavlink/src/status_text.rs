@@ -2,7 +2,7 @@
 //! lane switch, a service restarted — as one line of at most 50 characters with its severity.
 
 use ipc_types::{ChannelState, FaultReason, SensorType};
-use rins_runtime::lane_selector::{Switch, SwitchReason};
+use rins_navigator::lanes::{Switch, SwitchReason};
 
 use crate::dialect::{MavSeverity, STATUSTEXT_DATA};
 
@@ -109,7 +109,7 @@ mod tests {
 
     #[test]
     fn a_lane_switch_says_why() {
-        use rins_runtime::lane_selector::Distrust;
+        use rins_navigator::lanes::Distrust;
         let switch = |reason| Switch {
             from: 0,
             to: 1,

@@ -117,11 +117,11 @@ impl MavlinkStream {
     }
 
     /// A solution of the merged stream; `switches` is the lane selector's count of lane changes
-    /// and its latest ([`rins_runtime::nav_subscriber::NavSubscriber::switches`]).
+    /// and its latest ([`rins_navigator::lanes::NavSubscriber::switches`]).
     pub fn on_nav(
         &mut self,
         nav: &NavState,
-        switches: (u64, Option<rins_runtime::lane_selector::Switch>),
+        switches: (u64, Option<rins_navigator::lanes::Switch>),
         emit: &mut impl FnMut(MavMessage),
     ) {
         let t_ns = nav.header.origin_rx_ns;

@@ -2,19 +2,21 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::aided_config::AidedConfig;
+use crate::aiding::airspeed::AirspeedAidingConfig;
+use crate::aiding::baro::BaroAidingConfig;
+use crate::aiding::gnss::config::GnssAidingConfig;
+use crate::aiding::mag_heading::MagAidingConfig;
+use crate::aiding::tilt::TiltAidingConfig;
+use crate::aiding::zupt::ZuptConfig;
 use crate::alignment::AlignConfig;
-use crate::baro_height::BaroAidingConfig;
 use crate::checks::check_in;
 use crate::ekf::EkfNoise;
-use crate::gnss_config::GnssAidingConfig;
-use crate::inertial_core::{AidedConfig, ZuptConfig};
 use crate::integrity::IntegrityConfig;
 use crate::mag_calibration::MagCalibration;
-use crate::mag_heading::MagAidingConfig;
 use crate::mechanisation::StrapdownConfig;
 use crate::stance::StanceConfig;
 use crate::start::InFlightStart;
-use crate::tilt_aiding::TiltAidingConfig;
 use rins_earth::normal_gravity;
 
 pub use rins_runtime::config_error::ConfigError;
@@ -66,6 +68,8 @@ pub struct NavigatorConfig {
     pub tilt: TiltAidingConfig,
     /// GNSS position and velocity updates (`[navigator.gnss]`).
     pub gnss: GnssAidingConfig,
+    /// Pitot airspeed updates, zero wind assumed (`[navigator.airspeed]`).
+    pub airspeed: AirspeedAidingConfig,
     /// Hard- and soft-iron correction of the magnetometer (`[navigator.mag_calibration]`, as
     /// printed by `rins calibrate mag`).
     pub mag_calibration: MagCalibration,
@@ -102,6 +106,7 @@ impl Default for NavigatorConfig {
             mag: MagAidingConfig::default(),
             tilt: TiltAidingConfig::default(),
             gnss: GnssAidingConfig::default(),
+            airspeed: AirspeedAidingConfig::default(),
             mag_calibration: MagCalibration::default(),
             integrity: IntegrityConfig::default(),
             start: None,
@@ -255,6 +260,14 @@ impl NavigatorConfig {
             )
             .within("navigator.gnss"));
         }
+        if let Err((field, value)) = self.airspeed.check() {
+            return Err(ConfigError::new(
+                field,
+                value,
+                "out of range (|offset_pa| <= 1000, others finite and > 0)",
+            )
+            .within("navigator.airspeed"));
+        }
         if let Err((field, value)) = self.tilt.check() {
             return Err(
                 ConfigError::new(field, value, "must be finite and > 0 (the gains >= 0)")
@@ -306,6 +319,7 @@ impl NavigatorConfig {
             mag: self.mag,
             tilt: self.tilt,
             gnss: self.gnss,
+            airspeed: self.airspeed,
             mag_calibration: self.mag_calibration,
             stale_after_s: self.aiding_timeout_s,
             declination_rad: self.declination_deg.to_radians(),

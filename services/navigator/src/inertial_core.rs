@@ -1,7 +1,10 @@
 //! The aided navigator's inertial core: static alignment, then the error-state EKF predicted on
-//! every IMU sample, with the zero-velocity update whenever the stance detector fires; barometric
-//! height and magnetometer heading updates arrive through [`AidedNavigator::on_baro`] and
-//! [`AidedNavigator::on_mag`] (see [`crate::aiding`]).
+//! every IMU sample. It owns the filter, the stance detector, the records of the aiding sources
+//! and the integrity monitor; the aiding sources ([`crate::aiding`]) own their settings and
+//! state and reach the filter only through the `AidingContext` the core
+//! lends them: the tilt and zero-velocity updates on each IMU sample, the barometric heights,
+//! magnetometer samples and GNSS fixes through [`AidedNavigator::on_baro`],
+//! [`AidedNavigator::on_mag`] and [`AidedNavigator::on_gnss`].
 //!
 //! Both profiles run it — a foot-mounted unit (pedestrian) and the airframe (uav); the offline
 //! evaluations and the live navigator share this one code path, so what the real recordings
@@ -9,80 +12,23 @@
 
 use nalgebra::Vector3;
 
-use crate::aiding::booking::record_update;
-use crate::aiding::gnss_state::GnssAidingState;
-use crate::aiding::source::AidingSensor;
+pub use crate::aided_config::AidedConfig;
+use crate::aiding::context::{AidingContext, CorePhase, ImuNow};
+use crate::aiding::gnss::measurement::{GnssMeasurement, GnssOutcome};
+use crate::aiding::gnss::monitor::GnssMonitor;
+use crate::aiding::outcome::AidingOutcome;
+use crate::aiding::records::SourceRecords;
+use crate::aiding::sources::AidingSources;
 pub use crate::aiding::zupt::ZuptConfig;
-use crate::alignment::{AlignConfig, AlignError, Alignment, StaticAligner};
+use crate::alignment::{AlignError, Alignment, StaticAligner};
 use crate::attitude_recovery::AttitudeRecovery;
-use crate::baro_height::BaroAidingConfig;
-use crate::ekf::{AidingSource, EkfNoise, ErrorStateEkf};
-use crate::gnss_config::GnssAidingConfig;
+use crate::ekf::{AidingSource, ErrorStateEkf};
 pub use crate::imu_step::ImuStep;
-use crate::integrity::{IntegrityConfig, IntegrityMonitor};
-use crate::mag_calibration::MagCalibration;
-use crate::mag_heading::{FieldReference, MagAidingConfig};
-use crate::mechanisation::{ImuBias, NominalState, StepOutcome, StrapdownConfig};
-use crate::stance::{StanceConfig, StanceDetector};
-use crate::tilt_aiding::{TiltAiding, TiltAidingConfig};
+use crate::integrity::IntegrityMonitor;
+use crate::mechanisation::{ImuBias, NominalState, StepOutcome};
+use crate::stance::StanceDetector;
 use crate::unisolated_fault::{FusionFault, UnisolatedFaultBound};
 use ipc_types::Integrity;
-
-/// Settings of the inertial core.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AidedConfig {
-    /// Static alignment window and its limits.
-    pub align: AlignConfig,
-    /// Strapdown mechanisation options (largest step, coning correction).
-    pub strapdown: StrapdownConfig,
-    /// Filter noise and initial uncertainties.
-    pub noise: EkfNoise,
-    /// Zero-velocity updates.
-    pub zupt: ZuptConfig,
-    /// The stance detector that gates zero-velocity and stance heading updates.
-    pub stance: StanceConfig,
-    /// Barometric height updates.
-    pub baro: BaroAidingConfig,
-    /// Magnetometer heading updates.
-    pub mag: MagAidingConfig,
-    /// Tilt updates from the specific force (AHRS).
-    pub tilt: TiltAidingConfig,
-    /// GNSS position and velocity updates.
-    pub gnss: GnssAidingConfig,
-    /// Applied to every magnetometer sample before use.
-    pub mag_calibration: MagCalibration,
-    /// An aiding source whose last reading is older than this is stale: the filter coasts on the
-    /// inertial solution and re-admits the source, without its innovation gate, when it returns, s.
-    pub stale_after_s: f64,
-    /// Declination, rad, positive east.
-    pub declination_rad: f64,
-    /// Position where navigation starts: latitude, longitude (rad), altitude (m).
-    pub origin: [f64; 3],
-    /// The origin's latitude and longitude were configured; otherwise they are placeholders and
-    /// the horizontal position is unknown until an absolute fix sets it.
-    pub origin_known: bool,
-    /// The integrity monitor and its recovery policies (`[navigator.integrity]`).
-    pub integrity: IntegrityConfig,
-}
-
-impl AidedConfig {
-    /// The aiding sources this profile uses, indexed by [`AidingSource`].
-    pub fn configured_sources(&self) -> [bool; AidingSource::COUNT] {
-        let mut on = [false; AidingSource::COUNT];
-        for sensor in self.sensors() {
-            if sensor.enabled() {
-                on[sensor.source() as usize] = true;
-            }
-        }
-        on
-    }
-
-    /// The settings of every aiding source that has some of its own (the tilt updates from the
-    /// specific force are booked by the inertial core itself).
-    fn sensors(&self) -> [&dyn AidingSensor; 4] {
-        [&self.baro, &self.mag, &self.zupt, &self.gnss]
-    }
-}
 
 /// Where the navigator is in its sequence. Held inline, not boxed, so that the step from
 /// alignment to navigation does not allocate either (the live navigator may realign in flight).
@@ -97,39 +43,24 @@ enum Phase {
 /// aligned.
 #[derive(Debug, Clone)]
 pub struct AidedNavigator {
-    pub(crate) config: AidedConfig,
+    config: AidedConfig,
     phase: Phase,
     stance: StanceDetector,
     alignment: Option<Alignment>,
     last_align_error: Option<AlignError>,
     last_time_us: Option<u64>,
     /// Bias-corrected specific force of the last propagated sample, m/s².
-    pub(crate) last_force: Vector3<f64>,
+    last_force: Vector3<f64>,
     /// The stance detector fired on the last sample.
-    pub(crate) in_stance: bool,
-    /// Magnitude and dip of the field in the alignment window.
-    pub(crate) field_reference: Option<FieldReference>,
-    /// First valid baro height, m: the altitude navigation starts from.
-    pub(crate) initial_height_m: Option<f64>,
-    /// Device time of the last accepted update per [`AidingSource`], µs.
-    pub(crate) last_accepted_us: [Option<u64>; AidingSource::COUNT],
-    /// Device time of the last magnetometer update attempted, µs (rate limit).
-    pub(crate) last_mag_update_us: Option<u64>,
-    /// Device time of the last valid reading per [`AidingSource`] (baro and mag), µs.
-    pub(crate) last_reading_us: [Option<u64>; AidingSource::COUNT],
-    /// Device time navigation started, µs.
-    pub(crate) navigating_since_us: Option<u64>,
-    /// The magnetometer reference comes from the first sample after a takeover (there was no
-    /// alignment window of our own to take it from).
-    pub(crate) reference_from_next_mag: bool,
+    in_stance: bool,
+    /// The last reading and the last accepted update of every aiding source.
+    records: SourceRecords,
     /// Whether the solution can be used (see [`crate::integrity`]).
-    pub(crate) integrity: IntegrityMonitor,
+    integrity: IntegrityMonitor,
     /// Re-levelling after the attitude was lost (see [`crate::attitude_recovery`]).
     attitude_recovery: AttitudeRecovery,
-    /// Tilt updates in normal navigation (see [`crate::tilt_aiding`]).
-    tilt: TiltAiding,
-    /// GNSS aiding: state history and the receiver's consistency monitor.
-    pub(crate) gnss: GnssAidingState,
+    /// The aiding sources, each with its settings and state (see [`crate::aiding`]).
+    sources: AidingSources,
     /// A fault fusion detected and has not isolated (see [`crate::unisolated_fault`]).
     fusion_fault: UnisolatedFaultBound,
 }
@@ -147,17 +78,10 @@ impl AidedNavigator {
             last_time_us: None,
             last_force: Vector3::zeros(),
             in_stance: false,
-            field_reference: None,
-            initial_height_m: None,
-            last_accepted_us: [None; AidingSource::COUNT],
-            last_mag_update_us: None,
-            last_reading_us: [None; AidingSource::COUNT],
-            navigating_since_us: None,
-            reference_from_next_mag: false,
+            records: SourceRecords::new(config.watched_sources(), config.stale_after_s),
             integrity: Self::integrity_monitor(&config),
             attitude_recovery: AttitudeRecovery::default(),
-            tilt: TiltAiding::default(),
-            gnss: GnssAidingState::new(config.gnss),
+            sources: config.sources(),
             fusion_fault: UnisolatedFaultBound::default(),
         }
     }
@@ -202,15 +126,11 @@ impl AidedNavigator {
         self.alignment = None;
         self.last_align_error = None;
         self.last_time_us = Some(t_us);
-        self.initial_height_m = Some(state.alt);
-        self.field_reference = None;
-        self.reference_from_next_mag = true;
-        self.navigating_since_us = Some(t_us);
+        self.sources.on_take_over(state.alt);
+        self.records.start_navigating(Some(t_us));
         self.integrity = Self::integrity_monitor(&self.config);
         self.fusion_fault = UnisolatedFaultBound::default();
         self.attitude_recovery = AttitudeRecovery::default();
-        self.tilt.reset();
-        self.gnss.reset(self.config.gnss);
         self.phase = Phase::Navigating(ekf);
     }
 
@@ -218,16 +138,7 @@ impl AidedNavigator {
     /// (counted from the start of navigation when it never reported). Always false while
     /// aligning and for a disabled source.
     pub fn is_stale(&self, source: AidingSource) -> bool {
-        let enabled = self.config.sensors().iter().any(|sensor| {
-            sensor.source() == source && sensor.enabled() && sensor.watched_for_staleness()
-        });
-        let (Some(now), Some(since)) = (self.last_time_us, self.navigating_since_us) else {
-            return false;
-        };
-        let last = self.last_reading_us[source as usize]
-            .unwrap_or(since)
-            .max(since);
-        enabled && now.saturating_sub(last) as f64 * 1e-6 > self.config.stale_after_s
+        self.records.is_stale(source, self.last_time_us)
     }
 
     /// The settings in use.
@@ -240,23 +151,61 @@ impl AidedNavigator {
         matches!(self.phase, Phase::Navigating(_))
     }
 
-    pub(crate) fn ekf_mut(&mut self) -> Option<&mut ErrorStateEkf> {
-        match &mut self.phase {
-            Phase::Navigating(ekf) => Some(ekf),
-            Phase::Aligning(_) => None,
-        }
+    /// The core as lent to an aiding source for one reading, and the sources.
+    fn lend(&mut self) -> (AidingContext<'_>, &mut AidingSources) {
+        let phase = match &mut self.phase {
+            Phase::Navigating(ekf) => CorePhase::Navigating(ekf),
+            Phase::Aligning(aligner) => CorePhase::Aligning(aligner),
+        };
+        let imu = ImuNow {
+            time_us: self.last_time_us,
+            in_stance: self.in_stance,
+            force: self.last_force,
+        };
+        let ctx = AidingContext::new(phase, imu, &mut self.records, &mut self.integrity);
+        (ctx, &mut self.sources)
     }
 
-    pub(crate) fn aligner_mut(&mut self) -> Option<&mut StaticAligner> {
-        match &mut self.phase {
-            Phase::Aligning(aligner) => Some(aligner),
-            Phase::Navigating(_) => None,
-        }
+    /// One barometric height (m above mean sea level) with its variance (m²) at device time
+    /// `t_us` (see [`crate::aiding::baro`]).
+    pub fn on_baro(
+        &mut self,
+        t_us: u64,
+        height_m: f64,
+        variance_m2: f64,
+        valid: bool,
+    ) -> AidingOutcome {
+        let (mut ctx, sources) = self.lend();
+        sources
+            .baro
+            .on_reading(&mut ctx, t_us, height_m, variance_m2, valid)
+    }
+
+    /// One magnetometer sample (raw µT, body FRD) at device time `t_us` (see
+    /// `aiding/mag.rs`).
+    pub fn on_mag(&mut self, t_us: u64, raw_ut: [f64; 3]) -> AidingOutcome {
+        let (mut ctx, sources) = self.lend();
+        sources.mag.on_sample(&mut ctx, t_us, raw_ut)
+    }
+
+    /// One pitot differential pressure, Pa, at device time `t_us` (see
+    /// [`crate::aiding::airspeed`]).
+    pub fn on_airspeed(&mut self, t_us: u64, diff_pressure_pa: f64) -> AidingOutcome {
+        let (mut ctx, sources) = self.lend();
+        sources
+            .airspeed
+            .on_reading(&mut ctx, t_us, diff_pressure_pa)
+    }
+
+    /// One receiver fix (see [`crate::aiding::gnss`]).
+    pub fn on_gnss(&mut self, m: &GnssMeasurement) -> GnssOutcome {
+        let (mut ctx, sources) = self.lend();
+        sources.gnss.on_fix(&mut ctx, m)
     }
 
     /// The GNSS receiver's consistency monitor.
-    pub fn gnss_monitor(&self) -> &crate::gnss_monitor::GnssMonitor {
-        &self.gnss.monitor
+    pub fn gnss_monitor(&self) -> &GnssMonitor {
+        self.sources.gnss.monitor()
     }
 
     /// Device time of the last IMU sample, µs.
@@ -266,7 +215,7 @@ impl AidedNavigator {
 
     /// Device time of the last accepted update from `source`, µs.
     pub fn last_accepted_us(&self, source: AidingSource) -> Option<u64> {
-        self.last_accepted_us[source as usize]
+        self.records.last_accepted_us(source)
     }
 
     /// The filter, once aligned.
@@ -363,8 +312,7 @@ impl AidedNavigator {
                         &rate,
                     )
                 {
-                    record_update(
-                        &mut self.last_accepted_us,
+                    self.records.book_update(
                         &mut self.integrity,
                         AidingSource::Gravity,
                         t_us,
@@ -372,39 +320,41 @@ impl AidedNavigator {
                         2,
                     );
                 }
-                let tilt = &self.config.tilt;
-                if outcome.is_applied()
-                    && tilt.enabled
-                    && !self.attitude_recovery.is_lost()
-                    && let Some(result) = self.tilt.push(ekf, tilt, t_us, specific_force, &rate)
-                {
-                    record_update(
-                        &mut self.last_accepted_us,
+                if outcome.is_applied() && !self.attitude_recovery.is_lost() {
+                    let imu = ImuNow {
+                        time_us: self.last_time_us,
+                        in_stance: self.in_stance,
+                        force,
+                    };
+                    let mut ctx = AidingContext::new(
+                        CorePhase::Navigating(&mut *ekf),
+                        imu,
+                        &mut self.records,
                         &mut self.integrity,
-                        AidingSource::Gravity,
-                        t_us,
-                        result,
-                        2,
                     );
+                    self.sources
+                        .tilt
+                        .on_imu(&mut ctx, t_us, specific_force, &rate);
                 }
                 let g = ekf.strapdown().gravity();
                 step.stance = self.stance.push(rate.into(), force.into(), pressure, g);
                 self.in_stance = step.stance;
-                let z = self.config.zupt;
-                if z.enabled && step.stance && outcome.is_applied() {
-                    let result = ekf.zupt(z.sigma_mps, z.gate);
-                    record_update(
-                        &mut self.last_accepted_us,
+                if step.stance && outcome.is_applied() {
+                    let imu = ImuNow {
+                        time_us: self.last_time_us,
+                        in_stance: self.in_stance,
+                        force,
+                    };
+                    let mut ctx = AidingContext::new(
+                        CorePhase::Navigating(&mut *ekf),
+                        imu,
+                        &mut self.records,
                         &mut self.integrity,
-                        AidingSource::Zupt,
-                        t_us,
-                        result,
-                        3,
                     );
-                    step.zupt = Some(result);
+                    step.zupt = self.sources.zupt.on_stance(&mut ctx, t_us);
                 }
-                if self.config.gnss.enabled && outcome.is_applied() {
-                    self.gnss.history.record(t_us, ekf, rate);
+                if outcome.is_applied() {
+                    self.sources.gnss.on_imu(ekf, t_us, rate);
                 }
             }
         }
@@ -434,7 +384,7 @@ impl AidedNavigator {
                 let (integrity, reasons) = self.integrity.evaluate(ekf, stale);
                 // A receiver judged inconsistent leaves the solution usable (it coasts on the
                 // inertial one) but no longer vouched for by every source.
-                if self.gnss.monitor.rejected().is_some() {
+                if self.sources.gnss.monitor().rejected().is_some() {
                     let degraded = match integrity {
                         Integrity::Ok => Integrity::Degraded,
                         other => other,
@@ -463,7 +413,8 @@ impl AidedNavigator {
     /// component is observable, the rest of the bias is absorbed in roll and pitch.
     fn start(&mut self, a: Alignment) {
         let [lat, lon, alt] = self.config.origin;
-        let mut state = NominalState::at_rest(lat, lon, self.initial_height_m.unwrap_or(alt));
+        let initial_height_m = self.sources.baro.initial_height_m();
+        let mut state = NominalState::at_rest(lat, lon, initial_height_m.unwrap_or(alt));
         state.attitude = a.attitude;
         let mut ekf = ErrorStateEkf::new(
             state,
@@ -482,12 +433,9 @@ impl AidedNavigator {
             gyro_rps: a.gyro_bias_rps,
             accel_mps2: accel_bias,
         });
-        self.field_reference = a
-            .mean_field_ut
-            .and_then(|m| FieldReference::from_field(&m, &a.attitude));
+        self.sources.on_aligned(&a);
         self.alignment = Some(a);
-        self.navigating_since_us = self.last_time_us;
-        self.gnss.reset(self.config.gnss);
+        self.records.start_navigating(self.last_time_us);
         self.phase = Phase::Navigating(ekf);
     }
 }

@@ -365,5 +365,6 @@ fn inconsistency_bit(source: AidingSource) -> u32 {
         // Never configured: it only acts while the attitude is recovered.
         AidingSource::Gravity => 0,
         AidingSource::Gnss => why::GNSS_INCONSISTENT,
+        AidingSource::Airspeed => why::AIRSPEED_INCONSISTENT,
     }
 }

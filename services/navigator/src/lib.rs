@@ -5,26 +5,20 @@
 //! Pure functions and small structs, no I/O. Frames: NED navigation, FRD body; quaternions rotate
 //! body → NED (Hamilton, scalar first); SI units inside, degrees only in [`NavigatorConfig`].
 
+pub mod aided_config;
 pub mod aiding;
-pub mod aiding_queue;
 pub mod alignment;
 pub mod attitude;
 pub mod attitude_recovery;
-pub mod baro_height;
 mod checks;
 pub mod config;
 pub mod ekf;
 pub mod force_window;
-pub mod gnss_config;
-pub mod gnss_displacement;
-pub mod gnss_hold;
-pub mod gnss_monitor;
-pub mod gnss_updates;
 mod imu_step;
 pub mod inertial_core;
 pub mod integrity;
+pub mod lanes;
 pub mod mag_calibration;
-pub mod mag_heading;
 pub mod mechanisation;
 pub mod navigator;
 pub mod service;
@@ -32,7 +26,6 @@ pub mod stance;
 pub mod start;
 pub mod state_history;
 pub mod takeover;
-pub mod tilt_aiding;
 pub mod unisolated_fault;
 
 pub use alignment::{AlignConfig, AlignError, Alignment, StaticAligner};

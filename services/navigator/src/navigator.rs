@@ -20,12 +20,13 @@
 
 use ipc_types::{Integrity, NAV_STATES, NavMode, NavState, aiding, integrity_reason};
 
+use crate::aiding::gnss::measurement::{GnssMeasurement, GnssOutcome};
 use crate::aiding::outcome::AidingOutcome;
+use crate::aiding::readings::{Reading, ReadingSink};
 use crate::alignment::{AlignError, Alignment};
 use crate::attitude::quaternion_to_array;
 use crate::config::{ConfigError, NavigatorConfig};
 use crate::ekf::{AidingCounts, AidingSource, ErrorStateEkf};
-use crate::gnss_updates::{GnssMeasurement, GnssOutcome};
 use crate::inertial_core::AidedNavigator;
 use crate::mechanisation::{NominalState, StepOutcome};
 use crate::start::InFlightStart;
@@ -84,16 +85,25 @@ impl NavOutput {
         out.accel_bias_mps2 = self.accel_bias_mps2;
         out.integrity = self.integrity as u8;
         out.integrity_reasons = self.integrity_reasons;
-        for (k, c) in self.counts.iter().enumerate() {
-            out.aiding_accepted[k] = u32::try_from(c.accepted).unwrap_or(u32::MAX);
-            out.aiding_rejected[k] = u32::try_from(c.rejected).unwrap_or(u32::MAX);
-        }
+        // One slot per source, in `AidingSource` index order (checked at compile time below);
+        // a count past the `u32` range saturates.
+        out.aiding_accepted = self.counts.map(|c| saturate_u32(c.accepted));
+        out.aiding_rejected = self.counts.map(|c| saturate_u32(c.rejected));
     }
 
     /// True when `source`'s bit is set in [`NavOutput::aiding`].
     pub fn aided_by(&self, bit: u32) -> bool {
         self.aiding & bit != 0
     }
+}
+
+// The payload's per-source counts have one slot for each `AidingSource`, so that none is left
+// out of `NavState`: a new source needs a new payload layout.
+const _: () = assert!(ipc_types::AIDING_SOURCES == AidingSource::COUNT);
+
+/// `n`, or `u32::MAX` when it does not fit.
+fn saturate_u32(n: u64) -> u32 {
+    u32::try_from(n).unwrap_or(u32::MAX)
 }
 
 /// Aiding bit of each source.
@@ -104,6 +114,7 @@ const SOURCE_BITS: [(AidingSource, u32); AidingSource::COUNT] = [
     (AidingSource::Hupt, aiding::HUPT),
     (AidingSource::Gravity, aiding::GRAVITY),
     (AidingSource::Gnss, aiding::GNSS),
+    (AidingSource::Airspeed, aiding::AIRSPEED),
 ];
 
 /// The navigator of the process. Allocation-free per sample once aligned.
@@ -313,13 +324,19 @@ impl Navigator {
             .on_baro(device_time_us, height_m, variance_m2, valid)
     }
 
+    /// One pitot differential pressure, Pa, at device time (µs) (see
+    /// [`crate::aiding::airspeed`]).
+    pub fn on_airspeed(&mut self, device_time_us: u64, diff_pressure_pa: f64) -> AidingOutcome {
+        self.core.on_airspeed(device_time_us, diff_pressure_pa)
+    }
+
     /// One GNSS receiver fix, measured at device time `t_us` (see [`AidedNavigator::on_gnss`]).
     pub fn on_gnss(&mut self, fix: &ipc_types::GnssFix, t_us: u64) -> GnssOutcome {
         self.core.on_gnss(&GnssMeasurement::from_fix(fix, t_us))
     }
 
     /// The GNSS receiver's consistency monitor.
-    pub fn gnss_monitor(&self) -> &crate::gnss_monitor::GnssMonitor {
+    pub fn gnss_monitor(&self) -> &crate::aiding::gnss::monitor::GnssMonitor {
         self.core.gnss_monitor()
     }
 
@@ -402,6 +419,24 @@ impl Navigator {
             integrity_reasons,
             resets: self.core.resets(),
         }
+    }
+}
+
+impl ReadingSink for Navigator {
+    fn take(&mut self, r: Reading) {
+        let _ = match r {
+            Reading::Baro {
+                t_us,
+                height_m,
+                variance_m2,
+                valid,
+            } => self.on_baro(t_us, height_m, variance_m2, valid),
+            Reading::Mag { t_us, field_ut } => self.on_mag(t_us, field_ut),
+            Reading::Airspeed {
+                t_us,
+                diff_pressure_pa,
+            } => self.on_airspeed(t_us, diff_pressure_pa),
+        };
     }
 }
 

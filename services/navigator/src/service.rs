@@ -6,18 +6,19 @@ use std::time::Duration;
 
 use anyhow::{Result, bail};
 use ipc_types::{
-    Altitude, FusedImu, GnssFix, Health, Integrity, NavMode, NavState, PAYLOAD_VERSION, RawMag,
-    ServiceKind, Stage, integrity_reason, names,
+    Altitude, FusedImu, GnssFix, Health, Integrity, NavMode, NavState, PAYLOAD_VERSION,
+    RawAirspeed, RawMag, ServiceKind, Stage, integrity_reason, names,
 };
 use rins_runtime::ipc::{IpcError, TopicSubscriber};
 use rins_runtime::service::{Service, ServiceContext};
 use rins_runtime::stage_io::StageInput;
 use rins_runtime::stage_loop::{PipelineStage, StageLoop, StageTopics, Step};
 
-use crate::aiding_queue::{AidingQueue, Reading};
+use crate::aiding::gnss::hold::GnssHold;
+use crate::aiding::gnss::monitor::{RejectReason, Transition};
+use crate::aiding::hold::HOLD_US;
+use crate::aiding::readings::{AidingQueue, Reading};
 use crate::ekf::AidingSource;
-use crate::gnss_hold::GnssHold;
-use crate::gnss_monitor::{RejectReason, Transition};
 use crate::navigator::{Navigator, fused_sample_usable};
 use crate::takeover::Handover;
 
@@ -149,6 +150,8 @@ struct NavigatorStage {
     nav: Navigator,
     alt_in: StageInput<Altitude>,
     mag_in: StageInput<RawMag>,
+    /// Pitot airspeeds, when airspeed aiding is on.
+    airspeed_in: Option<StageInput<RawAirspeed>>,
     /// Receiver fixes, when GNSS aiding is on.
     gnss_in: Option<StageInput<GnssFix>>,
     /// Fixes waiting for the IMU stream to place them.
@@ -182,6 +185,9 @@ impl PipelineStage for NavigatorStage {
         })?;
         self.mag_in
             .drain(counters, |mag| queue.hold(Reading::from_mag(&mag), nav))?;
+        if let Some(airspeed_in) = &self.airspeed_in {
+            airspeed_in.drain(counters, |a| queue.hold(Reading::from_airspeed(&a), nav))?;
+        }
         if let Some(gnss_in) = &self.gnss_in {
             let hold = &mut self.gnss_hold;
             gnss_in.drain(counters, |fix| hold.push(fix))?;
@@ -262,7 +268,7 @@ impl PipelineStage for NavigatorStage {
             // Rare by design (the hold is long): each one means the lanes may differ slightly.
             tracing::warn!(
                 late = self.aiding.late(),
-                hold_us = crate::aiding_queue::HOLD_US,
+                hold_us = HOLD_US,
                 "aiding readings arrived after their place in the IMU stream"
             );
             self.late_logged = self.aiding.late();
@@ -318,6 +324,10 @@ impl Service for NavigatorService {
             true => Some(StageInput::new(&node, names::GNSS)?),
             false => None,
         };
+        let airspeed_in = match self.navigator.config().airspeed.enabled {
+            true => Some(StageInput::new(&node, names::RAW_AIRSPEED)?),
+            false => None,
+        };
         let mut stage = NavigatorStage {
             gnss_in,
             gnss_hold: GnssHold::new(gnss.delay_s),
@@ -326,6 +336,7 @@ impl Service for NavigatorService {
             nav: self.navigator,
             alt_in: StageInput::new(&node, names::ALTITUDE)?,
             mag_in: StageInput::new(&node, names::RAW_MAG)?,
+            airspeed_in,
             peer_in,
             listening: false,
             handover: Handover::default(),

@@ -9,10 +9,10 @@ use nalgebra::Vector3;
 use rins_runtime::config_error::ConfigError;
 use serde::{Deserialize, Serialize};
 
+use crate::aided_config::AidedConfig;
 use crate::attitude::quaternion_from_euler;
 use crate::checks::check_in;
 use crate::ekf::STATES;
-use crate::inertial_core::AidedConfig;
 use crate::mechanisation::{ImuBias, NominalState};
 
 /// Largest device time accepted, s (about 31 700 years of µs fit in a u64; this is far inside).

@@ -13,9 +13,9 @@
 
 use ipc_types::{FusedImu, NAV_STATES, NavMode, NavState};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use rins_runtime::lane_selector::{SelectorConfig, trusted};
 use thiserror::Error;
 
+use crate::lanes::{SelectorConfig, trusted};
 use crate::mechanisation::{ImuBias, NominalState};
 
 /// Why a peer state cannot be taken over.

@@ -257,7 +257,7 @@ fn without_resets_a_solution_every_source_rejects_is_invalid() {
         out.integrity_reasons & why::ALL_AIDING_REJECTED != 0,
         "{out:?}"
     );
-    assert_eq!(out.resets, [0; 6]);
+    assert_eq!(out.resets, [0; AidingSource::COUNT]);
 }
 
 #[test]

@@ -261,12 +261,17 @@ fn output_fills_the_ipc_payload() {
             AidingCounts::default(),
             AidingCounts::default(),
             AidingCounts::default(),
+            // Airspeed, the last source, carried like the others.
+            AidingCounts {
+                accepted: 9,
+                rejected: u64::from(u32::MAX) + 1,
+            },
         ],
         gyro_bias_rps: [1e-3, -2e-3, 3e-3],
         accel_bias_mps2: [0.1, 0.2, -0.3],
         integrity: Integrity::Degraded,
         integrity_reasons: integrity_reason::MAG_INCONSISTENT | integrity_reason::RECOVERING,
-        resets: [0, 2, 0, 0, 0, 0],
+        resets: [0, 2, 0, 0, 0, 0, 0],
     };
     let mut state = NavState::default();
     out.write_nav_state(&mut state);
@@ -281,8 +286,8 @@ fn output_fills_the_ipc_payload() {
     assert_eq!(state.aiding, aiding::BARO | aiding::ZUPT);
     assert_eq!(state.covariance_diag, out.covariance_diag);
     // Counts saturate rather than wrap.
-    assert_eq!(state.aiding_accepted, [5, 0, u32::MAX, 0, 0, 0]);
-    assert_eq!(state.aiding_rejected, [1, 0, 0, 0, 0, 0]);
+    assert_eq!(state.aiding_accepted, [5, 0, u32::MAX, 0, 0, 0, 9]);
+    assert_eq!(state.aiding_rejected, [1, 0, 0, 0, 0, 0, u32::MAX]);
     assert_eq!(state.quaternion, out.quaternion);
     assert_eq!(state.velocity_ned_mps, out.velocity_ned);
     assert_eq!(
@@ -303,7 +308,7 @@ fn configuration_parses_partially_and_rejects_unknown_or_out_of_range_fields() {
     assert!(toml::from_str::<NavigatorConfig>("align_seconds = 2.0\n").is_err());
 
     type Spoil = fn(&mut NavigatorConfig);
-    let cases: [(&str, Spoil); 10] = [
+    let cases: [(&str, Spoil); 12] = [
         ("align_s", |c| c.align_s = -1.0),
         ("initial_latitude_deg", |c| {
             (c.initial_latitude_deg, c.initial_longitude_deg) = (Some(91.0), Some(0.0))
@@ -324,6 +329,8 @@ fn configuration_parses_partially_and_rejects_unknown_or_out_of_range_fields() {
             c.align_max_rate_std_rps = -0.1
         }),
         ("mag.inflation", |c| c.mag.inflation = 0.5),
+        ("airspeed.sigma_mps", |c| c.airspeed.sigma_mps = -1.0),
+        ("airspeed.offset_pa", |c| c.airspeed.offset_pa = f64::NAN),
         ("mag_calibration", |c| {
             c.mag_calibration.hard_iron_ut[1] = f64::NAN
         }),

@@ -93,6 +93,8 @@ pub struct SimConfig {
     pub multirotor: MultirotorConfig,
     /// The simulated GNSS receiver (`[sim.gnss]`).
     pub gnss: crate::gnss_config::GnssReceiverConfig,
+    /// The simulated pitot airspeed sensor (`[sim.airspeed]`; off by default).
+    pub airspeed: crate::sensor_model::airspeed::AirspeedSensorConfig,
 }
 
 impl Default for SimConfig {
@@ -116,6 +118,7 @@ impl Default for SimConfig {
             calibration: CalibrationConfig::default(),
             multirotor: MultirotorConfig::default(),
             gnss: crate::gnss_config::GnssReceiverConfig::default(),
+            airspeed: Default::default(),
         }
     }
 }
@@ -218,6 +221,7 @@ impl SimConfig {
         self.gnss
             .validate(self.imu_rate_hz)
             .map_err(SimError::GnssReceiver)?;
+        self.airspeed.validate(self.imu_rate_hz)?;
         self.sensors.validate()
     }
 

@@ -1,13 +1,15 @@
 //! Device simulator: a deterministic truth trajectory, per-channel sensor error models and the frame
 //! generator that emulates the redundant sensor block — pure, no I/O, no clocks, no globals — and,
 //! around them, the process: the simulated serial line on a pseudo-terminal ([`serial_line`]), the
-//! fault commands it takes and the truth it publishes ([`service`]).
+//! fault commands it takes and the truth it publishes, one tick per IMU period on the runtime's
+//! paced loop ([`service`]).
 //!
 //! The Earth is modelled as non-rotating with constant standard gravity
 //! ([`rins_earth::STANDARD_GRAVITY`]); see [`trajectory`].
 
 pub mod calibration_config;
 pub mod config;
+mod device;
 pub mod device_fault;
 pub mod error;
 pub mod fault_command;
@@ -21,6 +23,7 @@ pub mod serial_line;
 pub mod service;
 pub mod sim_command;
 pub mod simulator;
+mod streaming;
 pub mod trajectory;
 
 pub use calibration_config::CalibrationConfig;

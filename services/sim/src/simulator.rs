@@ -1,14 +1,16 @@
 //! The simulator: one call per IMU period fills the frames the sensor block would send.
 //!
-//! The base tick is the IMU period. Barometer, magnetometer and auxiliary frames are emitted on the
+//! The base tick is the IMU period. Barometer, magnetometer, auxiliary and airspeed frames are
+//! emitted on the
 //! ticks where `⌊k·rate/imu_rate⌋` advances (and on tick 0), so any rate up to the IMU rate works
 //! without drift and without requiring an integer ratio.
 
-use rins_protocol::{AuxFrame, BaroFrame, Frame, ImuFrame, MagFrame, Payload};
+use rins_protocol::{AirspeedFrame, AuxFrame, BaroFrame, Frame, ImuFrame, MagFrame, Payload};
 
 use crate::config::SimConfig;
 use crate::error::SimError;
 use crate::sensor_model::SensorModel;
+use crate::sensor_model::airspeed::AirspeedModel;
 use crate::sensor_model::fault::{ChannelFault, InertialSensor};
 use crate::trajectory::Trajectory;
 
@@ -56,6 +58,8 @@ pub struct TickOutput {
     pub mag: Option<Frame>,
     /// Auxiliary (foot-pressure) frame, when one falls due.
     pub aux: Option<Frame>,
+    /// Airspeed frame, when the sensor is fitted and one falls due.
+    pub airspeed: Option<Frame>,
     /// Truth at the IMU sample time.
     pub truth: TruthSample,
 }
@@ -71,6 +75,7 @@ impl Default for TickOutput {
             baro: None,
             mag: None,
             aux: None,
+            airspeed: None,
             truth: TruthSample::default(),
         }
     }
@@ -83,6 +88,7 @@ struct Sequences {
     baro: u16,
     mag: u16,
     aux: u16,
+    airspeed: u16,
 }
 
 fn next(seq: &mut u16) -> u16 {
@@ -100,6 +106,8 @@ pub struct Simulator {
     aux_rate_hz: f64,
     trajectory: Trajectory,
     sensors: SensorModel,
+    /// The pitot sensor, when `[sim.airspeed]` fits one.
+    airspeed: Option<AirspeedModel>,
     tick: u64,
     seq: Sequences,
 }
@@ -129,6 +137,10 @@ impl Simulator {
             aux_rate_hz: config.aux_rate_hz,
             trajectory: Trajectory::new(config.scenario, config.trajectory_start()),
             sensors,
+            airspeed: config
+                .airspeed
+                .enabled
+                .then(|| AirspeedModel::new(config.airspeed, config.qnh_pa, seed)),
             tick: 0,
             seq: Sequences::default(),
         })
@@ -235,6 +247,21 @@ impl Simulator {
             })
         } else {
             None
+        };
+
+        let airspeed_due = self.airspeed.as_ref().map(|m| self.due(m.rate_hz()));
+        out.airspeed = match (&mut self.airspeed, airspeed_due) {
+            (Some(model), Some(true)) => {
+                let mut airspeed = AirspeedFrame::default();
+                let wind_n = self.trajectory.wind_n(t);
+                model.sample(&truth.velocity_n, &wind_n, truth.altitude_m, &mut airspeed);
+                Some(Frame {
+                    seq: next(&mut self.seq.airspeed),
+                    device_time_us,
+                    payload: Payload::Airspeed(airspeed),
+                })
+            }
+            _ => None,
         };
 
         let q = truth.attitude.quaternion();

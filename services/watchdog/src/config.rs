@@ -260,6 +260,12 @@ mod tests {
         toml::from_str(text).unwrap()
     }
 
+    /// Why `[watchdog]` text `text` parses but does not validate.
+    #[track_caller]
+    fn refusal(text: &str) -> String {
+        parse(text).validate().unwrap_err()
+    }
+
     #[test]
     fn service_overrides_fall_back_to_the_watchdog_values() {
         let c = parse(
@@ -281,23 +287,17 @@ mod tests {
 
     #[test]
     fn bad_overrides_name_the_key() {
-        let err = parse("[services.gps]\nmax_restarts = 1\n")
-            .validate()
-            .unwrap_err();
+        let err = refusal("[services.gps]\nmax_restarts = 1\n");
         assert!(
             err.starts_with("watchdog.services.gps: no such service"),
             "{err}"
         );
-        let err = parse("[services.fusion]\nrestart_window_s = -1\n")
-            .validate()
-            .unwrap_err();
+        let err = refusal("[services.fusion]\nrestart_window_s = -1\n");
         assert!(
             err.contains("watchdog.services.fusion.restart_window_s = -1"),
             "{err}"
         );
-        let err = parse("[services.fusion]\nrestart_initial_backoff_ms = 9000\n")
-            .validate()
-            .unwrap_err();
+        let err = refusal("[services.fusion]\nrestart_initial_backoff_ms = 9000\n");
         assert!(
             err.contains("watchdog.services.fusion.restart_initial_backoff_ms = 9000"),
             "{err}"
@@ -310,9 +310,7 @@ mod tests {
 
     #[test]
     fn limits_and_windows_out_of_range_are_refused() {
-        let err = parse("[services.fusion]\nmax_restarts = 10001\n")
-            .validate()
-            .unwrap_err();
+        let err = refusal("[services.fusion]\nmax_restarts = 10001\n");
         assert_eq!(
             err,
             "watchdog.services.fusion.max_restarts = 10001: must be <= 10000 (0: never restart)"
@@ -320,15 +318,11 @@ mod tests {
         assert!(parse("max_restarts = 10000\n").validate().is_ok());
         assert!(parse("max_restarts = 0\n").validate().is_ok());
         for window in ["0", "-0.0", "1e-300", "0.0009", "nan", "inf", "86400.5"] {
-            let err = parse(&format!("restart_window_s = {window}\n"))
-                .validate()
-                .unwrap_err();
+            let err = refusal(&format!("restart_window_s = {window}\n"));
             assert!(err.starts_with("watchdog.restart_window_s = "), "{err}");
             assert!(err.contains("[0.001, 86400]"), "{err}");
         }
-        let err = parse("[services.sim]\nrestart_stable_after_s = nan\n")
-            .validate()
-            .unwrap_err();
+        let err = refusal("[services.sim]\nrestart_stable_after_s = nan\n");
         assert!(
             err.starts_with("watchdog.services.sim.restart_stable_after_s = NaN"),
             "{err}"

@@ -6,9 +6,9 @@ use ipc_types::{
     Altitude, FaultApplied, FusedImu, Health, Integrity, LinkReport, NavMode, NavReport, NavState,
     RawBaro, RawImu, RawMag, RedundancyReport, ServiceKind, Truth, names,
 };
+use rins_navigator::lanes::NavSubscriber;
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{IpcNode, TopicSubscriber};
-use rins_runtime::nav_subscriber::NavSubscriber;
 
 use crate::accuracy::{Accuracy, ScoredSample};
 use crate::device_counters::DeviceCounters;

@@ -76,6 +76,21 @@ mod tests {
     use super::*;
     use nalgebra::UnitQuaternion;
 
+    const ALL_FLOWING: [f64; COUNTED.len()] = [1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0];
+
+    /// The line at 3 s with `rates`, nothing dropped, quiet device counters and no redundancy
+    /// report.
+    fn line_of(rates: &[f64; COUNTED.len()], nav: &NavState) -> String {
+        status_line(
+            3.0,
+            rates,
+            0,
+            &DeviceCounters::default(),
+            &RedundancyReport::default(),
+            Some(nav),
+        )
+    }
+
     #[test]
     fn euler_of_a_known_attitude() {
         let u = UnitQuaternion::from_euler_angles(0.1, 0.2, -0.3);
@@ -92,14 +107,7 @@ mod tests {
             altitude_m: 12.5,
             ..NavState::default()
         };
-        let line = status_line(
-            3.0,
-            &[1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0],
-            0,
-            &DeviceCounters::default(),
-            &RedundancyReport::default(),
-            Some(&nav),
-        );
+        let line = line_of(&ALL_FLOWING, &nav);
         for name in COUNTED {
             assert!(line.contains(name), "{line}");
         }
@@ -112,14 +120,7 @@ mod tests {
             aiding: ipc_types::aiding::BARO_STALE,
             ..nav
         };
-        let line = status_line(
-            3.0,
-            &[1000.0, 0.0, 100.0, 1000.0, 0.0, 1000.0],
-            0,
-            &DeviceCounters::default(),
-            &RedundancyReport::default(),
-            Some(&coasting),
-        );
+        let line = line_of(&[1000.0, 0.0, 100.0, 1000.0, 0.0, 1000.0], &coasting);
         assert!(
             line.contains("| navigating: baro stale, lane 0 |"),
             "{line}"
@@ -132,14 +133,7 @@ mod tests {
             integrity_reasons: integrity_reason::IMU_UNUSABLE | integrity_reason::COVARIANCE,
             ..nav
         };
-        let line = status_line(
-            3.0,
-            &[1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0],
-            0,
-            &DeviceCounters::default(),
-            &RedundancyReport::default(),
-            Some(&invalid),
-        );
+        let line = line_of(&ALL_FLOWING, &invalid);
         assert!(
             line.contains("| invalid, lane 0 | roll")
                 && line.contains("integrity INVALID: imu-unusable,covariance"),
@@ -156,14 +150,7 @@ mod tests {
             mode: NavMode::Navigating as u8,
             ..NavState::default()
         };
-        let line = status_line(
-            9.0,
-            &[1000.0, 50.0, 100.0, 0.0, 50.0, 0.0],
-            0,
-            &DeviceCounters::default(),
-            &RedundancyReport::default(),
-            Some(&nav),
-        );
+        let line = line_of(&[1000.0, 50.0, 100.0, 0.0, 50.0, 0.0], &nav);
         assert!(line.ends_with("| no navigation output"), "{line}");
         assert!(!line.contains("navigating"), "{line}");
     }
@@ -175,14 +162,7 @@ mod tests {
             integrity: 200,
             ..NavState::default()
         };
-        let line = status_line(
-            3.0,
-            &[1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0],
-            0,
-            &DeviceCounters::default(),
-            &RedundancyReport::default(),
-            Some(&unknown),
-        );
+        let line = line_of(&ALL_FLOWING, &unknown);
         assert!(
             line.contains("| mode 200, lane 0 | roll") && line.contains("integrity INVALID: "),
             "{line}"
@@ -208,7 +188,7 @@ mod tests {
         };
         let line = status_line(
             5.0,
-            &[1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0],
+            &ALL_FLOWING,
             0,
             &DeviceCounters::default(),
             &crate::redundancy_view::redundancy_of(&fused, 0),
@@ -224,7 +204,7 @@ mod tests {
 
     #[test]
     fn rare_device_counters_appear_only_when_non_zero() {
-        let rates = [1000.0, 50.0, 100.0, 1000.0, 50.0, 1000.0];
+        let rates = ALL_FLOWING;
         let none = RedundancyReport::default();
         let quiet = status_line(4.0, &rates, 0, &DeviceCounters::default(), &none, None);
         assert!(

@@ -30,8 +30,8 @@ pub struct LaneSwitchCauses {
     pub untrusted: u64,
 }
 
-impl From<rins_runtime::lane_selector::SwitchCounts> for LaneSwitchCauses {
-    fn from(c: rins_runtime::lane_selector::SwitchCounts) -> Self {
+impl From<rins_navigator::lanes::SwitchCounts> for LaneSwitchCauses {
+    fn from(c: rins_navigator::lanes::SwitchCounts) -> Self {
         Self {
             silent: c.silent,
             behind: c.behind,

@@ -19,8 +19,8 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
+use rins_navigator::lanes::NavSubscriber;
 use rins_runtime::ipc::{IpcSettings, create_node};
-use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::shm_cleanup;
 use rins_runtime::shutdown::Shutdown;
 use serde::Serialize;

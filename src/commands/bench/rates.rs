@@ -13,8 +13,8 @@ use std::process::Stdio;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
+use rins_navigator::lanes::NavSubscriber;
 use rins_runtime::ipc::create_node;
-use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::shutdown::Shutdown;
 use serde::Serialize;
 use serde_json::Value;

@@ -19,6 +19,8 @@ use rins::replay::offline::OfflinePipeline;
 use rins_fusion::service::fused_message;
 use rins_runtime::shutdown::Shutdown;
 
+use super::progress::Progress;
+
 pub use pyshoe::pyshoe;
 pub use quadrotor::quadrotor_ahrs;
 
@@ -39,6 +41,28 @@ impl Scratch {
     fn remove(self) {
         let _ = std::fs::remove_dir_all(&self.dir);
     }
+}
+
+/// Runs `run_one` on every recording of `recordings` in turn, under one progress bar (`label`)
+/// over them all into which each recording's own progress is scaled; the results in order. The
+/// scratch directory is removed when every one succeeded, and kept with its logs otherwise.
+fn each_live<T, R>(
+    label: &'static str,
+    recordings: &[T],
+    mut run_one: impl FnMut(&T, &Scratch, &mut dyn FnMut(usize, usize)) -> Result<R>,
+) -> Result<Vec<R>> {
+    let scratch = Scratch::new()?;
+    let mut bar = Progress::new(label);
+    let n = recordings.len();
+    let mut results = Vec::with_capacity(n);
+    for (k, recording) in recordings.iter().enumerate() {
+        let mut progress =
+            |done: usize, total: usize| bar.set(k * 1000 + done * 1000 / total.max(1), n * 1000);
+        results.push(run_one(recording, &scratch, &mut progress)?);
+    }
+    bar.finish();
+    scratch.remove();
+    Ok(results)
 }
 
 /// `cfg` written out and read back as the deployment will read it (`what` names it in errors).

@@ -16,8 +16,7 @@ use rins_eval::import::pyshoe::import_trial;
 use rins_eval::import::quadrotor::Profile;
 use rins_runtime::shutdown::Shutdown;
 
-use super::{Scratch, deploy, device_index, fused, in_process, navigating, reparsed};
-use crate::commands::progress::Progress;
+use super::{Scratch, deploy, device_index, each_live, fused, in_process, navigating, reparsed};
 
 /// The deployment's configuration for `walk`: the imported recording's (device, block,
 /// fusion), with the profile's navigator carrying the walk's stance setting. Refused when the
@@ -125,19 +124,10 @@ pub fn pyshoe(
     report: &mut PyshoeReport,
 ) -> Result<()> {
     let shutdown = Shutdown::install()?;
-    let scratch = Scratch::new()?;
-    let mut bar = Progress::new("eval pyshoe live");
-    let n = walks.len();
-    let mut results = Vec::with_capacity(n);
-    for (k, walk) in walks.iter().enumerate() {
-        let live = walk_live(
-            profile,
-            profile_text,
-            walk,
-            &scratch,
-            &shutdown,
-            &mut |done, total| bar.set(k * 1000 + done * 1000 / total.max(1), n * 1000),
-        )?;
+    let results = each_live("eval pyshoe live", walks, |walk, scratch, progress| {
+        walk_live(profile, profile_text, walk, scratch, &shutdown, progress)
+    })?;
+    for (walk, live) in walks.iter().zip(&results) {
         if let Some(t) = report
             .trials
             .iter_mut()
@@ -145,14 +135,10 @@ pub fn pyshoe(
         {
             t.live = Some(live.clone());
         }
-        results.push(live);
     }
-    bar.finish();
     report.live = Some(summarise(
         "each walk imported as one triad in 16-bit counts",
         &results,
     ));
-    // The configurations and logs are kept only when something went wrong.
-    scratch.remove();
     Ok(())
 }

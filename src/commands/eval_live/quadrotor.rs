@@ -24,8 +24,7 @@ use rins_eval::quadrotor_ahrs::run::AttitudeTrace;
 use rins_eval::quadrotor_nav::frames::{BodySample, Motion};
 use rins_runtime::shutdown::Shutdown;
 
-use super::{Scratch, deploy, device_index, fused, in_process, navigating, reparsed};
-use crate::commands::progress::Progress;
+use super::{Scratch, deploy, device_index, each_live, fused, in_process, navigating, reparsed};
 
 /// A flight as the running processes get it.
 struct Recording {
@@ -168,28 +167,20 @@ fn fly(
 pub fn quadrotor_ahrs(dir: &Path, runs: &[ScoredRun], report: &mut AhrsReport) -> Result<()> {
     let shutdown = Shutdown::install()?;
     let imported = import(dir, runs)?;
-    let scratch = Scratch::new()?;
-    let mut bar = Progress::new("eval quadrotor live");
-    let mut flights = Vec::with_capacity(runs.len());
-    for (k, run) in runs.iter().enumerate() {
-        let n = runs.len();
+    let flights = each_live("eval quadrotor live", runs, |run, scratch, progress| {
         let Some(flight) = imported.get(&run.flight) else {
             bail!("{}: not imported", run.flight);
         };
-        let live = fly(flight, run, &scratch, &shutdown, &mut |done, total| {
-            bar.set(k * 1000 + done * 1000 / total.max(1), n * 1000)
-        })?;
+        fly(flight, run, scratch, &shutdown, progress)
+    })?;
+    for (run, live) in runs.iter().zip(&flights) {
         if let Some(result) = report.flights.iter_mut().find(|f| f.name == run.flight) {
             result.live = Some(live.clone());
         }
-        flights.push(live);
     }
-    bar.finish();
     report.live = Some(summarise(
         "each flight imported as one block: 12 channels in the units' own axes, 16-bit counts",
         &flights,
     ));
-    // The configurations and logs are kept only when something went wrong.
-    scratch.remove();
     Ok(())
 }

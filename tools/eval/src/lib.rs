@@ -31,3 +31,4 @@ pub mod quadrotor_ahrs;
 pub mod quadrotor_gnss;
 pub mod quadrotor_nav;
 pub mod stats;
+mod trial_rows;

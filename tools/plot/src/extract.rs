@@ -214,7 +214,7 @@ impl Collector {
         let seconds = |device_us: u64| (device_us as f64 - t0_us as f64) / 1e6;
 
         // The merged stream: lane 0 while it has a usable solution, lane 1 otherwise (the
-        // runtime's selector also waits for a restarted lane to settle; a plot need not).
+        // consumers' selector also waits for a restarted lane to settle; a plot need not).
         let mut chosen: Vec<LaneSample> = Vec::with_capacity(self.lanes.len());
         let mut nav_unusable = 0;
         for lanes in self.lanes.values() {

@@ -29,9 +29,8 @@ use ipc_types::{
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rins_navigator::lanes::{NavSubscriber, SelectorConfig, trusted};
 use rins_runtime::ipc::{IpcSettings, TopicSubscriber, create_node};
-use rins_runtime::lane_selector::{SelectorConfig, trusted};
-use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::shutdown::Shutdown;
 use rins_sim::fault_command::ChannelId;
 

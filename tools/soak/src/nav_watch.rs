@@ -5,7 +5,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Result;
 use ipc_types::NavMode;
-use rins_runtime::nav_subscriber::NavSubscriber;
+use rins_navigator::lanes::NavSubscriber;
 use rins_watchdog::seq_gaps::SeqGaps;
 
 #[derive(Debug, Default)]

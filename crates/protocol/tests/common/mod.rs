@@ -4,8 +4,8 @@
 use proptest::collection::vec;
 use proptest::prelude::*;
 use rins_protocol::{
-    AuxFrame, BaroFrame, DecodedFrame, Decoder, Frame, ImuFrame, MAX_FRAME_LEN, MagFrame, Payload,
-    encode,
+    AirspeedFrame, AuxFrame, BaroFrame, DecodedFrame, Decoder, Frame, FrameType, ImuFrame,
+    MAX_FRAME_LEN, MagFrame, Payload, encode,
 };
 
 /// Proptest settings for these tests: `cases` unless `PROPTEST_CASES` is set (for long soak
@@ -85,6 +85,12 @@ pub fn arb_payload() -> impl Strategy<Value = Payload> {
         ),
         1 => any::<[i32; 3]>().prop_map(|field_nt| Payload::Mag(MagFrame { field_nt })),
         1 => any::<u16>().prop_map(|foot_pressure| Payload::Aux(AuxFrame { foot_pressure })),
+        1 => (-7000.0f32..=7000.0, -5000i16..=15000).prop_map(
+            |(diff_pressure_pa, temperature_centi_c)| Payload::Airspeed(AirspeedFrame {
+                diff_pressure_pa,
+                temperature_centi_c,
+            })
+        ),
     ]
 }
 
@@ -92,7 +98,7 @@ pub fn arb_payload() -> impl Strategy<Value = Payload> {
 /// advances monotonically, both starting anywhere (so wraps are exercised).
 pub fn arb_consecutive_frames(max_len: usize) -> impl Strategy<Value = Vec<Frame>> {
     (
-        any::<[u16; 4]>(),
+        any::<[u16; FrameType::COUNT]>(),
         any::<u32>(),
         vec((arb_payload(), 0u32..5_000), 1..max_len),
     )

@@ -2,7 +2,7 @@
 
 use ipc_types::{
     Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, GnssFix, Header, Health,
-    HealthReport, LinkReport, NavReport, NavState, RawAux, RawBaro, RawImu, RawMag,
+    HealthReport, LinkReport, NavReport, NavState, RawAirspeed, RawAux, RawBaro, RawImu, RawMag,
     RedundancyReport, ServiceHealth, SimControl, Truth,
 };
 
@@ -34,6 +34,11 @@ layout! {
     /// [`RawAux`], on [`ipc_types::names::RAW_AUX`].
     pub static RAW_AUX: RawAux = "RawAux" {
         version, _pad as pad0, header, foot_pressure, _pad2 as pad1,
+    }
+
+    /// [`RawAirspeed`], on [`ipc_types::names::RAW_AIRSPEED`].
+    pub static RAW_AIRSPEED: RawAirspeed = "RawAirspeed" {
+        version, _pad as pad0, header, diff_pressure_pa, temperature_c,
     }
 
     /// [`GnssFix`], on [`ipc_types::names::GNSS`].

@@ -3,7 +3,7 @@
 
 use ipc_types::{
     Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, GnssFix, Health, HealthReport,
-    NavState, RawAux, RawBaro, RawImu, RawMag, SimControl, Truth,
+    NavState, RawAirspeed, RawAux, RawBaro, RawImu, RawMag, SimControl, Truth,
 };
 
 use super::description::StructLayout;

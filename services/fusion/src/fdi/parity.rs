@@ -24,7 +24,7 @@
 use super::MAX_PARITY;
 use super::dense::{ParityMatrix, cholesky, forward_substitute};
 use crate::capability::CAPABILITY_EPSILON;
-use crate::geometry::{Geometry, MAX_CHANNELS, MIN_CHANNELS, MIN_RECIPROCAL_CONDITION};
+use crate::geometry::{Geometry, MAX_CHANNELS, MIN_RECIPROCAL_CONDITION};
 use faer::Mat;
 
 /// Why a parity space cannot be built for a channel set.
@@ -88,22 +88,15 @@ impl ParitySpace {
     pub fn new(geometry: &Geometry, mask: u32, variances: &[f64]) -> Result<Self, ParityError> {
         let mask = mask & geometry.full_mask();
         let axes = geometry.axes();
-        let mut active = [0u8; MAX_CHANNELS];
-        let mut n_active = 0;
         for i in (0..geometry.n()).filter(|i| mask & (1 << i) != 0) {
             let value = variances.get(i).copied().unwrap_or(f64::NAN);
             if !(value.is_finite() && value > 0.0) {
                 return Err(ParityError::InvalidVariance { channel: i, value });
             }
-            active[n_active] = i as u8;
-            n_active += 1;
         }
-        if n_active < MIN_CHANNELS {
-            return Err(ParityError::InsufficientChannels {
-                mask,
-                active: n_active,
-            });
-        }
+        let (active, n_active) = geometry
+            .active_channels(mask)
+            .map_err(|active| ParityError::InsufficientChannels { mask, active })?;
         let h = Mat::<f64>::from_fn(n_active, 3, |r, c| axes[usize::from(active[r])][c]);
         let svd = h.svd().map_err(|_| ParityError::Decomposition)?;
         let s = svd.S().column_vector();

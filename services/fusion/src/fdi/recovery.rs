@@ -162,22 +162,33 @@ mod tests {
             .thresholds
     }
 
+    /// One sample of `candidates` with `counts` and values `z` on the pyramid, every channel at
+    /// σ² = 1e-4, the detector's persistence (3 of 5) and 20 consistent samples needed.
+    fn push(
+        retest: &mut ExclusionRetest,
+        g: &Geometry,
+        candidates: u32,
+        counts: &[i16],
+        z: &[f64; MAX_CHANNELS],
+    ) -> Option<u32> {
+        let input = RetestInput {
+            candidates,
+            counts,
+            z,
+        };
+        retest.push(g, &[1e-4; MAX_CHANNELS], &thresholds(), (3, 5), &input, 20)
+    }
+
     #[test]
     fn consistent_varying_channels_return_after_the_run() {
         let g = pyramid();
-        let variances = [1e-4; MAX_CHANNELS];
         let mut retest = ExclusionRetest::default();
         let mut back = None;
         for k in 0..50 {
             let wiggle = 1e-3 * f64::from(k % 3);
             let z = measure(&g, [0.1, 0.0, 9.8], [wiggle, -wiggle, 0.0, wiggle]);
             let counts = [k as i16, -(k as i16), 7 + (k % 2) as i16, 3 * k as i16];
-            let input = RetestInput {
-                candidates: 0b1111,
-                counts: &counts,
-                z: &z,
-            };
-            back = retest.push(&g, &variances, &thresholds(), (3, 5), &input, 20);
+            back = push(&mut retest, &g, 0b1111, &counts, &z);
             if back.is_some() {
                 assert_eq!(k, 19, "returned on the 20th consistent sample");
                 break;
@@ -189,21 +200,12 @@ mod tests {
     #[test]
     fn an_inconsistent_channel_keeps_every_candidate_out() {
         let g = pyramid();
-        let variances = [1e-4; MAX_CHANNELS];
         let mut retest = ExclusionRetest::default();
         for k in 0..100 {
             // Channel 2 is 100 σ off: parity far above any threshold.
             let z = measure(&g, [0.1, 0.0, 9.8], [0.0, 0.0, 1.0, 0.0]);
             let counts = [k as i16; 4];
-            let input = RetestInput {
-                candidates: 0b1111,
-                counts: &counts,
-                z: &z,
-            };
-            assert_eq!(
-                retest.push(&g, &variances, &thresholds(), (3, 5), &input, 20),
-                None
-            );
+            assert_eq!(push(&mut retest, &g, 0b1111, &counts, &z), None);
             // The detector's rule: declared from the third exceedance on.
             assert!(retest.run() < 3, "run {} at sample {k}", retest.run());
         }
@@ -212,21 +214,12 @@ mod tests {
     #[test]
     fn a_frozen_channel_does_not_come_back_and_fewer_than_three_never_do() {
         let g = pyramid();
-        let variances = [1e-4; MAX_CHANNELS];
         let mut retest = ExclusionRetest::default();
         for k in 0..100 {
             let z = measure(&g, [0.0, 0.0, 9.8], [0.0; 4]);
             // Channel 3 never changes its count.
             let counts = [k as i16, k as i16, k as i16, 5];
-            let input = RetestInput {
-                candidates: 0b1111,
-                counts: &counts,
-                z: &z,
-            };
-            assert_eq!(
-                retest.push(&g, &variances, &thresholds(), (3, 5), &input, 20),
-                None
-            );
+            assert_eq!(push(&mut retest, &g, 0b1111, &counts, &z), None);
         }
         assert!(
             retest.run() >= 20,
@@ -236,15 +229,7 @@ mod tests {
         for k in 0..100 {
             let z = measure(&g, [0.0, 0.0, 9.8], [0.0; 4]);
             let counts = [k as i16; 4];
-            let input = RetestInput {
-                candidates: 0b0011,
-                counts: &counts,
-                z: &z,
-            };
-            assert_eq!(
-                retest.push(&g, &variances, &thresholds(), (3, 5), &input, 20),
-                None
-            );
+            assert_eq!(push(&mut retest, &g, 0b0011, &counts, &z), None);
         }
     }
 }

@@ -1,15 +1,20 @@
-//! Magnetometer heading updates of the [`AidedNavigator`]: samples that arrive on their own topic,
-//! calibrated, then used for the alignment heading or applied to the filter's current state
-//! (as a stance heading update, HUPT, when `stance_only`).
+//! The magnetometer as an aiding source: samples that arrive on their own topic, calibrated, then
+//! used for the alignment heading or applied to the filter's current state (as a stance heading
+//! update, HUPT, when `stance_only`). The measurement model and its adaptive noise are in
+//! [`crate::aiding::mag_heading`].
 
 use nalgebra::Vector3;
 
+use crate::aiding::context::AidingContext;
+use crate::aiding::mag_heading::{
+    FieldReference, MagAidingConfig, adaptive_sigma, measured_heading,
+};
 use crate::aiding::outcome::AidingOutcome;
 use crate::aiding::source::AidingSensor;
+use crate::alignment::Alignment;
 use crate::attitude::{rotation_vector_to_quaternion, wrap_pi};
 use crate::ekf::{ATT, AidingSource};
-use crate::inertial_core::AidedNavigator;
-use crate::mag_heading::{FieldReference, MagAidingConfig, adaptive_sigma, measured_heading};
+use crate::mag_calibration::MagCalibration;
 
 impl AidingSensor for MagAidingConfig {
     /// Heading updates in stance only are booked as HUPT, the others as magnetometer updates.
@@ -32,51 +37,98 @@ impl AidingSensor for MagAidingConfig {
     }
 }
 
-impl AidedNavigator {
+/// The magnetometer aiding: its settings, the field reference and the rate limit.
+#[derive(Debug, Clone)]
+pub(crate) struct MagAiding {
+    config: MagAidingConfig,
+    /// Applied to every sample before use.
+    calibration: MagCalibration,
+    /// Declination, rad, positive east.
+    declination_rad: f64,
+    /// Device time of the last heading update attempted, µs (rate limit).
+    last_update_us: Option<u64>,
+    /// Magnitude and dip of the field in the alignment window.
+    field_reference: Option<FieldReference>,
+    /// The reference comes from the first sample after a takeover (there was no alignment
+    /// window of our own to take it from).
+    reference_from_next: bool,
+}
+
+impl MagAiding {
+    pub(crate) fn new(
+        config: MagAidingConfig,
+        calibration: MagCalibration,
+        declination_rad: f64,
+    ) -> Self {
+        Self {
+            config,
+            calibration,
+            declination_rad,
+            last_update_us: None,
+            field_reference: None,
+            reference_from_next: false,
+        }
+    }
+
+    /// Navigation starts from the alignment `a`: the field reference is its mean field.
+    pub(crate) fn on_aligned(&mut self, a: &Alignment) {
+        self.field_reference = a
+            .mean_field_ut
+            .and_then(|m| FieldReference::from_field(&m, &a.attitude));
+    }
+
+    /// Navigation goes on from a solution taken over: the reference is taken from the next
+    /// sample at the taken-over attitude.
+    pub(crate) fn on_take_over(&mut self) {
+        self.field_reference = None;
+        self.reference_from_next = true;
+    }
+
     /// One magnetometer sample (raw µT, body FRD) at device time `t_us`: calibrated, then used
     /// for the alignment heading, or as a heading update (only in stance, counted as HUPT, when
     /// `stance_only`).
-    pub fn on_mag(&mut self, t_us: u64, raw_ut: [f64; 3]) -> AidingOutcome {
+    pub(crate) fn on_sample(
+        &mut self,
+        ctx: &mut AidingContext<'_>,
+        t_us: u64,
+        raw_ut: [f64; 3],
+    ) -> AidingOutcome {
         if raw_ut.iter().any(|x| !x.is_finite()) {
             return AidingOutcome::Skipped;
         }
-        let field = self.config.mag_calibration.apply(raw_ut);
-        if let Some(aligner) = self.aligner_mut() {
+        let field = self.calibration.apply(raw_ut);
+        if let Some(aligner) = ctx.aligner_mut() {
             aligner.push_mag(t_us, field);
             return AidingOutcome::Stored;
         }
-        let c = self.config.mag;
-        if !c.enabled || (c.stance_only && !self.in_stance) {
+        let c = self.config;
+        if !c.enabled || (c.stance_only && !ctx.in_stance()) {
             return AidingOutcome::Skipped;
         }
         // Back after an outage: the heading has coasted on the gyros; the first reading is
         // applied whatever its innovation, the following ones are gated again.
-        let returning = self.is_stale(AidingSource::Mag);
-        self.last_reading_us[AidingSource::Mag as usize] = Some(t_us);
+        let returning = ctx.is_stale(AidingSource::Mag);
+        ctx.note_reading(AidingSource::Mag, t_us);
         if c.max_rate_hz > 0.0
-            && let Some(last) = self.last_mag_update_us
+            && let Some(last) = self.last_update_us
             && (t_us.saturating_sub(last) as f64) < 1e6 / c.max_rate_hz
         {
             return AidingOutcome::Skipped;
         }
         if self.field_reference.is_none()
-            && self.reference_from_next_mag
-            && let Some(ekf) = self.ekf()
+            && self.reference_from_next
+            && let Some(ekf) = ctx.filter()
         {
             let attitude = ekf.state().attitude;
             self.field_reference = FieldReference::from_field(&Vector3::from(field), &attitude);
-            self.reference_from_next_mag = false;
+            self.reference_from_next = false;
         }
         let Some(reference) = self.field_reference else {
             return AidingOutcome::Skipped;
         };
-        let (declination, force) = (self.config.declination_rad, self.last_force);
-        let source = if c.stance_only {
-            AidingSource::Hupt
-        } else {
-            AidingSource::Mag
-        };
-        let Some(ekf) = self.ekf_mut() else {
+        let (declination, force) = (self.declination_rad, ctx.force());
+        let source = c.source();
+        let Some(ekf) = ctx.filter_mut() else {
             return AidingOutcome::Skipped;
         };
         let field = Vector3::from(field);
@@ -88,12 +140,12 @@ impl AidedNavigator {
         let sigma = adaptive_sigma(&c, &reference, &force, g, &field, &attitude);
         let gate = if returning { f64::INFINITY } else { c.gate };
         let outcome = ekf.heading(source, psi, sigma, gate);
-        self.last_mag_update_us = Some(t_us);
-        self.book_update(source, t_us, outcome, 1);
+        self.last_update_us = Some(t_us);
+        ctx.book_update(source, t_us, outcome, 1);
         // Only an undisturbed field (every adaptive check passed) may re-set the heading.
         let undisturbed = sigma <= c.sigma_deg.to_radians();
-        if undisturbed && self.integrity.wants_reset(source, t_us) {
-            self.reset_heading(source, t_us, psi, sigma);
+        if undisturbed && ctx.wants_reset(source, t_us) {
+            reset_heading(ctx, source, t_us, psi, sigma);
             return AidingOutcome::Reset;
         }
         if returning && outcome.is_accepted() {
@@ -102,23 +154,29 @@ impl AidedNavigator {
             AidingOutcome::Update(outcome)
         }
     }
+}
 
-    /// Every heading update of `source` gated out for the persistence time, from a field that
-    /// passes every disturbance check: the filter's heading is wrong (its gyros were out, or
-    /// integrated something that was not motion). The attitude is turned about the vertical onto
-    /// the measured heading and the heading error's correlations dropped.
-    fn reset_heading(&mut self, source: AidingSource, t_us: u64, psi: f64, sigma: f64) {
-        let Some(ekf) = self.ekf_mut() else {
-            return;
-        };
-        let attitude = ekf.state().attitude;
-        let c = attitude.to_rotation_matrix();
-        let current = c[(1, 0)].atan2(c[(0, 0)]);
-        let turn = rotation_vector_to_quaternion(&Vector3::new(0.0, 0.0, wrap_pi(psi - current)));
-        let mut q = turn * attitude;
-        q.renormalize();
-        ekf.state_mut().attitude = q;
-        ekf.reset_component(ATT + 2, sigma * sigma);
-        self.book_reset(source, t_us);
-    }
+/// Every heading update of `source` gated out for the persistence time, from a field that
+/// passes every disturbance check: the filter's heading is wrong (its gyros were out, or
+/// integrated something that was not motion). The attitude is turned about the vertical onto
+/// the measured heading and the heading error's correlations dropped.
+fn reset_heading(
+    ctx: &mut AidingContext<'_>,
+    source: AidingSource,
+    t_us: u64,
+    psi: f64,
+    sigma: f64,
+) {
+    let Some(ekf) = ctx.filter_mut() else {
+        return;
+    };
+    let attitude = ekf.state().attitude;
+    let c = attitude.to_rotation_matrix();
+    let current = c[(1, 0)].atan2(c[(0, 0)]);
+    let turn = rotation_vector_to_quaternion(&Vector3::new(0.0, 0.0, wrap_pi(psi - current)));
+    let mut q = turn * attitude;
+    q.renormalize();
+    ekf.state_mut().attitude = q;
+    ekf.reset_component(ATT + 2, sigma * sigma);
+    ctx.book_reset(source, t_us);
 }

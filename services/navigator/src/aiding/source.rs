@@ -16,4 +16,9 @@ pub(crate) trait AidingSensor {
     /// `stale_after_s` is an outage (pseudo-measurements made from the IMU samples themselves
     /// never go quiet).
     fn watched_for_staleness(&self) -> bool;
+
+    /// Its rejections and silences count in the integrity verdict (see [`crate::integrity`]).
+    fn judged_by_integrity(&self) -> bool {
+        true
+    }
 }

@@ -1,10 +1,11 @@
-//! The zero-velocity update as an aiding source: its settings; it is applied in the inertial core
-//! whenever the stance detector fires (see [`crate::inertial_core`]).
+//! The zero-velocity update as an aiding source: a pseudo-measurement of zero velocity, applied
+//! whenever the stance detector fires (`[navigator.stance]`).
 
 use serde::{Deserialize, Serialize};
 
+use crate::aiding::context::AidingContext;
 use crate::aiding::source::AidingSensor;
-use crate::ekf::AidingSource;
+use crate::ekf::{AidingSource, UpdateOutcome};
 
 /// Settings of the zero-velocity aiding (`[navigator.zupt]`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -40,5 +41,33 @@ impl AidingSensor for ZuptConfig {
     /// A pseudo-measurement made from the IMU samples: it has no stream of its own to go quiet.
     fn watched_for_staleness(&self) -> bool {
         false
+    }
+}
+
+/// The zero-velocity aiding: its settings (it keeps nothing between updates).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ZuptAiding {
+    config: ZuptConfig,
+}
+
+impl ZuptAiding {
+    pub(crate) fn new(config: ZuptConfig) -> Self {
+        Self { config }
+    }
+
+    /// The IMU sample at `t_us`, propagated, was taken in stance: the update, booked, when the
+    /// profile applies it.
+    pub(crate) fn on_stance(
+        &self,
+        ctx: &mut AidingContext<'_>,
+        t_us: u64,
+    ) -> Option<UpdateOutcome> {
+        let z = self.config;
+        if !z.enabled {
+            return None;
+        }
+        let result = ctx.filter_mut()?.zupt(z.sigma_mps, z.gate);
+        ctx.book_update(AidingSource::Zupt, t_us, result, 3);
+        Some(result)
     }
 }

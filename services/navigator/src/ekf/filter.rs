@@ -27,11 +27,13 @@ pub enum AidingSource {
     Gravity = 4,
     /// GNSS receiver position and velocity.
     Gnss = 5,
+    /// Pitot airspeed as the body-x velocity (zero wind assumed).
+    Airspeed = 6,
 }
 
 impl AidingSource {
     /// Number of sources, the length of per-source arrays.
-    pub const COUNT: usize = 6;
+    pub const COUNT: usize = 7;
     /// Every source, in index order.
     pub const ALL: [AidingSource; Self::COUNT] = [
         AidingSource::Baro,
@@ -40,6 +42,7 @@ impl AidingSource {
         AidingSource::Hupt,
         AidingSource::Gravity,
         AidingSource::Gnss,
+        AidingSource::Airspeed,
     ];
 
     /// Lower-case name for logs and reports.
@@ -51,6 +54,7 @@ impl AidingSource {
             AidingSource::Hupt => "hupt",
             AidingSource::Gravity => "gravity",
             AidingSource::Gnss => "gnss",
+            AidingSource::Airspeed => "airspeed",
         }
     }
 }

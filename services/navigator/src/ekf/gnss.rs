@@ -11,22 +11,12 @@
 //! past, which over the receiver's latency (a tenth of a second) differs by one tenth of a second
 //! of process noise.
 
-use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use nalgebra::{Matrix3, SMatrix, Vector3};
 
 use super::filter::skew;
+use super::linearised::Linearised;
 use super::{ATT, BG, POS, STATES, VEL};
 use crate::state_history::PastState;
-
-/// One linearised measurement: Jacobian, innovation `z − h(x̂)`, noise.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Linearised {
-    /// `∂h/∂δx`.
-    pub h: SMatrix<f64, 3, STATES>,
-    /// `z − h(x̂)`.
-    pub innovation: SVector<f64, 3>,
-    /// Measurement noise covariance.
-    pub r: Matrix3<f64>,
-}
 
 /// The antenna position measurement `(lat, lon, alt)` against the state `past`, with per-axis σ
 /// (north and east `sigma_h_m`, down `sigma_v_m`); the innovation is in NED metres.
@@ -36,7 +26,7 @@ pub fn antenna_position(
     lever_arm: &Vector3<f64>,
     sigma_h_m: f64,
     sigma_v_m: f64,
-) -> Linearised {
+) -> Linearised<3> {
     let c = past.attitude.to_rotation_matrix().into_inner();
     let arm_ned = c * lever_arm;
     let [lat, lon, alt] = measured;
@@ -60,7 +50,7 @@ pub fn antenna_velocity(
     measured_ned: [f64; 3],
     lever_arm: &Vector3<f64>,
     sigma_mps: f64,
-) -> Linearised {
+) -> Linearised<3> {
     let c = past.attitude.to_rotation_matrix().into_inner();
     let arm_velocity = c * past.rate_body.cross(lever_arm);
     let innovation = Vector3::from(measured_ned) - (past.velocity_ned + arm_velocity);

@@ -1,9 +1,10 @@
-//! The aiding measurements: each builds `h`, the innovation and `R`, then calls
-//! [`ErrorStateEkf::update`].
+//! The aiding measurements: each linearises its measurement (`h`, the innovation, `R`) and
+//! hands it to [`ErrorStateEkf::apply`].
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector1};
 
 use super::filter::{AidingSource, ErrorStateEkf, UpdateOutcome, skew};
+use super::linearised::Linearised;
 use super::{ATT, BA, POS, STATES, VEL};
 use crate::attitude::wrap_pi;
 
@@ -29,7 +30,7 @@ impl ErrorStateEkf {
             .copy_from(&Matrix3::identity());
         let innovation = -self.state().velocity_ned;
         let r = Matrix3::identity() * (sigma_mps * sigma_mps);
-        self.update(AidingSource::Zupt, &h, &innovation, &r, gate)
+        self.apply(AidingSource::Zupt, &Linearised { h, innovation, r }, gate)
     }
 
     /// Height measurement (barometric altitude), m, σ `sigma_m`: `δh = −δp_D`.
@@ -37,8 +38,8 @@ impl ErrorStateEkf {
         let mut h = SMatrix::<f64, 1, STATES>::zeros();
         h[(0, POS + 2)] = -1.0;
         let innovation = Vector1::new(height_m - self.state().alt);
-        let r = Vector1::new(sigma_m * sigma_m);
-        self.update(AidingSource::Baro, &h, &innovation, &SMatrix::from(r), gate)
+        let r = SMatrix::from(Vector1::new(sigma_m * sigma_m));
+        self.apply(AidingSource::Baro, &Linearised { h, innovation, r }, gate)
     }
 
     /// Tilt from gravity: the mean specific force `force_body` (m/s², FRD, as measured) of a
@@ -84,7 +85,11 @@ impl ErrorStateEkf {
         let innovation =
             SVector::<f64, 2>::new(acceleration_ned[0] - f_n.x, acceleration_ned[1] - f_n.y);
         let r = SMatrix::<f64, 2, 2>::identity() * (sigma_mps2 * sigma_mps2);
-        self.update(AidingSource::Gravity, &h, &innovation, &r, gate)
+        self.apply(
+            AidingSource::Gravity,
+            &Linearised { h, innovation, r },
+            gate,
+        )
     }
 
     /// Rotor drag of a multirotor (as PX4's EKF2 models it): the specific force along the body x
@@ -118,7 +123,11 @@ impl ErrorStateEkf {
             innovation[k] = force_body[k] - (b[k] - mu * v_body[k]);
         }
         let r = SMatrix::<f64, 2, 2>::identity() * (sigma_mps2 * sigma_mps2);
-        self.update(AidingSource::Gravity, &h, &innovation, &r, gate)
+        self.apply(
+            AidingSource::Gravity,
+            &Linearised { h, innovation, r },
+            gate,
+        )
     }
 
     /// Heading measurement, rad from north, σ `sigma_rad` (magnetometer heading, or the stance
@@ -139,6 +148,6 @@ impl ErrorStateEkf {
         }
         let innovation = SVector::<f64, 1>::new(wrap_pi(heading_rad - psi));
         let r = SMatrix::<f64, 1, 1>::new(sigma_rad * sigma_rad);
-        self.update(source, &h, &innovation, &r, gate)
+        self.apply(source, &Linearised { h, innovation, r }, gate)
     }
 }

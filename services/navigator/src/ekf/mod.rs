@@ -20,10 +20,12 @@
 
 mod filter;
 pub mod gnss;
+mod linearised;
 mod measurements;
 mod noise;
 
 pub use filter::{AidingCounts, AidingSource, CorrectionTotals, ErrorStateEkf, UpdateOutcome};
+pub use linearised::Linearised;
 pub use measurements::heading_jacobian;
 pub use noise::EkfNoise;
 

@@ -7,6 +7,7 @@
 //! and injecting a fault into one channel leaves the noise of every other channel unchanged.
 //! Samples are instantaneous values at the sample time (no anti-alias averaging).
 
+pub mod airspeed;
 pub mod baro;
 pub mod config;
 pub mod fault;

@@ -110,6 +110,25 @@ fn parse_with<const N: usize>(
     Ok(rows)
 }
 
+/// A still recording for the loaders' tests: the `header` line, then `seconds` of rows at
+/// `rate_hz`, each its time ((row number + `first_row`) / rate, s) followed by the same `values`.
+#[cfg(test)]
+pub(crate) fn still_rows(
+    header: &[&str],
+    rate_hz: f64,
+    seconds: f64,
+    first_row: usize,
+    values: &str,
+) -> String {
+    let mut text = header.join(",") + "\n";
+    let rows = (seconds * rate_hz).round() as usize + 1;
+    for k in 0..rows {
+        let t = (k + first_row) as f64 / rate_hz;
+        text += &format!("{t},{values}\n");
+    }
+    text
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -178,13 +178,8 @@ mod tests {
 
     /// A trial of `seconds` at 200 Hz, still, z down, the foot at (1, 2, 0.1).
     fn trial_text(seconds: f64) -> String {
-        let mut text = HEADER.join(",") + "\n";
-        let rows = (seconds * 200.0).round() as usize + 1;
-        for k in 0..rows {
-            let t = (k + 1) as f64 / 200.0;
-            text += &format!("{t},-0.1,0.2,-9.8,0.001,0,-0.002,1,2,0.1\n");
-        }
-        text
+        let values = "-0.1,0.2,-9.8,0.001,0,-0.002,1,2,0.1";
+        crate::datasets::csv::still_rows(&HEADER, 200.0, seconds, 1, values)
     }
 
     #[test]

@@ -70,13 +70,7 @@ mod tests {
 
     /// A still walk of `seconds` at 400 Hz lying level, z up: accel `+1 g` on z.
     fn walk_text(seconds: f64) -> String {
-        let mut text = HEADER.join(",") + "\n";
-        let rows = (seconds * 400.0).round() as usize + 1;
-        for k in 0..rows {
-            let t = k as f64 / 400.0;
-            text += &format!("{t},0.1,-0.2,0.3,0.01,-0.02,1\n");
-        }
-        text
+        crate::datasets::csv::still_rows(&HEADER, 400.0, seconds, 0, "0.1,-0.2,0.3,0.01,-0.02,1")
     }
 
     #[test]

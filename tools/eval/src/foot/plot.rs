@@ -104,24 +104,21 @@ pub fn draw_trial(dir: &Path, plot: &TrialPlot) -> Result<()> {
         .y_desc("y, m")
         .draw()
         .map_err(plot_error)?;
-    if let Some(truth) = &truth {
+    // The truth (when there is one) under the estimate.
+    let tracks = truth
+        .iter()
+        .map(|t| ("truth", t, TRUTH, 2))
+        .chain([("estimate", &estimate, ESTIMATE, 1)]);
+    for (name, track, colour, width) in tracks {
         chart
             .draw_series(LineSeries::new(
-                truth.iter().copied(),
-                TRUTH.stroke_width(2),
+                track.iter().copied(),
+                colour.stroke_width(width),
             ))
             .map_err(plot_error)?
-            .label("truth")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], TRUTH));
+            .label(name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
     }
-    chart
-        .draw_series(LineSeries::new(
-            estimate.iter().copied(),
-            ESTIMATE.stroke_width(1),
-        ))
-        .map_err(plot_error)?
-        .label("estimate")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], ESTIMATE));
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.8))

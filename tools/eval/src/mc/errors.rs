@@ -203,7 +203,7 @@ mod tests {
             accel_bias_mps2: [0.0; 3],
             integrity: ipc_types::Integrity::Ok,
             integrity_reasons: 0,
-            resets: [0; 6],
+            resets: [0; rins_navigator::ekf::AidingSource::COUNT],
         }
     }
 

@@ -103,7 +103,17 @@ impl Pipeline {
         let fuser = ImuFuser::new(&fusion, gyro_lsb, prepared.sim.accel_lsb_mps2())?;
         let altimeter = AltitudeEstimator::new(prepared.altimeter.clone())?;
         let navigator = Navigator::new(prepared.navigator.clone())?;
-        Ok(Self {
+        Ok(Self::at_start(sim, fuser, altimeter, navigator))
+    }
+
+    /// The chain of these stages before its first tick.
+    fn at_start(
+        sim: Simulator,
+        fuser: ImuFuser,
+        altimeter: AltitudeEstimator,
+        navigator: Navigator,
+    ) -> Self {
+        Self {
             sim,
             fuser,
             altimeter,
@@ -112,7 +122,7 @@ impl Pipeline {
             solution: None,
             degraded: false,
             fused: None,
-        })
+        }
     }
 
     /// The chain as a deployment builds it from its configuration: the simulator with the
@@ -141,16 +151,7 @@ impl Pipeline {
         let altimeter =
             AltitudeEstimator::new(altimeter.clone()).map_err(|e| e.within("altimeter"))?;
         let navigator = Navigator::new(navigator.clone())?;
-        Ok(Self {
-            sim: sim_model,
-            fuser,
-            altimeter,
-            navigator,
-            tick: TickOutput::default(),
-            solution: None,
-            degraded: false,
-            fused: None,
-        })
+        Ok(Self::at_start(sim_model, fuser, altimeter, navigator))
     }
 
     /// Sets a fault on one inertial channel from the next tick on.

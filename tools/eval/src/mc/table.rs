@@ -6,6 +6,9 @@ use std::fmt::Write;
 use super::report::{KillStats, McReport, PUBLISHED_CLAIMS, WindowStats};
 use crate::stats::Stat;
 
+/// The statistic of a window that one row of the kill table shows.
+type StatOf = fn(&WindowStats) -> Stat;
+
 impl McReport {
     /// The comparison as Markdown tables (for docs/fault-tolerance.md): the fault-free errors with their
     /// ratios beside the published ones, then the kill experiment.
@@ -46,13 +49,20 @@ impl McReport {
             o.label,
             triple(o.noise_amplification),
         );
-        let _ = writeln!(
-            s,
-            "| error | {a} final | {b} final | ratio of 2σ | {a} RMS over flight | {b} RMS over flight | ratio of means | [R1], 5 h: redundant / orthogonal = ratio |",
-            a = r.label,
-            b = o.label
+        let (a, b) = (&r.label, &o.label);
+        header(
+            &mut s,
+            &[
+                "error",
+                &format!("{a} final"),
+                &format!("{b} final"),
+                "ratio of 2σ",
+                &format!("{a} RMS over flight"),
+                &format!("{b} RMS over flight"),
+                "ratio of means",
+                "[R1], 5 h: redundant / orthogonal = ratio",
+            ],
         );
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
         let (rf, of) = (&r.nominal.final_errors, &o.nominal.final_errors);
         let (rr, or) = (&r.nominal.rms, &o.nominal.rms);
         let (fr, mr) = (&self.final_two_sigma_ratio, &self.rms_mean_ratio);
@@ -142,13 +152,17 @@ impl McReport {
             o.label,
             after(o.noise_amplification_after_kill),
         );
-        let _ = writeln!(
+        let (a, b) = (&r.label, &o.label);
+        header(
             s,
-            "| after the kill | {a}, no fault | {a}, channel dead | {b}, no fault | {b}, channel dead |",
-            a = r.label,
-            b = o.label
+            &[
+                "after the kill",
+                &format!("{a}, no fault"),
+                &format!("{a}, channel dead"),
+                &format!("{b}, no fault"),
+                &format!("{b}, channel dead"),
+            ],
         );
-        let _ = writeln!(s, "|---|---|---|---|---|");
         let cols = [&rk.nominal, &rk.faulted, &ok.nominal, &ok.faulted];
         let row = |s: &mut String, name: &str, cell: &dyn Fn(&WindowStats) -> String| {
             let cells: Vec<String> = cols.iter().map(|w| cell(w)).collect();
@@ -163,34 +177,30 @@ impl McReport {
         row(s, "runs navigating at the end", &|w| {
             format!("{} of {}", w.runs_solved_at_end, w.runs)
         });
-        let lost_or = |w: &WindowStats, stat: Stat| {
-            if w.runs_solved_at_end == 0 || stat.n == 0 {
-                "lost".to_string()
-            } else {
-                pm(&stat)
-            }
-        };
-        row(s, "final roll/pitch, °", &|w| {
-            lost_or(w, w.final_errors.roll_pitch_deg)
-        });
-        row(s, "final heading, °", &|w| {
-            lost_or(w, w.final_errors.heading_deg)
-        });
-        row(s, "final horizontal (per axis), m", &|w| {
-            lost_or(w, w.final_errors.horizontal_per_axis_m)
-        });
-        row(s, "final altitude, m", &|w| {
-            lost_or(w, w.final_errors.altitude_m)
-        });
-        row(s, "RMS roll/pitch after the kill, °", &|w| {
-            lost_or(w, w.rms.roll_pitch_deg)
-        });
-        row(s, "RMS heading after the kill, °", &|w| {
-            lost_or(w, w.rms.heading_deg)
-        });
-        row(s, "RMS horizontal after the kill, m", &|w| {
-            lost_or(w, w.rms.horizontal_m)
-        });
+        // The error rows: "lost" where no run was navigating at the end.
+        let errors: [(&str, StatOf); 7] = [
+            ("final roll/pitch, °", |w| w.final_errors.roll_pitch_deg),
+            ("final heading, °", |w| w.final_errors.heading_deg),
+            ("final horizontal (per axis), m", |w| {
+                w.final_errors.horizontal_per_axis_m
+            }),
+            ("final altitude, m", |w| w.final_errors.altitude_m),
+            ("RMS roll/pitch after the kill, °", |w| {
+                w.rms.roll_pitch_deg
+            }),
+            ("RMS heading after the kill, °", |w| w.rms.heading_deg),
+            ("RMS horizontal after the kill, m", |w| w.rms.horizontal_m),
+        ];
+        for (name, stat) in errors {
+            row(s, name, &|w| {
+                let stat = stat(w);
+                if w.runs_solved_at_end == 0 || stat.n == 0 {
+                    "lost".to_string()
+                } else {
+                    pm(&stat)
+                }
+            });
+        }
         let jump = |k: &KillStats| {
             let j = k.reconfiguration_jump_deg;
             if j.n == 0 {
@@ -216,6 +226,12 @@ impl McReport {
              had one."
         );
     }
+}
+
+/// A Markdown table's header row of `columns` and the rule under it.
+fn header(s: &mut String, columns: &[&str]) {
+    let _ = writeln!(s, "| {} |", columns.join(" | "));
+    let _ = writeln!(s, "|{}", "---|".repeat(columns.len()));
 }
 
 /// A number with about three significant digits.

@@ -5,7 +5,7 @@
 //! over the plausible drag coefficients of a small multirotor (0.3–0.6 /s forwards, 0.4–0.6 /s
 //! sideways) and two σs. Every other setting is the profile's.
 
-use rins_navigator::tilt_aiding::{TiltAidingConfig, TiltModel};
+use rins_navigator::aiding::tilt::{TiltAidingConfig, TiltModel};
 use serde::Serialize;
 
 /// Windows further than this from g are not used by any candidate, m/s²: the quadrotor's

@@ -62,6 +62,11 @@ fn cell(v: Option<f64>) -> String {
     v.map_or_else(|| "    -".to_string(), |x| format!("{x:5.2}"))
 }
 
+/// The [`cell`]s of one RMSE per unit, side by side.
+fn cells(v: &[Option<f64>]) -> String {
+    v.iter().map(|v| cell(*v)).collect::<Vec<_>>().join(" ")
+}
+
 /// The human-readable table.
 pub fn to_table(r: &AhrsReport) -> String {
     let mut s = String::new();
@@ -86,44 +91,24 @@ pub fn to_table(r: &AhrsReport) -> String {
         "gt off"
     );
     for f in &r.flights {
-        let single: Vec<String> = f
-            .single_roll_pitch_rmse_deg
-            .iter()
-            .map(|v| cell(*v))
-            .collect();
-        let peer: Vec<String> = f
-            .peer_roll_pitch_rmse_deg
-            .iter()
-            .map(|v| cell(*v))
-            .collect();
         let _ = writeln!(
             s,
             "{:22} {:6.2} | {} | {} | {:+7.3}  {}",
             f.name,
             f.fused_roll_pitch_rmse_deg,
-            single.join(" "),
-            peer.join(" "),
+            cells(&f.single_roll_pitch_rmse_deg),
+            cells(&f.peer_roll_pitch_rmse_deg),
             f.truth_offset_s,
             f.candidate
         );
     }
-    let single: Vec<String> = r
-        .single_roll_pitch_rmse_deg
-        .iter()
-        .map(|v| cell(*v))
-        .collect();
-    let peer: Vec<String> = r
-        .peer_roll_pitch_rmse_deg
-        .iter()
-        .map(|v| cell(*v))
-        .collect();
     let _ = writeln!(
         s,
         "{:22} {:6.2} | {} | {} |",
         "mean",
         r.roll_pitch_rmse_deg,
-        single.join(" "),
-        peer.join(" ")
+        cells(&r.single_roll_pitch_rmse_deg),
+        cells(&r.peer_roll_pitch_rmse_deg)
     );
     let _ = writeln!(
         s,

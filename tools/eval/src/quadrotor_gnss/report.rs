@@ -3,6 +3,7 @@
 use std::fmt::Write;
 
 use super::{GnssMode, GnssReport, OUTAGE_RATIO_TARGET, OUTAGE_S, ROLL_PITCH_TARGET_DEG};
+use crate::trial_rows::unit_then_fused_rows;
 
 /// One line per run, then the means and the targets.
 pub fn to_table(r: &GnssReport) -> String {
@@ -13,12 +14,7 @@ pub fn to_table(r: &GnssReport) -> String {
         "flight", "s", "run", "rp rmse°", "yaw rmse°", "horiz m", "end err m", "rejected"
     );
     for t in &r.trials {
-        for (k, run) in t.single.iter().chain(std::iter::once(&t.fused)).enumerate() {
-            let (name, secs) = if k == 0 {
-                (t.name.as_str(), format!("{:.1}", t.duration_s))
-            } else {
-                ("", String::new())
-            };
+        for (name, secs, run) in unit_then_fused_rows(&t.name, t.duration_s, &t.single, &t.fused) {
             let label = run.imu.map_or("fused".to_string(), |i| format!("imu{i}"));
             let _ = writeln!(
                 s,

@@ -4,7 +4,7 @@
 
 use nalgebra::Vector3;
 use rins_earth::LocalOrigin;
-use rins_navigator::gnss_updates::{GnssMeasurement, GnssOutcome};
+use rins_navigator::aiding::gnss::measurement::{GnssMeasurement, GnssOutcome};
 use rins_navigator::inertial_core::AidedConfig;
 use rins_navigator::inertial_core::AidedNavigator;
 use rins_navigator::mechanisation::quaternion_from_euler;

@@ -315,28 +315,26 @@ mod tests {
             .iter()
             .zip(gyro_bias)
             .enumerate()
-            .map(|(k, (mount, bias))| ImuSeries {
-                imu: k + 1,
-                lag_rows: 0,
-                residual_lag_rows: [0.0; 2],
-                repairs: Default::default(),
-                truth_offset_s: 0.0,
-                samples: (0..rows)
-                    .map(|j| {
-                        let t = j as f64 * dt;
-                        let (e, rates) = euler(t - 0.5 * dt);
-                        let omega = Vector3::from(body_rate_from_euler_rates(e, rates));
-                        let c = quaternion_from_euler(e[0], e[1], e[2]);
-                        let force = c.inverse() * Vector3::new(0.0, 0.0, -gravity);
-                        let unit = mount.inverse();
-                        ImuSample {
-                            t_s: t,
-                            gyro_rps: (unit * omega + Vector3::from(*bias)).into(),
-                            accel_mps2: (unit * force).into(),
-                            euler_rad: [0.0; 3],
-                        }
-                    })
-                    .collect(),
+            .map(|(k, (mount, bias))| {
+                ImuSeries::aligned(
+                    k + 1,
+                    (0..rows)
+                        .map(|j| {
+                            let t = j as f64 * dt;
+                            let (e, rates) = euler(t - 0.5 * dt);
+                            let omega = Vector3::from(body_rate_from_euler_rates(e, rates));
+                            let c = quaternion_from_euler(e[0], e[1], e[2]);
+                            let force = c.inverse() * Vector3::new(0.0, 0.0, -gravity);
+                            let unit = mount.inverse();
+                            ImuSample {
+                                t_s: t,
+                                gyro_rps: (unit * omega + Vector3::from(*bias)).into(),
+                                accel_mps2: (unit * force).into(),
+                                euler_rad: [0.0; 3],
+                            }
+                        })
+                        .collect(),
+                )
             })
             .collect();
         let truth = (0..=(SECONDS * 10.0) as usize)

@@ -5,6 +5,7 @@ use std::fmt::Write;
 use super::QuadrotorReport;
 use super::metrics::Scores;
 use crate::datasets::quadrotor::skipped_lines;
+use crate::trial_rows::unit_then_fused_rows;
 
 fn label(s: &Scores) -> String {
     s.imu.map_or_else(|| "fused".into(), |k| format!("IMU_{k}"))
@@ -19,12 +20,8 @@ pub fn to_table(r: &QuadrotorReport) -> String {
         "trial", "s", "run", "roll°", "pitch°", "rp rmse°", "height m", "|h| max m"
     );
     for t in &r.trials {
-        for (k, run) in t.single.iter().chain(std::iter::once(&t.fused)).enumerate() {
-            let (name, seconds) = if k == 0 {
-                (t.name.as_str(), format!("{:.1}", t.duration_s))
-            } else {
-                ("", String::new())
-            };
+        for (name, seconds, run) in unit_then_fused_rows(&t.name, t.duration_s, &t.single, &t.fused)
+        {
             let _ = writeln!(
                 s,
                 "{:<20} {:>6} {:<6} {:>8.2} {:>8.2} {:>10.2} {:>10.2} {:>10.2}",

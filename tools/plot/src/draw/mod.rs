@@ -12,6 +12,7 @@ use std::fmt::Debug;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::extract::{Extracted, NavPoint, TruthPoint};
 use crate::font::FAMILY;
 use crate::stats::{finite_bounds, finite_runs, padded, thin};
 
@@ -183,4 +184,49 @@ pub fn note(area: &Area<'_>, text: &str) -> Result<(), String> {
 /// The time span of every series given, padded.
 pub fn time_range(times: impl IntoIterator<Item = f64>) -> (f64, f64) {
     padded(finite_bounds(times))
+}
+
+/// The time span of the navigation output and the truth together, padded.
+pub fn nav_and_truth_time_range(data: &Extracted) -> (f64, f64) {
+    time_range(
+        data.nav
+            .iter()
+            .map(|p| p.t_s)
+            .chain(data.truth.iter().map(|p| p.t_s)),
+    )
+}
+
+/// The estimate's points `nav` makes of each solution and, when recorded, truth's that `truth`
+/// makes of each true state, as the lines of one panel: truth first, so that the estimate drawn
+/// over it stays visible where the two agree.
+pub fn estimate_over_truth(
+    data: &Extracted,
+    nav: impl Fn(&NavPoint) -> (f64, f64),
+    truth: impl Fn(&TruthPoint) -> (f64, f64),
+) -> Vec<Line> {
+    let estimate = Line::solid("estimate", ESTIMATE, data.nav.iter().map(nav).collect());
+    let truth = (!data.truth.is_empty())
+        .then(|| Line::solid("truth", TRUTH, data.truth.iter().map(truth).collect()));
+    truth.into_iter().chain([estimate]).collect()
+}
+
+/// Three panels stacked in `area`, one per name in `axes`, of the lines `lines_of` gives for
+/// that axis against time over `x`; `unit` on the y labels.
+pub fn axis_panels(
+    area: &Area<'_>,
+    axes: [&str; 3],
+    unit: &str,
+    x: (f64, f64),
+    lines_of: impl Fn(usize) -> Vec<Line>,
+) -> Result<(), String> {
+    for (axis, cell) in area.split_evenly((3, 1)).iter().enumerate() {
+        let y = format!("{} ({unit})", axes[axis]);
+        let labels = Labels {
+            caption: axes[axis],
+            x: "time (s)",
+            y: &y,
+        };
+        panel(cell, labels, &lines_of(axis), Some(x))?;
+    }
+    Ok(())
 }

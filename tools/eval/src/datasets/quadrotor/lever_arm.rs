@@ -160,26 +160,24 @@ mod tests {
         let imus = arms
             .iter()
             .enumerate()
-            .map(|(k, r)| ImuSeries {
-                imu: k + 1,
-                lag_rows: 0,
-                residual_lag_rows: [0.0; 2],
-                repairs: Default::default(),
-                truth_offset_s: 0.0,
-                samples: (0..n)
-                    .map(|j| {
-                        let t = j as f64 / rate;
-                        let w = omega(t);
-                        let kk = skew(&omega_dot(t)) + skew(&w) * skew(&w);
-                        let f = Vector3::new(0.3 * t.sin(), 0.0, -9.8) + kk * Vector3::from(*r);
-                        ImuSample {
-                            t_s: t,
-                            gyro_rps: w.into(),
-                            accel_mps2: f.into(),
-                            euler_rad: [0.0; 3],
-                        }
-                    })
-                    .collect(),
+            .map(|(k, r)| {
+                ImuSeries::aligned(
+                    k + 1,
+                    (0..n)
+                        .map(|j| {
+                            let t = j as f64 / rate;
+                            let w = omega(t);
+                            let kk = skew(&omega_dot(t)) + skew(&w) * skew(&w);
+                            let f = Vector3::new(0.3 * t.sin(), 0.0, -9.8) + kk * Vector3::from(*r);
+                            ImuSample {
+                                t_s: t,
+                                gyro_rps: w.into(),
+                                accel_mps2: f.into(),
+                                euler_rad: [0.0; 3],
+                            }
+                        })
+                        .collect(),
+                )
             })
             .collect();
         let installation = Installation {
@@ -193,16 +191,7 @@ mod tests {
                 })
                 .collect(),
         };
-        let trial = Trial {
-            name: "synthetic".into(),
-            path: "synthetic".into(),
-            imus,
-            truth: Vec::new(),
-            truth_offset_s: 0.0,
-            repairs: Default::default(),
-            notes: Vec::new(),
-        };
-        (trial, installation)
+        (Trial::synthetic(imus), installation)
     }
 
     #[test]

@@ -90,6 +90,22 @@ pub struct ImuSeries {
     pub samples: Vec<ImuSample>,
 }
 
+impl ImuSeries {
+    /// Unit `imu` recording `samples` on the reference's rows: no lag, nothing repaired, the
+    /// truth on the same clock. A test fixture.
+    #[cfg(test)]
+    pub(crate) fn aligned(imu: usize, samples: Vec<ImuSample>) -> Self {
+        Self {
+            imu,
+            lag_rows: 0,
+            residual_lag_rows: [0.0; 2],
+            repairs: Repairs::default(),
+            truth_offset_s: 0.0,
+            samples,
+        }
+    }
+}
+
 /// One ground-truth row in SI units.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TruthRow {
@@ -135,6 +151,21 @@ pub struct Trial {
 }
 
 impl Trial {
+    /// A trial named "synthetic" of the units `imus`, without truth, repairs or notes. A test
+    /// fixture.
+    #[cfg(test)]
+    pub(crate) fn synthetic(imus: Vec<ImuSeries>) -> Self {
+        Self {
+            name: "synthetic".into(),
+            path: "synthetic".into(),
+            imus,
+            truth: Vec::new(),
+            truth_offset_s: 0.0,
+            repairs: Repairs::default(),
+            notes: Vec::new(),
+        }
+    }
+
     /// Number of aligned samples (the same for every IMU).
     pub fn len(&self) -> usize {
         self.imus.first().map_or(0, |s| s.samples.len())

@@ -282,38 +282,28 @@ mod tests {
         let imus = mounts
             .iter()
             .enumerate()
-            .map(|(k, r)| ImuSeries {
-                imu: k + 1,
-                lag_rows: 0,
-                residual_lag_rows: [0.0; 2],
-                repairs: Default::default(),
-                truth_offset_s: 0.0,
-                samples: reference
-                    .iter()
-                    .enumerate()
-                    .map(|(j, (g, a))| {
-                        let bias = Vector3::new(0.01 * k as f64, -0.02, 0.005);
-                        let gk = r.inverse() * Vector3::from(*g) + bias;
-                        let ak = r.inverse() * Vector3::from(*a);
-                        ImuSample {
-                            t_s: j as f64 / 120.0,
-                            gyro_rps: gk.into(),
-                            accel_mps2: ak.into(),
-                            euler_rad: [0.0; 3],
-                        }
-                    })
-                    .collect(),
+            .map(|(k, r)| {
+                ImuSeries::aligned(
+                    k + 1,
+                    reference
+                        .iter()
+                        .enumerate()
+                        .map(|(j, (g, a))| {
+                            let bias = Vector3::new(0.01 * k as f64, -0.02, 0.005);
+                            let gk = r.inverse() * Vector3::from(*g) + bias;
+                            let ak = r.inverse() * Vector3::from(*a);
+                            ImuSample {
+                                t_s: j as f64 / 120.0,
+                                gyro_rps: gk.into(),
+                                accel_mps2: ak.into(),
+                                euler_rad: [0.0; 3],
+                            }
+                        })
+                        .collect(),
+                )
             })
             .collect();
-        Trial {
-            name: "synthetic".into(),
-            path: "synthetic".into(),
-            imus,
-            truth: Vec::new(),
-            truth_offset_s: 0.0,
-            repairs: Default::default(),
-            notes: Vec::new(),
-        }
+        Trial::synthetic(imus)
     }
 
     fn mounts() -> Vec<Rotation3<f64>> {

@@ -2,8 +2,8 @@
 //! backlog of both lanes still gets every sample once, in order.
 
 use ipc_types::{NavMode, NavState, names};
+use rins_navigator::lanes::NavSubscriber;
 use rins_runtime::ipc::{IpcSettings, TopicPublisher, create_node};
-use rins_runtime::nav_subscriber::NavSubscriber;
 use rins_runtime::shm_cleanup;
 
 fn nav(lane: u8, seq: u64) -> NavState {
@@ -20,9 +20,9 @@ fn nav(lane: u8, seq: u64) -> NavState {
 #[test]
 fn a_backlog_of_both_lanes_is_delivered_whole() {
     let settings = IpcSettings::new(
-        format!("rtnav{}_", std::process::id()),
+        format!("lnav{}_", std::process::id()),
         std::env::temp_dir()
-            .join(format!("rtnav{}root/", std::process::id()))
+            .join(format!("lnav{}root/", std::process::id()))
             .to_string_lossy()
             .into_owned(),
     );

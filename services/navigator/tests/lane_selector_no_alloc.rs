@@ -2,7 +2,7 @@
 //! lanes, delivering them, switching when the delivering lane dies, must not touch the heap.
 
 use ipc_types::{NavMode, NavState, Stage};
-use rins_runtime::lane_selector::{LaneSelector, SelectorConfig};
+use rins_navigator::lanes::{LaneSelector, SelectorConfig};
 use rins_test_support::counting_alloc::{CountingAllocator, allocations_during};
 
 #[global_allocator]

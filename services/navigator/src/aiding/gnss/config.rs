@@ -3,7 +3,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::aiding::source::AidingSensor;
 use crate::checks::positive;
+use crate::ekf::AidingSource;
 
 /// Settings of the GNSS position and velocity updates (`[navigator.gnss]`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -37,7 +39,7 @@ pub struct GnssAidingConfig {
     /// real quadrotor flights chooses (`rins eval quadrotor --mode gnss`): a smaller allowance
     /// or threshold raises alarms on clean fixes there.
     pub drift_threshold: f64,
-    /// Threshold of the displacement test ([`crate::gnss_displacement`]), σ (2 dof): the
+    /// Threshold of the displacement test ([`crate::aiding::gnss::displacement`]), σ (2 dof): the
     /// receiver's displacement over 10 s against the inertial velocity. Under white fix noise
     /// of the reported accuracy, 6 σ is passed once in some 10⁸ fixes; a 0.5 m/s drift passes it
     /// within about ten seconds.
@@ -89,5 +91,19 @@ impl GnssAidingConfig {
         positive("drift_threshold", self.drift_threshold)?;
         positive("displacement_threshold", self.displacement_threshold)?;
         positive("readmit_after_s", self.readmit_after_s)
+    }
+}
+
+impl AidingSensor for GnssAidingConfig {
+    fn source(&self) -> AidingSource {
+        AidingSource::Gnss
+    }
+
+    fn enabled(&self) -> bool {
+        self.enabled
+    }
+
+    fn watched_for_staleness(&self) -> bool {
+        true
     }
 }

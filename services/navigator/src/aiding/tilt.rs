@@ -18,7 +18,9 @@
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use crate::ekf::{ErrorStateEkf, UpdateOutcome};
+use crate::aiding::context::AidingContext;
+use crate::aiding::source::AidingSensor;
+use crate::ekf::{AidingSource, ErrorStateEkf, UpdateOutcome};
 use crate::force_window::ForceWindow;
 
 /// What the mean specific force is taken to measure.
@@ -123,23 +125,74 @@ impl TiltAidingConfig {
     }
 }
 
-/// The window in progress.
-#[derive(Debug, Clone, Copy, Default)]
+impl AidingSensor for TiltAidingConfig {
+    fn source(&self) -> AidingSource {
+        AidingSource::Gravity
+    }
+
+    fn enabled(&self) -> bool {
+        self.enabled
+    }
+
+    /// A pseudo-measurement made from the IMU samples: it has no stream of its own to go quiet.
+    fn watched_for_staleness(&self) -> bool {
+        false
+    }
+
+    /// Its updates share their bucket with the attitude recovery's, which levels the filter
+    /// whatever the profile; a window gated out in a sustained manoeuvre is the model's limit,
+    /// not a fault of the solution.
+    fn judged_by_integrity(&self) -> bool {
+        false
+    }
+}
+
+/// The tilt aiding: its settings and the window in progress.
+#[derive(Debug, Clone, Copy)]
 pub struct TiltAiding {
+    config: TiltAidingConfig,
     window: ForceWindow,
 }
 
 impl TiltAiding {
+    /// No window open yet.
+    pub fn new(config: TiltAidingConfig) -> Self {
+        Self {
+            config,
+            window: ForceWindow::default(),
+        }
+    }
+
+    /// One propagated sample at `t_us` in normal navigation (specific force as measured, rate
+    /// bias-corrected): the update of a window that closed, booked.
+    pub(crate) fn on_imu(
+        &mut self,
+        ctx: &mut AidingContext<'_>,
+        t_us: u64,
+        force_body: [f64; 3],
+        rate_body: &Vector3<f64>,
+    ) {
+        if !self.config.enabled {
+            return;
+        }
+        let Some(ekf) = ctx.filter_mut() else {
+            return;
+        };
+        if let Some(result) = self.push(ekf, t_us, force_body, rate_body) {
+            ctx.book_update(AidingSource::Gravity, t_us, result, 2);
+        }
+    }
+
     /// One propagated sample at `t_us`: specific force as measured, rate bias-corrected. Returns
     /// the update made when a window closed (`None` while it is open or when it was not used).
     pub fn push(
         &mut self,
         ekf: &mut ErrorStateEkf,
-        config: &TiltAidingConfig,
         t_us: u64,
         force_body: [f64; 3],
         rate_body: &Vector3<f64>,
     ) -> Option<UpdateOutcome> {
+        let config = &self.config;
         let mean =
             self.window
                 .push(t_us, config.window_s, &Vector3::from(force_body), rate_body)?;
@@ -227,13 +280,13 @@ mod tests {
         let g = ekf.strapdown().gravity();
         let sigma = 0.2;
         let config = gravity_config(sigma);
-        let mut aiding = TiltAiding::default();
+        let mut aiding = TiltAiding::new(config);
         let mut windows = 0;
         for k in 1..=100u64 {
             let force = [0.0, 0.0, -g];
             assert!(ekf.predict([0.0; 3], force, 1.0 / RATE_HZ).is_applied());
             let t_us = k * 10_000;
-            if let Some(o) = aiding.push(&mut ekf, &config, t_us, force, &Vector3::zeros()) {
+            if let Some(o) = aiding.push(&mut ekf, t_us, force, &Vector3::zeros()) {
                 assert!(o.is_accepted(), "{o:?}");
                 windows += 1;
             }
@@ -261,12 +314,12 @@ mod tests {
         let mut ekf = filter(0.0, 0.5_f64.to_radians());
         let g = ekf.strapdown().gravity();
         let config = gravity_config(0.1);
-        let mut aiding = TiltAiding::default();
+        let mut aiding = TiltAiding::new(config);
         for k in 1..=(120.0 * RATE_HZ) as u64 {
             let force = [0.0, 0.0, -g];
             assert!(ekf.predict(bias, force, 1.0 / RATE_HZ).is_applied());
             let rate = Vector3::from(bias) - ekf.bias().gyro_rps;
-            let _ = aiding.push(&mut ekf, &config, k * 10_000, force, &rate);
+            let _ = aiding.push(&mut ekf, k * 10_000, force, &rate);
         }
         let learnt = ekf.bias().gyro_rps;
         for axis in 0..2 {
@@ -305,9 +358,9 @@ mod tests {
                 max_force_error_mps2: 5.0,
                 ..gravity_config(0.2)
             };
-            let mut aiding = TiltAiding::default();
+            let mut aiding = TiltAiding::new(config);
             for k in 0..=10u64 {
-                let _ = aiding.push(&mut ekf, &config, k * 10_000, force.into(), &rate);
+                let _ = aiding.push(&mut ekf, k * 10_000, force.into(), &rate);
             }
             (ekf.state().euler()[0], bank)
         };
@@ -340,10 +393,10 @@ mod tests {
             lateral_drag_per_s: mu,
             ..gravity_config(0.05)
         };
-        let mut aiding = TiltAiding::default();
+        let mut aiding = TiltAiding::new(config);
         for k in 1..=(30.0 * RATE_HZ) as u64 {
             assert!(ekf.predict([0.0; 3], force, 1.0 / RATE_HZ).is_applied());
-            let _ = aiding.push(&mut ekf, &config, k * 10_000, force, &Vector3::zeros());
+            let _ = aiding.push(&mut ekf, k * 10_000, force, &Vector3::zeros());
         }
         let [_, estimated, _] = ekf.state().euler();
         assert!(

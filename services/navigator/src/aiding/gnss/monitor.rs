@@ -13,9 +13,9 @@
 //! growing. Its fixes go on being compared; once they have passed the gate for
 //! `readmit_after_s`, it is re-admitted and the sums start again. The caller holds a receiver
 //! rejected for a jump out while its fixes stay about as far away as they jumped (see
-//! [`crate::gnss_updates`]): the grown covariance alone would in time let a persistent jump back.
+//! [`crate::aiding::gnss`]): the grown covariance alone would in time let a persistent jump back.
 
-use crate::gnss_config::GnssAidingConfig;
+use crate::aiding::gnss::config::GnssAidingConfig;
 
 /// Why the receiver was rejected.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -149,7 +149,7 @@ impl GnssMonitor {
     }
 
     /// Rejects a receiver still believed for a drift another test saw (see
-    /// [`crate::gnss_displacement`]); nothing when it is rejected already.
+    /// [`crate::aiding::gnss::displacement`]); nothing when it is rejected already.
     pub fn reject_for_drift(&mut self, t_us: u64) {
         if self.standing == Standing::Accepted {
             self.reject(t_us, RejectReason::Drift);

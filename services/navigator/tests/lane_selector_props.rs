@@ -2,7 +2,7 @@
 
 use ipc_types::{NavMode, NavState};
 use proptest::prelude::*;
-use rins_runtime::lane_selector::{LaneSelector, SelectorConfig};
+use rins_navigator::lanes::{LaneSelector, SelectorConfig};
 
 const N: u64 = 600;
 

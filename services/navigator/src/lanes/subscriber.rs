@@ -6,9 +6,11 @@ use std::time::Duration;
 
 use ipc_types::{NavState, names};
 
-use crate::clock::monotonic_ns;
-use crate::ipc::{IpcError, IpcNode, SampleSource, TopicSubscriber, TopicWaitSet};
-use crate::lane_selector::{LANES, LaneSelector, SelectorConfig, Switch, SwitchCounts};
+use rins_runtime::clock::monotonic_ns;
+use rins_runtime::ipc::{IpcError, IpcNode, SampleSource, TopicSubscriber, TopicWaitSet};
+
+use crate::lanes::selector::{LANES, LaneSelector, SelectorConfig};
+use crate::lanes::switch::{Switch, SwitchCounts};
 
 /// Both navigator lanes' topics, merged into the stream consumers see.
 pub struct NavSubscriber {

@@ -1,80 +1,73 @@
 //! Placing receiver fixes on the device time base, at a fixed place in the IMU stream.
 //!
 //! The receiver does not know the sensor block's clock; what both share is the receive clock
-//! (CLOCK_MONOTONIC) their bytes were stamped with. A fix is held until an IMU sample received
-//! [`HOLD_NS`] after it comes through; that sample's device and receive times put the fix's
-//! receive instant on the device time base, and the receiver's configured latency goes back from
-//! there to the instant it measured. The same sample is chosen whatever the scheduling of the
-//! processes, so two navigator lanes apply the fix to the same state.
-
-use std::collections::VecDeque;
+//! (CLOCK_MONOTONIC) their bytes were stamped with. A fix is held (see [`crate::aiding::hold`])
+//! until an IMU sample received [`HOLD_NS`] after it comes through; that sample's device and
+//! receive times put the fix's receive instant on the device time base, and the receiver's
+//! configured latency goes back from there to the instant it measured. The same sample is chosen
+//! whatever the scheduling of the processes, so two navigator lanes apply the fix to the same
+//! state.
 
 use ipc_types::GnssFix;
 
+use crate::aiding::hold::{HOLD_US, Held, Hold};
+
 /// How much later than a fix an IMU sample must have been received to release it, ns: as for the
 /// other aiding readings, well beyond the hops' scheduling delays.
-pub const HOLD_NS: u64 = crate::aiding_queue::HOLD_US * 1_000;
+pub const HOLD_NS: u64 = HOLD_US * 1_000;
 
 /// Fixes held at most (at 5–20 Hz, a second's worth); beyond it the oldest is dropped, counted.
 const CAPACITY: usize = 32;
 
+impl Held for GnssFix {
+    /// The receive time, ns.
+    fn place(&self) -> (u64, u8) {
+        (self.header.origin_rx_ns, 0)
+    }
+}
+
 /// Fixes waiting for the IMU stream.
 #[derive(Debug, Clone)]
 pub struct GnssHold {
-    held: VecDeque<GnssFix>,
+    held: Hold<GnssFix>,
     delay_us: u64,
-    dropped: u64,
 }
 
 impl GnssHold {
     /// An empty hold for a receiver whose output lags its measurement by `delay_s`.
     pub fn new(delay_s: f64) -> Self {
         Self {
-            held: VecDeque::with_capacity(CAPACITY),
+            held: Hold::new(HOLD_NS, CAPACITY),
             delay_us: (delay_s.max(0.0) * 1e6).round() as u64,
-            dropped: 0,
         }
     }
 
-    /// Holds `fix` (in receive order).
+    /// Holds `fix` (in receive order); a full hold drops its oldest.
     pub fn push(&mut self, fix: GnssFix) {
-        if self.held.len() == CAPACITY {
-            self.held.pop_front();
-            self.dropped += 1;
-        }
-        let rx = fix.header.origin_rx_ns;
-        let at = self
-            .held
-            .iter()
-            .rposition(|h| h.header.origin_rx_ns <= rx)
-            .map_or(0, |i| i + 1);
-        self.held.insert(at, fix);
+        let _dropped = self.held.push(fix);
     }
 
     /// Hands `apply` every fix the IMU sample of device time `imu_t_us`, received at
     /// `imu_rx_ns`, releases, with the device time its receiver measured at.
     pub fn release(&mut self, imu_t_us: u64, imu_rx_ns: u64, mut apply: impl FnMut(&GnssFix, u64)) {
-        while let Some(front) = self.held.front() {
-            let rx = front.header.origin_rx_ns;
-            if rx.saturating_add(HOLD_NS) > imu_rx_ns {
-                break;
-            }
-            let before_us = (imu_rx_ns - rx) / 1_000;
-            let t_us = imu_t_us
-                .saturating_sub(before_us)
-                .saturating_sub(self.delay_us);
-            if let Some(fix) = self.held.pop_front() {
-                apply(&fix, t_us);
-            }
-        }
+        let delay_us = self.delay_us;
+        self.held.release(imu_rx_ns, |fix| {
+            let before_us = (imu_rx_ns - fix.header.origin_rx_ns) / 1_000;
+            let t_us = imu_t_us.saturating_sub(before_us).saturating_sub(delay_us);
+            apply(&fix, t_us);
+        });
     }
 
     /// Fixes dropped because the IMU stream stopped while fixes went on arriving.
     pub fn dropped(&self) -> u64 {
-        self.dropped
+        self.held.displaced()
+    }
+
+    /// Fixes that arrived after the IMU sample that should have placed them.
+    pub fn late(&self) -> u64 {
+        self.held.late()
     }
 }
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,7 +1,7 @@
 //! A drift test that does not go through the filter's gain: the receiver's displacement against
 //! the velocity over the same time.
 //!
-//! The innovation test ([`crate::gnss_monitor`]) sees a slow drift only through what the filter
+//! The innovation test ([`crate::aiding::gnss::monitor`]) sees a slow drift only through what the filter
 //! has not yet followed. How much the filter follows depends on its covariance, and so on the
 //! phase of flight: a 0.5 m/s drift starting 31 or 45 s into the simulated flight went unseen
 //! for 40 s. This test instead sums, between consecutive fixes, the receiver's horizontal

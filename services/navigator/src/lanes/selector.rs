@@ -1,10 +1,8 @@
 //! Choosing between the two navigator lanes: one contiguous navigation stream out of two.
 //!
-//! Both lanes run the same filter on the same fused IMU samples and stamp each solution with the
-//! sequence number of its IMU sample, so the lanes' outputs are interchangeable sample by sample. The
-//! selector delivers every sequence number once, in order, from the lane it has selected, and keeps
-//! the other lane's samples that are ahead of the output so that a switch continues exactly at the
-//! next sequence number: killing the selected lane loses no sample.
+//! The selector delivers every sequence number once, in order, from the lane it has selected, and
+//! keeps the other lane's samples that are ahead of the output so that a switch continues exactly
+//! at the next sequence number: killing the selected lane loses no sample.
 //!
 //! Switching rule, built against the known failure modes of lane switching:
 //! - **Dead lane** (liveness): the selected lane has delivered nothing beyond the output while the
@@ -37,9 +35,11 @@
 //! Allocation-free after construction: each lane's pending samples sit in a fixed ring.
 
 use std::collections::VecDeque;
-use std::fmt;
 
-use ipc_types::{NavMode, NavState, Stage};
+use ipc_types::{NavState, Stage};
+
+use crate::lanes::switch::{Switch, SwitchCounts, SwitchReason};
+use crate::lanes::trust::distrust;
 
 /// Number of navigator lanes.
 pub const LANES: usize = 2;
@@ -78,149 +78,6 @@ impl Default for SelectorConfig {
     }
 }
 
-/// Why a solution is not trusted ([`distrust`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Distrust {
-    /// Still aligning.
-    Aligning,
-    /// Its mode is invalid (or a mode this build cannot read).
-    Invalid,
-    /// Its solution has run only this many samples (since alignment or takeover).
-    Young {
-        /// Samples since the solution started (0: no start recorded).
-        run: u64,
-    },
-    /// Its attitude is not finite.
-    NonFinite,
-}
-
-impl Distrust {
-    /// One word or two, for logs and one-line messages.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Aligning => "aligning",
-            Self::Invalid => "invalid",
-            Self::Young { .. } => "too young",
-            Self::NonFinite => "non-finite",
-        }
-    }
-}
-
-/// Why the selector changed lanes: what it saw when it did.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SwitchReason {
-    /// The selected lane delivered nothing for `silent_ns` (navigator publish times) while the
-    /// other lane was `ahead` samples ahead of the output.
-    Silent {
-        /// How long the selected lane had been silent, ns.
-        silent_ns: u64,
-        /// Samples of the other lane pending ahead of the output.
-        ahead: u32,
-    },
-    /// The selected lane delivered nothing while the other lane, whose samples carry no publish
-    /// times, was `ahead` samples ahead: judged by the count alone.
-    Behind {
-        /// Samples of the other lane pending ahead of the output.
-        ahead: u32,
-    },
-    /// The other lane's pending samples filled the ring (`ahead` of them) and the selected lane
-    /// had been silent for `silent_ns` on the consumer's clock.
-    RingFull {
-        /// How long the selected lane had been silent, ns.
-        silent_ns: u64,
-        /// Samples of the other lane pending ahead of the output.
-        ahead: u32,
-    },
-    /// The selected lane's next sample was not trusted and the other lane's was.
-    Untrusted(Distrust),
-}
-
-impl SwitchReason {
-    /// A name for the cause alone, for counts and structured logs.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Silent { .. } => "silent",
-            Self::Behind { .. } => "behind",
-            Self::RingFull { .. } => "ring-full",
-            Self::Untrusted(_) => "untrusted",
-        }
-    }
-}
-
-/// A change of the lane delivering, and why.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Switch {
-    /// The lane left.
-    pub from: usize,
-    /// The lane delivering from now on.
-    pub to: usize,
-    /// Why the selector switched.
-    pub reason: SwitchReason,
-    /// Sequence number of the first sample delivered from the new lane.
-    pub at_seq: u64,
-}
-
-impl fmt::Display for Switch {
-    /// `lane 0 → 1 at seq 1234: lane 0 silent 12.3 ms while lane 1 was 15 samples ahead`.
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let (from, to) = (self.from, self.to);
-        write!(f, "lane {from} → {to} at seq {}: ", self.at_seq)?;
-        match self.reason {
-            SwitchReason::Silent { silent_ns, ahead } => write!(
-                f,
-                "lane {from} silent {:.1} ms while lane {to} was {ahead} samples ahead",
-                silent_ns as f64 * 1e-6
-            ),
-            SwitchReason::Behind { ahead } => write!(
-                f,
-                "lane {from} silent while lane {to} was {ahead} samples ahead (no publish times)"
-            ),
-            SwitchReason::RingFull { silent_ns, ahead } => write!(
-                f,
-                "lane {to}'s {ahead} pending samples filled the ring, lane {from} silent {:.1} ms",
-                silent_ns as f64 * 1e-6
-            ),
-            SwitchReason::Untrusted(Distrust::Young { run }) => write!(
-                f,
-                "lane {from}'s solution too young ({run} samples), lane {to} trusted"
-            ),
-            SwitchReason::Untrusted(d) => {
-                write!(f, "lane {from} {}, lane {to} trusted", d.name())
-            }
-        }
-    }
-}
-
-/// Lane changes since start, by cause.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct SwitchCounts {
-    /// [`SwitchReason::Silent`].
-    pub silent: u64,
-    /// [`SwitchReason::Behind`].
-    pub behind: u64,
-    /// [`SwitchReason::RingFull`].
-    pub ring_full: u64,
-    /// [`SwitchReason::Untrusted`].
-    pub untrusted: u64,
-}
-
-impl SwitchCounts {
-    /// All of them.
-    pub fn total(&self) -> u64 {
-        self.silent + self.behind + self.ring_full + self.untrusted
-    }
-
-    fn count(&mut self, reason: SwitchReason) {
-        let slot = match reason {
-            SwitchReason::Silent { .. } => &mut self.silent,
-            SwitchReason::Behind { .. } => &mut self.behind,
-            SwitchReason::RingFull { .. } => &mut self.ring_full,
-            SwitchReason::Untrusted(_) => &mut self.untrusted,
-        };
-        *slot += 1;
-    }
-}
-
 /// See the module documentation.
 #[derive(Debug, Clone)]
 pub struct LaneSelector {
@@ -236,25 +93,6 @@ pub struct LaneSelector {
     last_switch: Option<Switch>,
     filled: u64,
     overwritten: u64,
-}
-
-/// Why `s` is not a solution the selector may choose for quality; `None` when it is.
-pub fn distrust(s: &NavState, settle: u64) -> Option<Distrust> {
-    let run = s.header.origin_seq.saturating_sub(s.solution_start_seq);
-    match NavMode::from_u8(s.mode) {
-        Some(NavMode::Aligning) => Some(Distrust::Aligning),
-        Some(m) if !m.is_usable() => Some(Distrust::Invalid),
-        None => Some(Distrust::Invalid),
-        Some(_) if s.solution_start_seq == 0 => Some(Distrust::Young { run: 0 }),
-        Some(_) if run < settle => Some(Distrust::Young { run }),
-        Some(_) if !s.quaternion.iter().all(|q| q.is_finite()) => Some(Distrust::NonFinite),
-        Some(_) => None,
-    }
-}
-
-/// A solution the selector may choose for quality.
-pub fn trusted(s: &NavState, settle: u64) -> bool {
-    distrust(s, settle).is_none()
 }
 
 /// A navigator's publish time of `s`, `None` for a sample without one.
@@ -475,9 +313,11 @@ impl LaneSelector {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use ipc_types::NavMode;
 
-    const SETTLE: u64 = 100;
+    use super::*;
+    use crate::lanes::test_samples::{SETTLE, aligning, nav};
+    use crate::lanes::trust::Distrust;
 
     fn cfg() -> SelectorConfig {
         SelectorConfig {
@@ -490,46 +330,10 @@ mod tests {
     }
 
     /// A navigating solution of `lane` at `seq` that started at `start`.
-    fn nav(lane: u8, seq: u64, start: u64) -> NavState {
-        let mut s = NavState {
-            mode: NavMode::Navigating as u8,
-            lane,
-            solution_start_seq: start,
-            ..NavState::default()
-        };
-        s.header.origin_seq = seq;
-        s
-    }
-
-    fn aligning(lane: u8, seq: u64) -> NavState {
-        let mut s = nav(lane, seq, 0);
-        s.mode = NavMode::Aligning as u8;
-        s
-    }
-
     fn drain(sel: &mut LaneSelector, out: &mut Vec<(u64, u8)>) {
         while let Some(s) = sel.pop() {
             out.push((s.header.origin_seq, s.lane));
         }
-    }
-
-    #[test]
-    fn only_a_settled_usable_mode_is_trusted() {
-        let settled = nav(0, 1 + SETTLE, 1);
-        assert!(trusted(&settled, SETTLE));
-        let coasting = NavState {
-            mode: NavMode::Coasting as u8,
-            ..settled
-        };
-        assert!(trusted(&coasting, SETTLE));
-        // Aligning, invalid, or a mode this build cannot read: no usable solution.
-        for mode in [NavMode::Aligning as u8, NavMode::Invalid as u8, 4, u8::MAX] {
-            assert!(
-                !trusted(&NavState { mode, ..settled }, SETTLE),
-                "mode {mode}"
-            );
-        }
-        assert!(!trusted(&nav(0, SETTLE, 1), SETTLE));
     }
 
     #[test]
@@ -1031,35 +835,6 @@ mod tests {
         assert_eq!(out.len(), 400);
     }
 
-    #[test]
-    fn every_distrust_is_named_and_reported() {
-        let settled = nav(0, 1 + SETTLE, 1);
-        assert_eq!(distrust(&settled, SETTLE), None);
-        let cases = [
-            (aligning(0, 500), Distrust::Aligning),
-            (
-                NavState {
-                    mode: NavMode::Invalid as u8,
-                    ..settled
-                },
-                Distrust::Invalid,
-            ),
-            (NavState { mode: 4, ..settled }, Distrust::Invalid),
-            (nav(0, 130, 100), Distrust::Young { run: 30 }),
-            (nav(0, 130, 0), Distrust::Young { run: 0 }),
-            (
-                NavState {
-                    quaternion: [f64::NAN, 0.0, 0.0, 0.0],
-                    ..settled
-                },
-                Distrust::NonFinite,
-            ),
-        ];
-        for (s, want) in cases {
-            assert_eq!(distrust(&s, SETTLE), Some(want), "{s:?}");
-        }
-    }
-
     /// Lane 0 delivers `bad` at `at` (and is settled otherwise); lane 1 is trusted throughout.
     fn quality_switch(bad: impl Fn(u64) -> NavState, at: u64) -> Option<Switch> {
         let mut sel = LaneSelector::new(cfg());
@@ -1122,46 +897,6 @@ mod tests {
             ),
             (1, 1, 1, 3)
         );
-    }
-
-    #[test]
-    fn the_reasons_read_as_what_happened() {
-        let switch = |reason| Switch {
-            from: 1,
-            to: 0,
-            reason,
-            at_seq: 42,
-        };
-        assert_eq!(
-            switch(SwitchReason::Behind { ahead: 8 }).to_string(),
-            "lane 1 → 0 at seq 42: lane 1 silent while lane 0 was 8 samples ahead (no publish times)"
-        );
-        assert_eq!(
-            switch(SwitchReason::RingFull {
-                silent_ns: 8_250_000,
-                ahead: 512
-            })
-            .to_string(),
-            "lane 1 → 0 at seq 42: lane 0's 512 pending samples filled the ring, lane 1 silent 8.2 ms"
-        );
-        assert_eq!(
-            switch(SwitchReason::Untrusted(Distrust::Aligning)).to_string(),
-            "lane 1 → 0 at seq 42: lane 1 aligning, lane 0 trusted"
-        );
-        let names = [
-            SwitchReason::Silent {
-                silent_ns: 0,
-                ahead: 0,
-            },
-            SwitchReason::Behind { ahead: 0 },
-            SwitchReason::RingFull {
-                silent_ns: 0,
-                ahead: 0,
-            },
-            SwitchReason::Untrusted(Distrust::Invalid),
-        ]
-        .map(SwitchReason::name);
-        assert_eq!(names, ["silent", "behind", "ring-full", "untrusted"]);
     }
 
     #[test]

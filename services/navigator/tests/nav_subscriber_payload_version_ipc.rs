@@ -1,0 +1,96 @@
+//! The payload version check of the merged navigation stream over real iceoryx2 shared memory: a
+//! sample written with another payload version on either lane never reaches the consumer and is
+//! counted, while the samples of this build around it come through. Every consumer of the
+//! navigation solution (mavlink, the watchdog's monitor, `rins echo nav`, soak) reads it this way,
+//! from a node of its own or a tool's.
+
+use ipc_types::{NavMode, NavState, PAYLOAD_VERSION, names};
+use rins_navigator::lanes::NavSubscriber;
+use rins_runtime::ipc::{IpcNode, IpcSettings, SampleSource, TopicPublisher, create_node};
+use rins_runtime::payload::Versioned;
+use rins_runtime::shm_cleanup;
+use rins_runtime::tool_node::ToolNode;
+
+/// Another build's version on either side of this one's.
+const OTHER_VERSIONS: [u16; 2] = [PAYLOAD_VERSION + 1, PAYLOAD_VERSION - 1];
+
+fn nav(lane: u8, version: u16, seq: u64) -> NavState {
+    let mut s = NavState {
+        version,
+        mode: NavMode::Navigating as u8,
+        lane,
+        solution_start_seq: 1,
+        ..NavState::default()
+    };
+    s.header.origin_seq = seq;
+    s
+}
+
+/// The merged navigation stream drops another version on either lane (in between a contiguous
+/// sequence of this build's, so that no lane looks late); the lane totals count only what was
+/// taken in.
+fn nav_subscriber_rejects(node: &IpcNode) {
+    let mut sub = NavSubscriber::new(node).expect("subscriber");
+    let lanes = names::NAV_LANES.map(|t| TopicPublisher::<NavState>::new(node, t).expect("lane"));
+    for (lane, publisher) in (0u8..).zip(&lanes) {
+        for (seq, other) in (1..=3).zip(OTHER_VERSIONS) {
+            publisher
+                .publish(nav(lane, PAYLOAD_VERSION, seq))
+                .expect("publish");
+            publisher
+                .publish(nav(lane, other, 100 + seq))
+                .expect("publish");
+        }
+        publisher
+            .publish(nav(lane, PAYLOAD_VERSION, 3))
+            .expect("publish");
+    }
+    let mut got = Vec::new();
+    while let Some(s) = sub.receive().expect("receive") {
+        assert!(s.is_current(), "{s:?}");
+        got.push((s.header.origin_seq, s.lane));
+    }
+    assert_eq!(got, [(1, 0), (2, 0), (3, 0)]);
+    assert_eq!(sub.rejected(), 4);
+    assert_eq!(SampleSource::rejected(&sub), 4);
+    assert_eq!(sub.lane_totals(), [3, 3]);
+}
+
+fn settings(tag: &str) -> IpcSettings {
+    let pid = std::process::id();
+    IpcSettings::new(
+        format!("lnv{tag}{pid}_"),
+        std::env::temp_dir()
+            .join(format!("lnv{tag}{pid}root/"))
+            .to_string_lossy()
+            .into_owned(),
+    )
+}
+
+fn clean(settings: &IpcSettings) {
+    shm_cleanup::remove_all(settings, true);
+    let _ = std::fs::remove_dir_all(&settings.root);
+    assert!(shm_cleanup::shm_entries(settings).is_empty());
+}
+
+/// A service (mavlink, the watchdog) reads the stream from a node of its own.
+#[test]
+fn the_navigation_stream_drops_another_version_on_either_lane() {
+    let settings = settings("nv");
+    {
+        let node = create_node("nv", &settings).expect("node");
+        nav_subscriber_rejects(&node);
+    }
+    clean(&settings);
+}
+
+/// A tool (`rins echo nav`) reads it from the tool's node.
+#[test]
+fn a_tools_navigation_stream_drops_another_version() {
+    let settings = settings("tl");
+    {
+        let tool = ToolNode::join_settings("echo", settings.clone()).expect("tool node");
+        nav_subscriber_rejects(tool.node());
+    }
+    clean(&settings);
+}
