@@ -1,7 +1,8 @@
 //! The table of every topic: its name, the payload it carries and how tools reach it. Everything
 //! that lists topics is generated from it: the names in [`crate::names`], the payload layouts and
-//! topic list of a recording, the runtime's payload traits, `rins record`'s choices and the Python
-//! mirror. Adding a topic is one entry here (plus its payload struct and that struct's layout).
+//! topic list of a recording, the runtime's payload traits, `rins record`'s choices and help,
+//! `rins echo`'s topics and the Python mirror. Adding a topic is one entry here (plus its payload
+//! struct and that struct's layout).
 //!
 //! [`for_each_topic!`](crate::for_each_topic) hands the table to a macro of the caller's, which
 //! generates what that crate needs. The table is grouped by payload, in the order payloads are

@@ -5,6 +5,33 @@ use std::path::PathBuf;
 
 use clap::{Args, Subcommand};
 
+/// The short names the topic table marks as recordable, with their place in a recording.
+macro_rules! record_short_names {
+    ($(
+        $payload:ident ($kind:ident) {
+            $(
+                $(#[$meta:meta])*
+                $constant:ident = $topic:literal
+                    $(, echo $echo:literal)?
+                    $(, record $short:literal at $rank:literal)?;
+            )+
+        }
+    )+) => {
+        [$($($(($rank, $short),)?)+)+]
+    };
+}
+
+/// The `--topics` help: every recordable topic's short name, in the order a recording holds them.
+fn record_topics_help() -> String {
+    let mut ranked = ipc_types::for_each_topic!(record_short_names);
+    ranked.sort_by_key(|(rank, _)| *rank);
+    let names: Vec<&str> = ranked.iter().map(|(_, short)| *short).collect();
+    format!(
+        "Comma-separated short names of the topics to record (default: all): {}",
+        names.join(", ")
+    )
+}
+
 /// `rins record FILE`.
 #[derive(Debug, Args)]
 pub struct RecordArgs {
@@ -21,10 +48,8 @@ pub struct RecordArgs {
     /// With --dir: the most rins's own recordings in DIR may take together, MB (default 2048).
     #[arg(long, value_name = "MB", requires = "dir")]
     pub max_total_mb: Option<u64>,
-    /// Comma-separated short names of the topics to record (default: all): raw-imu, raw-baro,
-    /// raw-mag, raw-aux, fused-imu, altitude, nav, nav-standby, truth, health, heartbeat, fault,
-    /// sim-control, fusion-control, fusion-reply, raw-airspeed.
-    #[arg(long, value_delimiter = ',')]
+    /// Short names of the topics to record (the help lists them from the topic table).
+    #[arg(long, value_delimiter = ',', help = record_topics_help())]
     pub topics: Vec<String>,
     /// Stop after this many seconds.
     #[arg(long, allow_negative_numbers = true)]

@@ -5,10 +5,7 @@ use std::io::Write;
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, bail};
-use ipc_types::{
-    Altitude, FusedImu, GnssFix, Health, HealthReport, NavState, RawAirspeed, RawAux, RawBaro,
-    RawImu, RawMag, Truth, names,
-};
+use ipc_types::{NavState, names};
 use rins_navigator::lanes::NavSubscriber;
 use rins_runtime::ipc::{IpcNode, SampleSource, TopicSubscriber};
 use rins_runtime::payload::{OtherVersionWarning, Versioned};
@@ -103,27 +100,53 @@ trait ReceivedAt {
     fn received_ns(&self) -> Option<u64>;
 }
 
-macro_rules! received_at {
-    (with header: $($t:ty),*; without: $($u:ty),*) => {
-        $(impl ReceivedAt for $t {
+/// From the topic table: the receive time of every payload, and the payload `rins echo` shows
+/// for each short name the table gives it (a payload given one must have a [`Readable`] form).
+macro_rules! echo_table {
+    ($(
+        $payload:ident ($kind:ident) {
+            $(
+                $(#[$meta:meta])*
+                $constant:ident = $topic:literal
+                    $(, echo $echo:literal)?
+                    $(, record $short:literal at $rank:literal)?;
+            )+
+        }
+    )+) => {
+        $(echo_table!(@received $kind $payload);)+
+
+        /// Prints the topic whose echo short name is `short`; `None` for a name the table does
+        /// not give.
+        fn echo_by_short_name(short: &str, opts: EchoOptions) -> Option<Result<()>> {
+            match short {
+                $($($(
+                    $echo => Some(echo_topic::<ipc_types::$payload>(names::$constant, opts)),
+                )?)+)+
+                _ => None,
+            }
+        }
+    };
+    // Truth comes from the simulator, not from a received frame: no receive time.
+    (@received stamped Truth) => {
+        echo_table!(@received unstamped Truth);
+    };
+    (@received stamped $payload:ident) => {
+        impl ReceivedAt for ipc_types::$payload {
             fn received_ns(&self) -> Option<u64> {
                 Some(self.header.origin_rx_ns)
             }
-        })*
-        $(impl ReceivedAt for $u {
+        }
+    };
+    (@received unstamped $payload:ident) => {
+        impl ReceivedAt for ipc_types::$payload {
             fn received_ns(&self) -> Option<u64> {
                 None
             }
-        })*
+        }
     };
 }
 
-received_at!(
-    with header: RawImu, RawBaro, RawMag, RawAux, RawAirspeed, GnssFix, FusedImu, Altitude,
-        NavState;
-    // Truth comes from the simulator, not from a received frame: no receive time.
-    without: Truth, Health, HealthReport
-);
+ipc_types::for_each_topic!(echo_table);
 
 /// Prints what `open` yields, a topic or the merged navigation stream. Samples from before the
 /// start (a topic's history, kept for restarted services) are skipped: echo shows what comes.
@@ -221,29 +244,21 @@ pub fn run(topic: &str, count: Option<u64>, csv: bool, raw: bool, timeout_s: f64
             known.join(", ")
         );
     };
-    match *service {
-        names::RAW_IMU => echo_topic::<RawImu>(names::RAW_IMU, opts),
-        names::RAW_BARO => echo_topic::<RawBaro>(names::RAW_BARO, opts),
-        names::RAW_MAG => echo_topic::<RawMag>(names::RAW_MAG, opts),
-        names::RAW_AUX => echo_topic::<RawAux>(names::RAW_AUX, opts),
-        names::RAW_AIRSPEED => echo_topic::<RawAirspeed>(names::RAW_AIRSPEED, opts),
-        names::GNSS => echo_topic::<GnssFix>(names::GNSS, opts),
-        names::FUSED_IMU => echo_topic::<FusedImu>(names::FUSED_IMU, opts),
-        names::ALTITUDE => echo_topic::<Altitude>(names::ALTITUDE, opts),
-        // The stream consumers see: both navigator lanes through the lane selector.
-        names::NAV_STATE => echo_from::<NavState, _>(names::NAV_STATE, opts, NavSubscriber::new),
-        names::TRUTH => echo_topic::<Truth>(names::TRUTH, opts),
-        names::HEARTBEAT => echo_topic::<Health>(names::HEARTBEAT, opts),
-        names::HEALTH => echo_topic::<HealthReport>(names::HEALTH, opts),
-        // A topic given an echo name in the table but no payload here: refused, never shown
-        // as another payload.
-        other => bail!("topic {topic:?} ({other}) cannot be echoed"),
+    // The stream consumers see: both navigator lanes through the lane selector.
+    if *service == names::NAV_STATE {
+        return echo_from::<NavState, _>(names::NAV_STATE, opts, NavSubscriber::new);
+    }
+    match echo_by_short_name(topic, opts) {
+        Some(echoed) => echoed,
+        // Unreachable while the short name comes from the same table; refused, never guessed.
+        None => bail!("topic {topic:?} ({service}) cannot be echoed"),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use ipc_types::FusedImu;
 
     #[test]
     fn flatten_names_nested_columns() {

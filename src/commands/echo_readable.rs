@@ -7,9 +7,9 @@
 //! (`"bit N"` in a list): a newer writer or a corrupted sample is shown as it is, never guessed.
 
 use ipc_types::{
-    Altitude, ChannelState, FaultReason, FusedImu, GnssFix, Health, HealthReport, Integrity,
-    LinkError, NavMode, NavState, RawAirspeed, RawAux, RawBaro, RawImu, RawMag, ServiceKind,
-    ServiceState, Stage, Truth, aiding, fused_flags, integrity_reason, status,
+    ChannelState, FaultReason, FusedImu, Health, HealthReport, Integrity, LinkError, NavMode,
+    NavState, RawImu, ServiceKind, ServiceState, Stage, Truth, aiding, fused_flags,
+    integrity_reason, status,
 };
 use serde::Serialize;
 use serde_json::{Map, Value};
@@ -24,14 +24,19 @@ pub const BIT_FIELDS: [&str; 5] = [
     "valid_mask",
 ];
 
-/// A payload as `rins echo` shows it by default.
+/// A payload as `rins echo` shows it by default. A payload with nothing to name or cut keeps
+/// the default: the wire form without padding, times by stage.
 pub trait Readable: Serialize {
     /// The readable JSON object of this sample.
-    fn readable(&self) -> serde_json::Result<Value>;
+    fn readable(&self) -> serde_json::Result<Value> {
+        let mut m = wire(self)?;
+        header(&mut m);
+        Ok(Value::Object(m))
+    }
 }
 
 /// The wire form as a JSON object, without the padding fields (at any depth).
-fn wire(sample: &impl Serialize) -> serde_json::Result<Map<String, Value>> {
+fn wire<T: Serialize + ?Sized>(sample: &T) -> serde_json::Result<Map<String, Value>> {
     let mut value = serde_json::to_value(sample)?;
     drop_padding(&mut value);
     Ok(match value {
@@ -283,16 +288,10 @@ impl Readable for HealthReport {
     }
 }
 
-/// Payloads with nothing to name or cut: the wire form without padding, times by stage.
+/// Payloads shown in the default readable form.
 macro_rules! plain_readable {
-    ($($t:ty),*) => {
-        $(impl Readable for $t {
-            fn readable(&self) -> serde_json::Result<Value> {
-                let mut m = wire(self)?;
-                header(&mut m);
-                Ok(Value::Object(m))
-            }
-        })*
+    ($($t:ident),*) => {
+        $(impl Readable for ipc_types::$t {})*
     };
 }
 
@@ -301,7 +300,7 @@ plain_readable!(RawBaro, RawMag, RawAux, RawAirspeed, GnssFix, Altitude);
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ipc_types::MAX_CHANNELS;
+    use ipc_types::{MAX_CHANNELS, RawAirspeed};
 
     fn fused_with_four_gyros() -> FusedImu {
         let mut f = FusedImu {

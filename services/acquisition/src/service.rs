@@ -5,7 +5,7 @@
 use std::time::Duration;
 
 use anyhow::{Result, anyhow};
-use ipc_types::{Health, RawAirspeed, RawAux, RawBaro, RawImu, RawMag, ServiceKind, Stage, names};
+use ipc_types::{Health, ServiceKind, Stage, names};
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{IpcNode, IpcSettings, create_node};
 use rins_runtime::service::{Service, ServiceContext};
@@ -22,49 +22,44 @@ use rins_protocol::{DecodedFrame, Decoder, DecoderStats, FrameType, Payload, lin
 use rins_serial_reader::presence::{Opened, Presence, Retry};
 use rins_serial_reader::reconnecting::{LineEvents, read_reconnecting};
 
-/// The topics acquisition publishes, one per frame type; each sample leaves stamped with the
-/// acquisition's publish time.
-struct Publishers {
-    imu: StagePublisher<RawImu>,
-    baro: StagePublisher<RawBaro>,
-    mag: StagePublisher<RawMag>,
-    aux: StagePublisher<RawAux>,
-    airspeed: StagePublisher<RawAirspeed>,
-}
+/// Generates [`Publishers`]: the topic of each frame type and the dispatch of a decoded frame to
+/// it, from one line per frame type: `Variant => field: Payload on TOPIC via conversion`.
+macro_rules! raw_topics {
+    ($($variant:ident => $field:ident: $payload:ident on $topic:ident via $convert:path;)+) => {
+        /// The topics acquisition publishes, one per frame type; each sample leaves stamped with
+        /// the acquisition's publish time.
+        struct Publishers {
+            $($field: StagePublisher<ipc_types::$payload>,)+
+        }
 
-impl Publishers {
-    fn new(node: &IpcNode) -> Result<Self> {
-        let stage = Stage::Acquisition;
-        Ok(Self {
-            imu: StagePublisher::new(node, names::RAW_IMU, stage)?,
-            baro: StagePublisher::new(node, names::RAW_BARO, stage)?,
-            mag: StagePublisher::new(node, names::RAW_MAG, stage)?,
-            aux: StagePublisher::new(node, names::RAW_AUX, stage)?,
-            airspeed: StagePublisher::new(node, names::RAW_AIRSPEED, stage)?,
-        })
-    }
+        impl Publishers {
+            fn new(node: &IpcNode) -> Result<Self> {
+                let stage = Stage::Acquisition;
+                Ok(Self {
+                    $($field: StagePublisher::new(node, names::$topic, stage)?,)+
+                })
+            }
 
-    fn publish(&self, frame: &DecodedFrame, rx_ns: u64) -> Result<()> {
-        let header = to_ipc::origin_header(frame, rx_ns);
-        match &frame.payload {
-            Payload::Imu(f) => {
-                self.imu.publish(to_ipc::raw_imu(f, header))?;
-            }
-            Payload::Baro(f) => {
-                self.baro.publish(to_ipc::raw_baro(f, header))?;
-            }
-            Payload::Mag(f) => {
-                self.mag.publish(to_ipc::raw_mag(f, header))?;
-            }
-            Payload::Aux(f) => {
-                self.aux.publish(to_ipc::raw_aux(f, header))?;
-            }
-            Payload::Airspeed(f) => {
-                self.airspeed.publish(to_ipc::raw_airspeed(f, header))?;
+            /// Publishes `frame` on its topic; allocation-free (the payload is built in place).
+            fn publish(&self, frame: &DecodedFrame, rx_ns: u64) -> Result<()> {
+                let header = to_ipc::origin_header(frame, rx_ns);
+                match &frame.payload {
+                    $(Payload::$variant(f) => {
+                        self.$field.publish($convert(f, header))?;
+                    })+
+                }
+                Ok(())
             }
         }
-        Ok(())
-    }
+    };
+}
+
+raw_topics! {
+    Imu => imu: RawImu on RAW_IMU via to_ipc::raw_imu;
+    Baro => baro: RawBaro on RAW_BARO via to_ipc::raw_baro;
+    Mag => mag: RawMag on RAW_MAG via to_ipc::raw_mag;
+    Aux => aux: RawAux on RAW_AUX via to_ipc::raw_aux;
+    Airspeed => airspeed: RawAirspeed on RAW_AIRSPEED via to_ipc::raw_airspeed;
 }
 
 fn millis(d: Duration) -> u64 {

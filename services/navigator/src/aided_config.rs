@@ -2,16 +2,13 @@
 //! ([`crate::NavigatorConfig::aided_config`]): plain values, copied into each run of the
 //! evaluations' parameter searches.
 
-use crate::aiding::airspeed::{AirspeedAiding, AirspeedAidingConfig};
-use crate::aiding::baro::{BaroAiding, BaroAidingConfig};
-use crate::aiding::gnss::GnssAiding;
+use crate::aiding::airspeed::AirspeedAidingConfig;
+use crate::aiding::baro::BaroAidingConfig;
 use crate::aiding::gnss::config::GnssAidingConfig;
-use crate::aiding::mag::MagAiding;
 use crate::aiding::mag_heading::MagAidingConfig;
-use crate::aiding::source::AidingSensor;
-use crate::aiding::sources::AidingSources;
-use crate::aiding::tilt::{TiltAiding, TiltAidingConfig};
-use crate::aiding::zupt::{ZuptAiding, ZuptConfig};
+use crate::aiding::source::{AidingSensor, Bucket};
+use crate::aiding::tilt::TiltAidingConfig;
+use crate::aiding::zupt::ZuptConfig;
 use crate::alignment::AlignConfig;
 use crate::ekf::{AidingSource, EkfNoise};
 use crate::integrity::IntegrityConfig;
@@ -84,27 +81,49 @@ impl AidedConfig {
         on
     }
 
-    /// The settings of every aiding source.
-    fn sensors(&self) -> [&dyn AidingSensor; 6] {
-        [
-            &self.baro,
-            &self.mag,
-            &self.zupt,
-            &self.tilt,
-            &self.gnss,
-            &self.airspeed,
-        ]
+    /// Each bucket's aiding bit in the navigation state, indexed by [`AidingSource`].
+    pub(crate) fn aiding_bits(&self) -> [u32; AidingSource::COUNT] {
+        self.per_bucket(|bucket| bucket.aiding_bit)
     }
 
-    /// Every aiding source, with its settings and nothing kept yet.
-    pub(crate) fn sources(&self) -> AidingSources {
-        AidingSources {
-            baro: BaroAiding::new(self.baro),
-            mag: MagAiding::new(self.mag, self.mag_calibration, self.declination_rad),
-            zupt: ZuptAiding::new(self.zupt),
-            tilt: TiltAiding::new(self.tilt),
-            gnss: GnssAiding::new(self.gnss),
-            airspeed: AirspeedAiding::new(self.airspeed),
+    /// Each bucket's integrity reason when its innovations are inconsistent, indexed by
+    /// [`AidingSource`].
+    pub(crate) fn inconsistency_reasons(&self) -> [u32; AidingSource::COUNT] {
+        self.per_bucket(|bucket| bucket.inconsistent)
+    }
+
+    fn per_bucket(&self, pick: impl Fn(&Bucket) -> u32) -> [u32; AidingSource::COUNT] {
+        let mut bits = [0; AidingSource::COUNT];
+        for sensor in self.sensors() {
+            for bucket in sensor.buckets() {
+                bits[bucket.source as usize] = pick(bucket);
+            }
+        }
+        bits
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::NavigatorConfig;
+
+    #[test]
+    fn every_bucket_is_declared_by_exactly_one_source_with_distinct_bits() {
+        let config = NavigatorConfig::default().aided_config();
+        let mut declared = [0; AidingSource::COUNT];
+        for sensor in config.sensors() {
+            for bucket in sensor.buckets() {
+                declared[bucket.source as usize] += 1;
+            }
+            // The bucket its settings book under is one it declares.
+            assert!(sensor.buckets().iter().any(|b| b.source == sensor.source()));
+        }
+        assert_eq!(declared, [1; AidingSource::COUNT]);
+        let bits = config.aiding_bits();
+        for (i, bit) in bits.iter().enumerate() {
+            assert_eq!(bit.count_ones(), 1);
+            assert!(bits[..i].iter().all(|b| b != bit));
         }
     }
 }

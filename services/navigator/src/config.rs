@@ -219,18 +219,6 @@ impl NavigatorConfig {
                 ConfigError::new(field, value, "must be finite and > 0").within("navigator.ekf")
             );
         }
-        check(
-            "zupt.sigma_mps",
-            self.zupt.sigma_mps,
-            positive,
-            "must be finite and > 0 m/s",
-        )?;
-        check(
-            "zupt.gate",
-            self.zupt.gate,
-            positive,
-            "must be finite and > 0",
-        )?;
         if let Err((field, value)) = self.stance.check() {
             return Err(ConfigError::new(
                 field,
@@ -239,40 +227,8 @@ impl NavigatorConfig {
             )
             .within("navigator.stance"));
         }
-        if let Err((field, value)) = self.baro.check() {
-            return Err(
-                ConfigError::new(field, value, "must be finite and > 0").within("navigator.baro")
-            );
-        }
-        if let Err((field, value)) = self.mag.check() {
-            return Err(ConfigError::new(
-                field,
-                value,
-                "out of range (inflation >= 1, max_rate_hz >= 0, others finite and > 0)",
-            )
-            .within("navigator.mag"));
-        }
-        if let Err((field, value)) = self.gnss.check() {
-            return Err(ConfigError::new(
-                field,
-                value,
-                "out of range (delay_s in [0, 0.5], |lever_arm_m| <= 100, others finite and > 0)",
-            )
-            .within("navigator.gnss"));
-        }
-        if let Err((field, value)) = self.airspeed.check() {
-            return Err(ConfigError::new(
-                field,
-                value,
-                "out of range (|offset_pa| <= 1000, others finite and > 0)",
-            )
-            .within("navigator.airspeed"));
-        }
-        if let Err((field, value)) = self.tilt.check() {
-            return Err(
-                ConfigError::new(field, value, "must be finite and > 0 (the gains >= 0)")
-                    .within("navigator.tilt"),
-            );
+        for sensor in self.aided_config().sensors() {
+            sensor.validate()?;
         }
         if let Err((field, value)) = self.integrity.check() {
             return Err(ConfigError::new(

@@ -87,7 +87,11 @@ impl AidedNavigator {
     }
 
     fn integrity_monitor(config: &AidedConfig) -> IntegrityMonitor {
-        let mut monitor = IntegrityMonitor::new(config.integrity, config.configured_sources());
+        let mut monitor = IntegrityMonitor::new(
+            config.integrity,
+            config.configured_sources(),
+            config.inconsistency_reasons(),
+        );
         monitor.set_position_unknown(!config.origin_known);
         monitor
     }

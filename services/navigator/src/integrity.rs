@@ -53,6 +53,9 @@ pub struct IntegrityMonitor {
     recovery_us: u64,
     /// Sources the profile uses (index [`AidingSource`]).
     configured: [bool; AidingSource::COUNT],
+    /// The reason bit of each source whose innovations are inconsistent (index
+    /// [`AidingSource`]).
+    inconsistency_reasons: [u32; AidingSource::COUNT],
     sources: [SourceRecord; AidingSource::COUNT],
     /// Newest device time seen on any IMU sample, µs.
     latest_us: u64,
@@ -77,14 +80,20 @@ pub struct IntegrityMonitor {
 }
 
 impl IntegrityMonitor {
-    /// A monitor for a profile that uses the sources marked in `configured`.
-    pub fn new(config: IntegrityConfig, configured: [bool; AidingSource::COUNT]) -> Self {
+    /// A monitor for a profile that uses the sources marked in `configured`, each raising its
+    /// reason of `inconsistency_reasons` when its innovations are inconsistent.
+    pub fn new(
+        config: IntegrityConfig,
+        configured: [bool; AidingSource::COUNT],
+        inconsistency_reasons: [u32; AidingSource::COUNT],
+    ) -> Self {
         Self {
             config,
             outage_us: micros(config.imu_outage_s),
             persist_us: micros(config.rejection_persist_s),
             recovery_us: micros(config.recovery_s),
             configured,
+            inconsistency_reasons,
             sources: [SourceRecord::default(); AidingSource::COUNT],
             latest_us: 0,
             outage_since_us: None,
@@ -277,7 +286,7 @@ impl IntegrityMonitor {
             let full = r.len >= c.nis_window as usize && source != AidingSource::Zupt;
             let high = full && r.mean_nis().is_some_and(|m| m > c.nis_limit);
             if r.rejected_run >= MIN_REJECTED_RUN || high {
-                degraded |= inconsistency_bit(source);
+                degraded |= self.inconsistency_reasons[i];
             }
         }
         if reporting > 0 && rejected == reporting {
@@ -354,17 +363,4 @@ pub fn attitude_sigma_rad(ekf: &ErrorStateEkf) -> f64 {
         return f64::NAN;
     }
     sigmas.into_iter().fold(0.0, f64::max)
-}
-
-/// The reason bit of an inconsistent source.
-fn inconsistency_bit(source: AidingSource) -> u32 {
-    match source {
-        AidingSource::Baro => why::BARO_INCONSISTENT,
-        AidingSource::Mag => why::MAG_INCONSISTENT,
-        AidingSource::Zupt | AidingSource::Hupt => why::ZUPT_INCONSISTENT,
-        // Never configured: it only acts while the attitude is recovered.
-        AidingSource::Gravity => 0,
-        AidingSource::Gnss => why::GNSS_INCONSISTENT,
-        AidingSource::Airspeed => why::AIRSPEED_INCONSISTENT,
-    }
 }

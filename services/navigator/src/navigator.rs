@@ -106,17 +106,6 @@ fn saturate_u32(n: u64) -> u32 {
     u32::try_from(n).unwrap_or(u32::MAX)
 }
 
-/// Aiding bit of each source.
-const SOURCE_BITS: [(AidingSource, u32); AidingSource::COUNT] = [
-    (AidingSource::Baro, aiding::BARO),
-    (AidingSource::Mag, aiding::MAG),
-    (AidingSource::Zupt, aiding::ZUPT),
-    (AidingSource::Hupt, aiding::HUPT),
-    (AidingSource::Gravity, aiding::GRAVITY),
-    (AidingSource::Gnss, aiding::GNSS),
-    (AidingSource::Airspeed, aiding::AIRSPEED),
-];
-
 /// The navigator of the process. Allocation-free per sample once aligned.
 #[derive(Debug, Clone)]
 pub struct Navigator {
@@ -359,12 +348,13 @@ impl Navigator {
         if let Some(ekf) = ekf {
             let b = ekf.bias();
             (gyro_bias_rps, accel_bias_mps2) = (b.gyro_rps.into(), b.accel_mps2.into());
-            for (source, bit) in SOURCE_BITS {
+            let bits = self.core.config().aiding_bits();
+            for source in AidingSource::ALL {
                 let recent = self.core.last_accepted_us(source).is_some_and(|t| {
                     self.state_time_us <= t.saturating_add(self.aiding_timeout_us)
                 });
                 if recent {
-                    aiding_bits |= bit;
+                    aiding_bits |= bits[source as usize];
                 }
                 counts[source as usize] = ekf.counts(source);
             }

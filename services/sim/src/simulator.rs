@@ -1,17 +1,17 @@
 //! The simulator: one call per IMU period fills the frames the sensor block would send.
 //!
-//! The base tick is the IMU period. Barometer, magnetometer, auxiliary and airspeed frames are
-//! emitted on the
-//! ticks where `⌊k·rate/imu_rate⌋` advances (and on tick 0), so any rate up to the IMU rate works
-//! without drift and without requiring an integer ratio.
+//! The base tick is the IMU period. The slower sensors' frames ([`crate::slow_sensors`]:
+//! barometer, magnetometer, auxiliary, airspeed) are emitted on the ticks where
+//! `⌊k·rate/imu_rate⌋` advances (and on tick 0), so any rate up to the IMU rate works without
+//! drift and without requiring an integer ratio.
 
-use rins_protocol::{AirspeedFrame, AuxFrame, BaroFrame, Frame, ImuFrame, MagFrame, Payload};
+use rins_protocol::{Frame, FrameType, ImuFrame, Payload};
 
 use crate::config::SimConfig;
 use crate::error::SimError;
 use crate::sensor_model::SensorModel;
-use crate::sensor_model::airspeed::AirspeedModel;
 use crate::sensor_model::fault::{ChannelFault, InertialSensor};
+use crate::slow_sensors::{SampleAt, SlowSensor, slow_sensors};
 use crate::trajectory::Trajectory;
 
 /// Ground truth published alongside each IMU frame.
@@ -64,6 +64,30 @@ pub struct TickOutput {
     pub truth: TruthSample,
 }
 
+impl TickOutput {
+    /// Where a frame of type `frame` goes; `None` for the IMU's, filled every tick.
+    fn slot_mut(&mut self, frame: FrameType) -> Option<&mut Option<Frame>> {
+        match frame {
+            FrameType::Imu => None,
+            FrameType::Baro => Some(&mut self.baro),
+            FrameType::Mag => Some(&mut self.mag),
+            FrameType::Aux => Some(&mut self.aux),
+            FrameType::Airspeed => Some(&mut self.airspeed),
+        }
+    }
+
+    /// The frames of the tick in frame-type order, `None` where none fell due.
+    pub fn frames(&self) -> [Option<&Frame>; FrameType::COUNT] {
+        FrameType::ALL.map(|t| match t {
+            FrameType::Imu => Some(&self.imu),
+            FrameType::Baro => self.baro.as_ref(),
+            FrameType::Mag => self.mag.as_ref(),
+            FrameType::Aux => self.aux.as_ref(),
+            FrameType::Airspeed => self.airspeed.as_ref(),
+        })
+    }
+}
+
 impl Default for TickOutput {
     fn default() -> Self {
         Self {
@@ -81,35 +105,34 @@ impl Default for TickOutput {
     }
 }
 
-/// Per-frame-type sequence counters, in [`rins_protocol::FrameType`] index order.
-#[derive(Debug, Clone, Copy, Default)]
-struct Sequences {
-    imu: u16,
-    baro: u16,
-    mag: u16,
-    aux: u16,
-    airspeed: u16,
-}
-
 fn next(seq: &mut u16) -> u16 {
     let s = *seq;
     *seq = seq.wrapping_add(1);
     s
 }
 
+/// Whether a frame at `rate_hz` falls due on IMU tick `k` of `imu_rate_hz`.
+fn due(k: u64, rate_hz: f64, imu_rate_hz: f64) -> bool {
+    if k == 0 {
+        return true;
+    }
+    // Multiply before dividing: with integer rates both products are exact integers and the
+    // quotient is exact whenever it is whole, so frames land exactly on schedule.
+    let index = |k: u64| (k as f64 * rate_hz / imu_rate_hz).floor();
+    index(k) != index(k - 1)
+}
+
 /// The device simulator: truth trajectory plus sensor models, advanced one IMU period per step.
 #[derive(Debug, Clone)]
 pub struct Simulator {
     imu_rate_hz: f64,
-    baro_rate_hz: f64,
-    mag_rate_hz: f64,
-    aux_rate_hz: f64,
     trajectory: Trajectory,
     sensors: SensorModel,
-    /// The pitot sensor, when `[sim.airspeed]` fits one.
-    airspeed: Option<AirspeedModel>,
+    /// The sensors sampled slower than the IMU that the configuration fits.
+    slow: Vec<Box<dyn SlowSensor>>,
     tick: u64,
-    seq: Sequences,
+    /// Per-frame-type sequence counters, in [`FrameType`] index order.
+    seq: [u16; FrameType::COUNT],
 }
 
 impl Simulator {
@@ -132,17 +155,11 @@ impl Simulator {
         )?;
         Ok(Self {
             imu_rate_hz: config.imu_rate_hz,
-            baro_rate_hz: config.baro_rate_hz,
-            mag_rate_hz: config.mag_rate_hz,
-            aux_rate_hz: config.aux_rate_hz,
             trajectory: Trajectory::new(config.scenario, config.trajectory_start()),
             sensors,
-            airspeed: config
-                .airspeed
-                .enabled
-                .then(|| AirspeedModel::new(config.airspeed, config.qnh_pa, seed)),
+            slow: slow_sensors(config, seed),
             tick: 0,
-            seq: Sequences::default(),
+            seq: [0; FrameType::COUNT],
         })
     }
 
@@ -188,17 +205,6 @@ impl Simulator {
         self.sensors.set_fault(sensor, channel, None, now)
     }
 
-    fn due(&self, rate_hz: f64) -> bool {
-        let k = self.tick;
-        if k == 0 {
-            return true;
-        }
-        // Multiply before dividing: with integer rates both products are exact integers and the
-        // quotient is exact whenever it is whole, so frames land exactly on schedule.
-        let index = |k: u64| (k as f64 * rate_hz / self.imu_rate_hz).floor();
-        index(k) != index(k - 1)
-    }
-
     /// Advances one IMU period and fills `out`; allocation-free.
     pub fn step(&mut self, out: &mut TickOutput) {
         let t = self.time_s();
@@ -210,59 +216,35 @@ impl Simulator {
         let mut imu = ImuFrame::default();
         self.sensors.imu(&truth, &mut imu);
         out.imu = Frame {
-            seq: next(&mut self.seq.imu),
+            seq: next(&mut self.seq[FrameType::Imu.index()]),
             device_time_us,
             payload: Payload::Imu(imu),
         };
 
-        out.baro = if self.due(self.baro_rate_hz) {
-            let mut baro = BaroFrame::default();
-            self.sensors.baro(truth.altitude_m, &mut baro);
-            Some(Frame {
-                seq: next(&mut self.seq.baro),
-                device_time_us,
-                payload: Payload::Baro(baro),
-            })
-        } else {
-            None
-        };
-        out.mag = if self.due(self.mag_rate_hz) {
-            let mut mag = MagFrame::default();
-            self.sensors.mag(&truth.attitude, &mut mag);
-            Some(Frame {
-                seq: next(&mut self.seq.mag),
-                device_time_us,
-                payload: Payload::Mag(mag),
-            })
-        } else {
-            None
-        };
-        out.aux = if self.due(self.aux_rate_hz) {
-            let mut aux = AuxFrame::default();
-            self.sensors.foot_pressure(truth.foot_load, &mut aux);
-            Some(Frame {
-                seq: next(&mut self.seq.aux),
-                device_time_us,
-                payload: Payload::Aux(aux),
-            })
-        } else {
-            None
-        };
-
-        let airspeed_due = self.airspeed.as_ref().map(|m| self.due(m.rate_hz()));
-        out.airspeed = match (&mut self.airspeed, airspeed_due) {
-            (Some(model), Some(true)) => {
-                let mut airspeed = AirspeedFrame::default();
-                let wind_n = self.trajectory.wind_n(t);
-                model.sample(&truth.velocity_n, &wind_n, truth.altitude_m, &mut airspeed);
-                Some(Frame {
-                    seq: next(&mut self.seq.airspeed),
-                    device_time_us,
-                    payload: Payload::Airspeed(airspeed),
-                })
+        for frame in FrameType::ALL {
+            if let Some(slot) = out.slot_mut(frame) {
+                *slot = None;
             }
-            _ => None,
+        }
+        let at = SampleAt {
+            t_s: t,
+            truth: &truth,
+            trajectory: &self.trajectory,
         };
+        for sensor in &mut self.slow {
+            if !due(self.tick, sensor.rate_hz(), self.imu_rate_hz) {
+                continue;
+            }
+            let payload = sensor.sample(&at, &mut self.sensors);
+            let frame = payload.frame_type();
+            if let Some(slot) = out.slot_mut(frame) {
+                *slot = Some(Frame {
+                    seq: next(&mut self.seq[frame.index()]),
+                    device_time_us,
+                    payload,
+                });
+            }
+        }
 
         let q = truth.attitude.quaternion();
         out.truth = TruthSample {

@@ -4,7 +4,7 @@
 //! receiver's bytes on its own.
 
 use ipc_types::{FaultApplied, Header, Health, PAYLOAD_VERSION, SimControl, Truth, names};
-use rins_protocol::{Frame, MAX_FRAME_LEN, encode};
+use rins_protocol::{FrameType, MAX_FRAME_LEN, encode};
 use rins_runtime::ipc::{IpcError, IpcNode, TopicPublisher, TopicSubscriber};
 use rins_runtime::paced_loop::PacedSource;
 
@@ -13,8 +13,8 @@ use crate::fault_command::WhiteNoise;
 use crate::fault_schedule::{FaultSchedule, ScheduledFault};
 use crate::simulator::{Simulator, TickOutput, TruthSample};
 
-/// Frames of one tick at most: IMU, baro, mag, aux, airspeed.
-const FRAMES_PER_TICK: usize = 5;
+/// Frames of one tick at most: one of each frame type.
+const FRAMES_PER_TICK: usize = FrameType::COUNT;
 
 /// The simulated device streaming: the simulator, its lines and the topics of its process.
 pub(crate) struct Streaming<'a> {
@@ -118,16 +118,10 @@ pub fn truth_message(t: &TruthSample) -> Truth {
 
 /// Encodes the frames of one tick into `buf`, returning the byte count.
 fn encode_tick(out: &TickOutput, buf: &mut [u8]) -> usize {
-    let frames: [Option<&Frame>; FRAMES_PER_TICK] = [
-        Some(&out.imu),
-        out.baro.as_ref(),
-        out.mag.as_ref(),
-        out.aux.as_ref(),
-        out.airspeed.as_ref(),
-    ];
     let mut len = 0;
-    for frame in frames.into_iter().flatten() {
-        // The simulator only produces valid frames, and the buffer holds five of the largest.
+    for frame in out.frames().into_iter().flatten() {
+        // The simulator only produces valid frames, and the buffer holds one of the largest per
+        // frame type.
         if let Ok(n) = encode(frame, &mut buf[len..]) {
             len += n;
         }

@@ -1,10 +1,8 @@
 //! The layout of every payload and nested struct, declared with `layout!`.
 
-use ipc_types::{
-    Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, GnssFix, Header, Health,
-    HealthReport, LinkReport, NavReport, NavState, RawAirspeed, RawAux, RawBaro, RawImu, RawMag,
-    RedundancyReport, ServiceHealth, SimControl, Truth,
-};
+// Every payload is described here: all of them are in scope, so a new one is its `layout!` entry
+// alone.
+use ipc_types::*;
 
 use super::description::{FieldKind, StructLayout};
 use super::field_type::{FieldType, field_of, layout};

@@ -1,24 +1,20 @@
 //! The table of top-level payloads, in the order of the topic table: the list itself, the
 //! largest payload size, and the lookup by type name.
 
-use ipc_types::{
-    Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, GnssFix, Health, HealthReport,
-    NavState, RawAirspeed, RawAux, RawBaro, RawImu, RawMag, SimControl, Truth,
-};
-
 use super::description::StructLayout;
 use super::field_type::layout_of;
 
-/// Lists every payload of the topic table, in its order.
+/// Lists every payload of the topic table, in its order; each is named from the table, so a new
+/// payload needs no line here.
 macro_rules! payload_lists {
     ($($payload:ident ($kind:ident) { $($topics:tt)* })+) => {
         /// Every top-level payload (each starts with `version`); the nested structs are reached
         /// through their fields.
-        pub static PAYLOADS: [&StructLayout; PAYLOAD_COUNT] = [$(layout_of::<$payload>()),+];
+        pub static PAYLOADS: [&StructLayout; PAYLOAD_COUNT] = [$(layout_of::<ipc_types::$payload>()),+];
 
         // A constant cannot read a static's fields, so the sizes are listed again from the types;
         // a test checks the list against `PAYLOADS`.
-        pub(super) const PAYLOAD_SIZES: [usize; PAYLOAD_COUNT] = [$(size_of::<$payload>()),+];
+        pub(super) const PAYLOAD_SIZES: [usize; PAYLOAD_COUNT] = [$(size_of::<ipc_types::$payload>()),+];
 
         const PAYLOAD_COUNT: usize = [$(stringify!($payload)),+].len();
     };

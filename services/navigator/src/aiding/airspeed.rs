@@ -13,12 +13,14 @@
 //! Readings arrive on their own topic, like the barometer's, and are applied to the filter's
 //! current state; one further than `max_lag_s` from the navigation time is dropped.
 
+use ipc_types::{aiding, integrity_reason as why};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector1, Vector3};
+use rins_runtime::config_error::ConfigError;
 use serde::{Deserialize, Serialize};
 
 use crate::aiding::context::AidingContext;
 use crate::aiding::outcome::AidingOutcome;
-use crate::aiding::source::AidingSensor;
+use crate::aiding::source::{AidingSensor, Bucket};
 use crate::checks::positive;
 use crate::ekf::{ATT, AidingSource, Linearised, STATES, VEL};
 
@@ -85,12 +87,31 @@ impl AidingSensor for AirspeedAidingConfig {
         AidingSource::Airspeed
     }
 
+    fn buckets(&self) -> &'static [Bucket] {
+        &[Bucket {
+            source: AidingSource::Airspeed,
+            aiding_bit: aiding::AIRSPEED,
+            inconsistent: why::AIRSPEED_INCONSISTENT,
+        }]
+    }
+
     fn enabled(&self) -> bool {
         self.enabled
     }
 
     fn watched_for_staleness(&self) -> bool {
         true
+    }
+
+    fn validate(&self) -> Result<(), ConfigError> {
+        self.check().map_err(|(field, value)| {
+            ConfigError::new(
+                field,
+                value,
+                "out of range (|offset_pa| <= 1000, others finite and > 0)",
+            )
+            .within("navigator.airspeed")
+        })
     }
 }
 

@@ -4,11 +4,13 @@
 //! rather than applied to the wrong epoch. The first valid reading is the altitude navigation
 //! starts from.
 
+use ipc_types::{aiding, integrity_reason as why};
+use rins_runtime::config_error::ConfigError;
 use serde::{Deserialize, Serialize};
 
 use crate::aiding::context::AidingContext;
 use crate::aiding::outcome::AidingOutcome;
-use crate::aiding::source::AidingSensor;
+use crate::aiding::source::{AidingSensor, Bucket};
 use crate::checks::positive;
 use crate::ekf::{AidingSource, POS, VEL};
 
@@ -63,12 +65,26 @@ impl AidingSensor for BaroAidingConfig {
         AidingSource::Baro
     }
 
+    fn buckets(&self) -> &'static [Bucket] {
+        &[Bucket {
+            source: AidingSource::Baro,
+            aiding_bit: aiding::BARO,
+            inconsistent: why::BARO_INCONSISTENT,
+        }]
+    }
+
     fn enabled(&self) -> bool {
         self.enabled
     }
 
     fn watched_for_staleness(&self) -> bool {
         true
+    }
+
+    fn validate(&self) -> Result<(), ConfigError> {
+        self.check().map_err(|(field, value)| {
+            ConfigError::new(field, value, "must be finite and > 0").within("navigator.baro")
+        })
     }
 }
 

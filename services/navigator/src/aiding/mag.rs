@@ -3,14 +3,16 @@
 //! update, HUPT, when `stance_only`). The measurement model and its adaptive noise are in
 //! [`crate::aiding::mag_heading`].
 
+use ipc_types::{aiding, integrity_reason as why};
 use nalgebra::Vector3;
+use rins_runtime::config_error::ConfigError;
 
 use crate::aiding::context::AidingContext;
 use crate::aiding::mag_heading::{
     FieldReference, MagAidingConfig, adaptive_sigma, measured_heading,
 };
 use crate::aiding::outcome::AidingOutcome;
-use crate::aiding::source::AidingSensor;
+use crate::aiding::source::{AidingSensor, Bucket};
 use crate::alignment::Alignment;
 use crate::attitude::{rotation_vector_to_quaternion, wrap_pi};
 use crate::ekf::{ATT, AidingSource};
@@ -26,6 +28,22 @@ impl AidingSensor for MagAidingConfig {
         }
     }
 
+    /// A stance heading that disagrees is reported as the stance updates' inconsistency.
+    fn buckets(&self) -> &'static [Bucket] {
+        &[
+            Bucket {
+                source: AidingSource::Mag,
+                aiding_bit: aiding::MAG,
+                inconsistent: why::MAG_INCONSISTENT,
+            },
+            Bucket {
+                source: AidingSource::Hupt,
+                aiding_bit: aiding::HUPT,
+                inconsistent: why::ZUPT_INCONSISTENT,
+            },
+        ]
+    }
+
     fn enabled(&self) -> bool {
         self.enabled
     }
@@ -34,6 +52,17 @@ impl AidingSensor for MagAidingConfig {
     /// the gait, not an outage.
     fn watched_for_staleness(&self) -> bool {
         !self.stance_only
+    }
+
+    fn validate(&self) -> Result<(), ConfigError> {
+        self.check().map_err(|(field, value)| {
+            ConfigError::new(
+                field,
+                value,
+                "out of range (inflation >= 1, max_rate_hz >= 0, others finite and > 0)",
+            )
+            .within("navigator.mag")
+        })
     }
 }
 

@@ -8,11 +8,15 @@
 //! [`hold::Hold`] for their place in the IMU stream.
 //!
 //! Adding a source: one file here with its settings (a `[navigator.<source>]` section that
-//! implements `AidingSensor`, `source.rs`), its state, and its update taking an `AidingContext`;
-//! then one line in each list of [`crate::aided_config::AidedConfig`] (`sensors()` and
-//! `sources()`, beside its settings field, also in [`crate::NavigatorConfig`]), a field in
-//! `AidingSources` (`sources.rs`), the core's entry point that hands it its readings, and the
-//! service's subscription to its topic.
+//! implements `AidingSensor`, `source.rs`: its bucket with its aiding bit and inconsistency
+//! reason, and the check of its settings), its state, and its update taking an `AidingContext`;
+//! then its `AidingSource` bucket ([`crate::ekf::AidingSource`]), one line in `aiding_sources!`
+//! (`sources.rs`, which makes its field of `AidingSources` and its places in
+//! [`crate::aided_config::AidedConfig`]'s `sensors()` and `sources()`), its settings field in
+//! `AidedConfig` and in [`crate::NavigatorConfig`] (with its default and its copy into
+//! `AidedConfig`), and, for readings on a topic of their own, the core's entry point that hands
+//! it its readings, their place in the hold queue (`readings.rs`) and the service's subscription
+//! to its topic.
 
 pub mod airspeed;
 pub mod baro;

@@ -126,6 +126,7 @@ mod tests {
         let mut integrity = IntegrityMonitor::new(
             crate::integrity::IntegrityConfig::default(),
             [true; AidingSource::COUNT],
+            [0; AidingSource::COUNT],
         );
         let gated = UpdateOutcome::Rejected { d2: 100.0 };
         r.book_update(&mut integrity, AidingSource::Baro, 10, gated, 1);

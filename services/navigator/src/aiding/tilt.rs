@@ -15,11 +15,13 @@
 //!
 //! One update per window of `window_s`; allocation-free.
 
+use ipc_types::aiding;
 use nalgebra::Vector3;
+use rins_runtime::config_error::ConfigError;
 use serde::{Deserialize, Serialize};
 
 use crate::aiding::context::AidingContext;
-use crate::aiding::source::AidingSensor;
+use crate::aiding::source::{AidingSensor, Bucket};
 use crate::ekf::{AidingSource, ErrorStateEkf, UpdateOutcome};
 use crate::force_window::ForceWindow;
 
@@ -130,6 +132,17 @@ impl AidingSensor for TiltAidingConfig {
         AidingSource::Gravity
     }
 
+    /// The bucket is shared with the attitude recovery, which books there whatever the profile.
+    /// It is never judged by the integrity monitor (see `judged_by_integrity`), so it has no
+    /// inconsistency reason.
+    fn buckets(&self) -> &'static [Bucket] {
+        &[Bucket {
+            source: AidingSource::Gravity,
+            aiding_bit: aiding::GRAVITY,
+            inconsistent: 0,
+        }]
+    }
+
     fn enabled(&self) -> bool {
         self.enabled
     }
@@ -144,6 +157,13 @@ impl AidingSensor for TiltAidingConfig {
     /// not a fault of the solution.
     fn judged_by_integrity(&self) -> bool {
         false
+    }
+
+    fn validate(&self) -> Result<(), ConfigError> {
+        self.check().map_err(|(field, value)| {
+            ConfigError::new(field, value, "must be finite and > 0 (the gains >= 0)")
+                .within("navigator.tilt")
+        })
     }
 }
 

@@ -1,10 +1,13 @@
 //! The zero-velocity update as an aiding source: a pseudo-measurement of zero velocity, applied
 //! whenever the stance detector fires (`[navigator.stance]`).
 
+use ipc_types::{aiding, integrity_reason as why};
+use rins_runtime::config_error::ConfigError;
 use serde::{Deserialize, Serialize};
 
 use crate::aiding::context::AidingContext;
-use crate::aiding::source::AidingSensor;
+use crate::aiding::source::{AidingSensor, Bucket};
+use crate::checks::check_in;
 use crate::ekf::{AidingSource, UpdateOutcome};
 
 /// Settings of the zero-velocity aiding (`[navigator.zupt]`).
@@ -34,6 +37,14 @@ impl AidingSensor for ZuptConfig {
         AidingSource::Zupt
     }
 
+    fn buckets(&self) -> &'static [Bucket] {
+        &[Bucket {
+            source: AidingSource::Zupt,
+            aiding_bit: aiding::ZUPT,
+            inconsistent: why::ZUPT_INCONSISTENT,
+        }]
+    }
+
     fn enabled(&self) -> bool {
         self.enabled
     }
@@ -41,6 +52,25 @@ impl AidingSensor for ZuptConfig {
     /// A pseudo-measurement made from the IMU samples: it has no stream of its own to go quiet.
     fn watched_for_staleness(&self) -> bool {
         false
+    }
+
+    /// Its keys are named as `zupt.<key>` of `[navigator]`.
+    fn validate(&self) -> Result<(), ConfigError> {
+        let positive = |x: f64| x > 0.0;
+        check_in(
+            "navigator",
+            "zupt.sigma_mps",
+            self.sigma_mps,
+            positive,
+            "must be finite and > 0 m/s",
+        )?;
+        check_in(
+            "navigator",
+            "zupt.gate",
+            self.gate,
+            positive,
+            "must be finite and > 0",
+        )
     }
 }
 

@@ -11,13 +11,15 @@ use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
-use rins_protocol::AirspeedFrame;
 use rins_protocol::layout::AIRSPEED_MAX_ABS_PA;
+use rins_protocol::{AirspeedFrame, Payload};
 use serde::{Deserialize, Serialize};
 
 use super::baro::isa_temperature_k;
 use super::temperature::to_centi_c;
 use crate::error::{SimError, check_range};
+use crate::sensor_model::SensorModel;
+use crate::slow_sensors::{SampleAt, SlowSensor};
 
 /// The random stream of the airspeed noise, after those of the other sensors (0..=5).
 const AIRSPEED_STREAM: u64 = 6;
@@ -124,6 +126,25 @@ impl AirspeedModel {
         let reading = self.expected_pa(&(velocity_n - wind_n), altitude_m) + noise;
         out.diff_pressure_pa = reading.clamp(-full_scale, full_scale) as f32;
         out.temperature_centi_c = to_centi_c(isa_temperature_k(altitude_m) - 273.15);
+    }
+}
+
+impl SlowSensor for AirspeedModel {
+    fn rate_hz(&self) -> f64 {
+        self.config.rate_hz
+    }
+
+    fn sample(&mut self, at: &SampleAt<'_>, _: &mut SensorModel) -> Payload {
+        let mut frame = AirspeedFrame::default();
+        let wind_n = at.trajectory.wind_n(at.t_s);
+        AirspeedModel::sample(
+            self,
+            &at.truth.velocity_n,
+            &wind_n,
+            at.truth.altitude_m,
+            &mut frame,
+        );
+        Payload::Airspeed(frame)
     }
 }
 
