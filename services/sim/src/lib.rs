@@ -23,6 +23,7 @@ pub mod serial_line;
 pub mod service;
 pub mod sim_command;
 pub mod simulator;
+mod slow_sensor;
 mod slow_sensors;
 mod streaming;
 pub mod trajectory;

@@ -11,7 +11,8 @@ use crate::config::SimConfig;
 use crate::error::SimError;
 use crate::sensor_model::SensorModel;
 use crate::sensor_model::fault::{ChannelFault, InertialSensor};
-use crate::slow_sensors::{SampleAt, SlowSensor, slow_sensors};
+use crate::slow_sensor::{SampleAt, SlowSensor};
+use crate::slow_sensors::slow_sensors;
 use crate::trajectory::Trajectory;
 
 /// Ground truth published alongside each IMU frame.

@@ -19,7 +19,7 @@ use super::baro::isa_temperature_k;
 use super::temperature::to_centi_c;
 use crate::error::{SimError, check_range};
 use crate::sensor_model::SensorModel;
-use crate::slow_sensors::{SampleAt, SlowSensor};
+use crate::slow_sensor::{SampleAt, SlowSensor};
 
 /// The random stream of the airspeed noise, after those of the other sensors (0..=5).
 const AIRSPEED_STREAM: u64 = 6;
