@@ -20,6 +20,15 @@ pub use eval_args::{
     FootMethodArg, QuadrotorMode, SweepArgs,
 };
 
+/// The `rins echo` topic help: every short name it accepts, in the topic table's order.
+fn echo_topics_help() -> String {
+    let names: Vec<&str> = ipc_types::names::TOPICS
+        .iter()
+        .map(|(short, _)| *short)
+        .collect();
+    format!("Topic: {}", names.join(", "))
+}
+
 #[derive(Debug, Parser)]
 #[command(
     name = "rins",
@@ -92,8 +101,8 @@ pub enum Command {
     Probe(ProbeArgs),
     /// Print every sample of a topic.
     Echo {
-        /// Topic: raw-imu, raw-baro, raw-mag, raw-aux, raw-airspeed, gnss, fused-imu, altitude, nav,
-        /// truth, heartbeat, health.
+        /// Short name of the topic (the help lists them from the topic table).
+        #[arg(help = echo_topics_help())]
         topic: String,
         /// Stop after this many samples.
         #[arg(long)]
@@ -501,6 +510,23 @@ mod tests {
         }
         Cli::command().debug_assert();
         check(&Cli::command(), "rins");
+    }
+
+    #[test]
+    fn the_echo_help_names_every_topic_echo_shows() {
+        let cli = Cli::command();
+        let echo = cli.find_subcommand("echo").expect("`rins echo`");
+        let topic = echo
+            .get_arguments()
+            .find(|a| a.get_id() == "topic")
+            .expect("the topic argument");
+        let help = topic
+            .get_help()
+            .map(ToString::to_string)
+            .unwrap_or_default();
+        let listed: Vec<&str> = help.trim_start_matches("Topic: ").split(", ").collect();
+        let shorts: Vec<&str> = ipc_types::names::TOPICS.iter().map(|(s, _)| *s).collect();
+        assert_eq!(listed, shorts, "{help}");
     }
 
     #[test]

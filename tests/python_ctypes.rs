@@ -137,20 +137,15 @@ fn flag_tables() -> [(&'static str, &'static str, BitNames); 6] {
 
 /// Every topic of the topic table, as the Python constant it becomes: the Rust constant's name.
 macro_rules! topic_constants {
-    ($($payload:ident ($kind:ident) { $(
-        $(#[$meta:meta])*
-        $constant:ident = $topic:literal
-            $(, echo $echo:literal)?
-            $(, record $short:literal at $rank:literal)?;
-    )+ })+) => {
-        vec![$($((stringify!($constant), names::$constant)),+),+]
+    ($($(#[$doc:meta])* $constant:ident $topic:literal $payload:ident $kind:ident;)+) => {
+        vec![$((stringify!($constant), names::$constant)),+]
     };
 }
 
 /// The Python topic constants in the module's order: the table's, except that the simulator's
 /// commands come before its answers (the reverse of the payload order) as they always have.
 fn topic_constants() -> Vec<(&'static str, &'static str)> {
-    let mut constants = ipc_types::for_each_topic!(topic_constants);
+    let mut constants = ipc_types::for_each_topic!(topics => topic_constants);
     let answer = constants
         .iter()
         .position(|(c, _)| *c == "SIM_FAULT_APPLIED");

@@ -4,7 +4,7 @@
 use iceoryx2::prelude::ZeroCopySend;
 use serde::Serialize;
 
-use crate::{ChannelState, FaultReason, MAX_CHANNELS};
+use crate::{FusedImu, MAX_CHANNELS};
 
 wire_enum! {
     /// Which process a [`Health`] message speaks for; the name is the process's service name.
@@ -250,19 +250,22 @@ pub struct RedundancyReport {
 }
 
 impl Default for RedundancyReport {
+    /// No fused sample heard: the channels as a default [`FusedImu`] has them (none fitted, every
+    /// one absent, no fault reason, no test statistic).
     fn default() -> Self {
+        let none = FusedImu::default();
         Self {
             heard: 0,
-            n_gyro: 0,
-            n_accel: 0,
+            n_gyro: none.n_gyro,
+            n_accel: none.n_accel,
             _pad: [0; 1],
-            flags: 0,
-            gyro_state: [ChannelState::Absent as u8; MAX_CHANNELS],
-            accel_state: [ChannelState::Absent as u8; MAX_CHANNELS],
-            gyro_reason: [FaultReason::None as u8; MAX_CHANNELS],
-            accel_reason: [FaultReason::None as u8; MAX_CHANNELS],
-            gyro_test_statistic: 0.0,
-            accel_test_statistic: 0.0,
+            flags: none.flags,
+            gyro_state: none.gyro_state,
+            accel_state: none.accel_state,
+            gyro_reason: none.gyro_reason,
+            accel_reason: none.accel_reason,
+            gyro_test_statistic: none.gyro_test_statistic,
+            accel_test_statistic: none.accel_test_statistic,
             age_ms: 0,
             _pad2: [0; 4],
         }

@@ -1,65 +1,30 @@
 //! Service names: each topic's constant, generated from the topic table
 //! ([`crate::for_each_topic!`]), the one place where topics are named.
 
-/// Generates a constant per topic and the list of the short names `rins echo` accepts.
-macro_rules! topic_names {
-    ($(
-        $payload:ident ($kind:ident) {
-            $(
-                $(#[$meta:meta])*
-                $constant:ident = $topic:literal
-                    $(, echo $echo:literal)?
-                    $(, record $short:literal at $rank:literal)?;
-            )+
-        }
-    )+) => {
-        $($(
-            $(#[$meta])*
-            pub const $constant: &str = $topic;
-        )+)+
-
-        /// Every topic with its `rins echo` short name, if it has one, in table order.
-        const ECHO_NAMES: &[(Option<&str>, &str)] = &[$($(
-            (topic_names!(@some $($echo)?), $topic),
-        )+)+];
-    };
-    (@some) => { None };
-    (@some $echo:literal) => { Some($echo) };
+/// A constant per topic, named and documented as in the table.
+macro_rules! topic_constants {
+    ($($(#[$doc:meta])* $constant:ident $topic:literal $payload:ident $kind:ident;)+) => {$(
+        $(#[$doc])*
+        pub const $constant: &str = $topic;
+    )+};
 }
 
-crate::for_each_topic!(topic_names);
+crate::for_each_topic!(topics => topic_constants);
+
+/// The topics `rins echo` shows, by the short name it accepts.
+macro_rules! echo_topics {
+    ($($short:literal $constant:ident $payload:ident $kind:ident;)+) => {
+        /// Every published topic, with the short name `rins echo` accepts, in table order.
+        pub const TOPICS: [(&str, &str); [$($short),+].len()] = [$(($short, $constant)),+];
+    };
+}
+
+crate::for_each_topic!(echo => echo_topics);
 
 /// Output topic of each navigator lane: lane 0 (primary) publishes on [`NAV_STATE`], so a
 /// single-lane deployment needs nothing else; lane 1 is the hot standby. Consumers that want the
 /// contiguous stream read both through the navigator's lane selector (`rins_navigator::lanes`).
 pub const NAV_LANES: [&str; 2] = [NAV_STATE, NAV_STATE_STANDBY];
-
-const ECHO_COUNT: usize = {
-    let mut n = 0;
-    let mut i = 0;
-    while i < ECHO_NAMES.len() {
-        if ECHO_NAMES[i].0.is_some() {
-            n += 1;
-        }
-        i += 1;
-    }
-    n
-};
-
-/// Every published topic, with the short name `rins echo` accepts.
-pub const TOPICS: [(&str, &str); ECHO_COUNT] = {
-    let mut out = [("", ""); ECHO_COUNT];
-    let mut n = 0;
-    let mut i = 0;
-    while i < ECHO_NAMES.len() {
-        if let (Some(short), topic) = ECHO_NAMES[i] {
-            out[n] = (short, topic);
-            n += 1;
-        }
-        i += 1;
-    }
-    out
-};
 
 #[cfg(test)]
 mod tests {

@@ -112,21 +112,82 @@ pub mod integrity_reason {
 /// within the aiding timeout (never while the solution is invalid); the `_STALE` bits say that a
 /// configured source went quiet.
 pub mod aiding {
-    /// Barometric height updates.
-    pub const BARO: u32 = 1 << 0;
-    /// Magnetometer heading updates (also while the heading is still the one the magnetometer
-    /// gave at alignment).
-    pub const MAG: u32 = 1 << 1;
-    /// Zero-velocity updates.
-    pub const ZUPT: u32 = 1 << 2;
-    /// Heading updates during stance (a foot-mounted unit).
-    pub const HUPT: u32 = 1 << 3;
-    /// The tilt is being re-levelled from gravity (after the IMU stopped propagating the attitude).
-    pub const GRAVITY: u32 = 1 << 4;
-    /// GNSS position and velocity updates.
-    pub const GNSS: u32 = 1 << 5;
-    /// Pitot airspeed updates.
-    pub const AIRSPEED: u32 = 1 << 6;
+    /// The aiding sources, one line per source: `Variant = index, BIT => "name";` makes the
+    /// [`AidingSourceId`] `Variant` of index `index` (its slot in the per-source counts of
+    /// [`NavState`](crate::NavState)), its bit `BIT = 1 << index` and its name in
+    /// [`SOURCE_NAMES`]. A new source goes last, with a new payload layout.
+    macro_rules! aiding_sources {
+        ($($(#[$doc:meta])* $variant:ident = $index:literal, $bit:ident => $name:literal;)+) => {
+            $($(#[$doc])* pub const $bit: u32 = 1 << $index;)+
+
+            /// An aiding source of the navigator: the bucket its updates are counted in.
+            #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+            #[repr(u8)]
+            pub enum AidingSourceId {
+                $($(#[$doc])* $variant = $index,)+
+            }
+
+            impl AidingSourceId {
+                /// Number of sources, the length of per-source arrays.
+                pub const COUNT: usize = [$($index),+].len();
+                /// Every source, in index order.
+                pub const ALL: [Self; Self::COUNT] = [$(Self::$variant),+];
+
+                /// Lower-case name for logs and reports.
+                pub const fn name(self) -> &'static str {
+                    match self {
+                        $(Self::$variant => $name,)+
+                    }
+                }
+
+                /// Its bit in [`NavState::aiding`](crate::NavState).
+                pub const fn bit(self) -> u32 {
+                    1 << self as u32
+                }
+            }
+
+            /// Every source with its name, in bit order.
+            pub const SOURCE_NAMES: [(u32, &str); AidingSourceId::COUNT] = [$(($bit, $name)),+];
+        };
+    }
+
+    aiding_sources! {
+        /// Barometric height updates.
+        Baro = 0, BARO => "baro";
+        /// Magnetometer heading updates (also while the heading is still the one the magnetometer
+        /// gave at alignment).
+        Mag = 1, MAG => "mag";
+        /// Zero-velocity updates.
+        Zupt = 2, ZUPT => "zupt";
+        /// Heading updates during stance (a foot-mounted unit).
+        Hupt = 3, HUPT => "hupt";
+        /// The tilt is being re-levelled from gravity (after the IMU stopped propagating the
+        /// attitude).
+        Gravity = 4, GRAVITY => "gravity";
+        /// GNSS position and velocity updates.
+        Gnss = 5, GNSS => "gnss";
+        /// Pitot airspeed updates.
+        Airspeed = 6, AIRSPEED => "airspeed";
+    }
+
+    // Each source is where its list line puts it, with its bit, and no source bit is a stale or
+    // rejected one.
+    const _: () = {
+        let mut k = 0;
+        while k < AidingSourceId::COUNT {
+            assert!(AidingSourceId::ALL[k] as usize == k);
+            assert!(AidingSourceId::ALL[k].bit() == SOURCE_NAMES[k].0);
+            k += 1;
+        }
+        let mut source_bits = 0;
+        let mut k = 0;
+        while k < SOURCE_NAMES.len() {
+            source_bits |= SOURCE_NAMES[k].0;
+            k += 1;
+        }
+        assert!(source_bits & (BARO_STALE | MAG_STALE | GNSS_STALE | GNSS_REJECTED) == 0);
+    };
+
     /// Baro aiding is configured but no reading arrived within the aiding timeout: the altitude
     /// coasts on the inertial solution.
     pub const BARO_STALE: u32 = 1 << 8;
@@ -139,17 +200,6 @@ pub mod aiding {
     /// The GNSS receiver's fixes are rejected as inconsistent with the inertial solution (a jump
     /// or a drift): the position coasts on the inertial solution until they agree again.
     pub const GNSS_REJECTED: u32 = 1 << 11;
-
-    /// Every source with its name, in bit order.
-    pub const SOURCE_NAMES: [(u32, &str); 7] = [
-        (BARO, "baro"),
-        (MAG, "mag"),
-        (ZUPT, "zupt"),
-        (HUPT, "hupt"),
-        (GRAVITY, "gravity"),
-        (GNSS, "gnss"),
-        (AIRSPEED, "airspeed"),
-    ];
 
     /// Every stale-source bit with the source's name.
     pub const STALE_NAMES: [(u32, &str); 3] = [
@@ -171,9 +221,9 @@ pub mod aiding {
 }
 
 /// Aiding sources counted in [`NavState::aiding_accepted`] / [`NavState::aiding_rejected`], in
-/// this order: baro, mag, zupt, hupt, gravity, gnss, airspeed (the navigator's source index; a
-/// new source goes last).
-pub const AIDING_SOURCES: usize = 7;
+/// the index order of [`aiding::AidingSourceId`]: baro, mag, zupt, hupt, gravity, gnss, airspeed
+/// (a new source goes last).
+pub const AIDING_SOURCES: usize = aiding::AidingSourceId::COUNT;
 
 /// Length of [`NavState::covariance_diag`]: attitude error, velocity, position, gyro bias, accel bias.
 pub const NAV_STATES: usize = 15;

@@ -1,12 +1,11 @@
 //! The table of every topic: its name, the payload it carries and how tools reach it. Everything
 //! that lists topics is generated from it: the names in [`crate::names`], the payload layouts and
 //! topic list of a recording, the runtime's payload traits, `rins record`'s choices and help,
-//! `rins echo`'s topics and the Python mirror. Adding a topic is one entry here (plus its payload
-//! struct and that struct's layout).
+//! `rins echo`'s topics, their readable forms and help, and the Python mirror. Adding a topic is
+//! one entry here (plus its payload struct and that struct's layout).
 //!
-//! [`for_each_topic!`](crate::for_each_topic) hands the table to a macro of the caller's, which
-//! generates what that crate needs. The table is grouped by payload, in the order payloads are
-//! listed everywhere (a payload carried on several topics, the navigator lanes, appears once):
+//! The table is grouped by payload, in the order payloads are listed everywhere (a payload
+//! carried on several topics, the navigator lanes, appears once):
 //!
 //! ```text
 //! Payload (stamped | unstamped) {
@@ -21,13 +20,30 @@
 //! - `record "short" at RANK`: `rins record --topics` accepts it by that name; RANK is its place
 //!   in the order a recording's channels are written, which keeps recordings as they have always
 //!   been laid out.
+//!
+//! Readers do not match this grammar: [`for_each_topic!`](crate::for_each_topic) hands a
+//! reader's macro one flat projection of the table, entries ending in `;`, in table order:
+//!
+//! - `payloads`, for each payload: `Payload stamped;` or `Payload unstamped;`
+//! - `topics`, for each topic: its doc, then `CONSTANT "topic/name" Payload kind;`
+//! - `echo`, for each topic with `echo`: `"short" CONSTANT Payload kind;`
+//! - `record`, for each topic with `record`: `RANK "short" CONSTANT Payload kind;` (in table
+//!   order, not in rank order)
+//!
+//! `kind` is `stamped` or `unstamped`, `CONSTANT` the topic's constant in [`crate::names`].
 
-/// Calls `$callback! { table }` with the topic table (see the module documentation for its
-/// grammar); the callback is a `macro_rules!` macro in scope where this is invoked.
+/// Calls `$callback! { entries }` with one projection of the topic table (see the module
+/// documentation for each projection's entries): `for_each_topic!(payloads => callback)`. The
+/// callback is a `macro_rules!` macro in scope where this is invoked. `for_each_topic!(callback)`
+/// hands over the table as written, in its own grammar.
 #[macro_export]
 macro_rules! for_each_topic {
     ($callback:ident) => {
-        $callback! {
+        $crate::for_each_topic!(table => $callback)
+    };
+    ($projection:ident => $callback:ident) => {
+        $crate::__project_topic_table! {
+            $projection $callback
             RawImu (stamped) {
                 /// Raw IMU frames ([`crate::RawImu`]), from acquisition.
                 RAW_IMU = "rins/raw/imu", echo "raw-imu", record "raw-imu" at 0;
@@ -99,6 +115,53 @@ macro_rules! for_each_topic {
                 RAW_AIRSPEED = "rins/raw/airspeed", echo "raw-airspeed",
                     record "raw-airspeed" at 15;
             }
+        }
+    };
+}
+
+/// Projects the topic table for [`for_each_topic!`]: the table's grammar is matched here, and
+/// only here. Every projection is built in one pass, then the one asked for is handed over.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __project_topic_table {
+    (@pick payloads $callback:ident [$($payloads:tt)*] $topics:tt $echo:tt $record:tt) => {
+        $callback! { $($payloads)* }
+    };
+    (@pick topics $callback:ident $payloads:tt [$($topics:tt)*] $echo:tt $record:tt) => {
+        $callback! { $($topics)* }
+    };
+    (@pick echo $callback:ident $payloads:tt $topics:tt [$($echo:tt)*] $record:tt) => {
+        $callback! { $($echo)* }
+    };
+    (@pick record $callback:ident $payloads:tt $topics:tt $echo:tt [$($record:tt)*]) => {
+        $callback! { $($record)* }
+    };
+    (@pick $other:ident $($rest:tt)*) => {
+        compile_error!(concat!(
+            "for_each_topic!: unknown projection `",
+            stringify!($other),
+            "` (payloads, topics, echo, record)"
+        ));
+    };
+    (table $callback:ident $($table:tt)*) => {
+        $callback! { $($table)* }
+    };
+    ($projection:ident $callback:ident $(
+        $payload:ident ($kind:ident) {
+            $(
+                $(#[$meta:meta])*
+                $constant:ident = $topic:literal
+                    $(, echo $echo:literal)?
+                    $(, record $short:literal at $rank:literal)?;
+            )+
+        }
+    )+) => {
+        $crate::__project_topic_table! {
+            @pick $projection $callback
+            [$($payload $kind;)+]
+            [$($($(#[$meta])* $constant $topic $payload $kind;)+)+]
+            [$($($($echo $constant $payload $kind;)?)+)+]
+            [$($($($rank $short $constant $payload $kind;)?)+)+]
         }
     };
 }

@@ -7,23 +7,14 @@ use clap::{Args, Subcommand};
 
 /// The short names the topic table marks as recordable, with their place in a recording.
 macro_rules! record_short_names {
-    ($(
-        $payload:ident ($kind:ident) {
-            $(
-                $(#[$meta:meta])*
-                $constant:ident = $topic:literal
-                    $(, echo $echo:literal)?
-                    $(, record $short:literal at $rank:literal)?;
-            )+
-        }
-    )+) => {
-        [$($($(($rank, $short),)?)+)+]
+    ($($rank:literal $short:literal $constant:ident $payload:ident $kind:ident;)+) => {
+        [$(($rank, $short)),+]
     };
 }
 
 /// The `--topics` help: every recordable topic's short name, in the order a recording holds them.
 fn record_topics_help() -> String {
-    let mut ranked = ipc_types::for_each_topic!(record_short_names);
+    let mut ranked = ipc_types::for_each_topic!(record => record_short_names);
     ranked.sort_by_key(|(rank, _)| *rank);
     let names: Vec<&str> = ranked.iter().map(|(_, short)| *short).collect();
     format!(

@@ -100,53 +100,49 @@ trait ReceivedAt {
     fn received_ns(&self) -> Option<u64>;
 }
 
-/// From the topic table: the receive time of every payload, and the payload `rins echo` shows
-/// for each short name the table gives it (a payload given one must have a [`Readable`] form).
-macro_rules! echo_table {
-    ($(
-        $payload:ident ($kind:ident) {
-            $(
-                $(#[$meta:meta])*
-                $constant:ident = $topic:literal
-                    $(, echo $echo:literal)?
-                    $(, record $short:literal at $rank:literal)?;
-            )+
-        }
-    )+) => {
-        $(echo_table!(@received $kind $payload);)+
-
-        /// Prints the topic whose echo short name is `short`; `None` for a name the table does
-        /// not give.
-        fn echo_by_short_name(short: &str, opts: EchoOptions) -> Option<Result<()>> {
-            match short {
-                $($($(
-                    $echo => Some(echo_topic::<ipc_types::$payload>(names::$constant, opts)),
-                )?)+)+
-                _ => None,
-            }
-        }
-    };
+/// The receive time of every payload of the topic table.
+macro_rules! received_at {
     // Truth comes from the simulator, not from a received frame: no receive time.
-    (@received stamped Truth) => {
-        echo_table!(@received unstamped Truth);
+    (@one Truth stamped) => {
+        received_at!(@one Truth unstamped);
     };
-    (@received stamped $payload:ident) => {
+    (@one $payload:ident stamped) => {
         impl ReceivedAt for ipc_types::$payload {
             fn received_ns(&self) -> Option<u64> {
                 Some(self.header.origin_rx_ns)
             }
         }
     };
-    (@received unstamped $payload:ident) => {
+    (@one $payload:ident unstamped) => {
         impl ReceivedAt for ipc_types::$payload {
             fn received_ns(&self) -> Option<u64> {
                 None
             }
         }
     };
+    ($($payload:ident $kind:ident;)+) => {
+        $(received_at!(@one $payload $kind);)+
+    };
 }
 
-ipc_types::for_each_topic!(echo_table);
+ipc_types::for_each_topic!(payloads => received_at);
+
+/// The payload `rins echo` shows for each short name the topic table gives (every payload has a
+/// [`Readable`] form).
+macro_rules! echo_by_short_name {
+    ($($short:literal $constant:ident $payload:ident $kind:ident;)+) => {
+        /// Prints the topic whose echo short name is `short`; `None` for a name the table does
+        /// not give.
+        fn echo_by_short_name(short: &str, opts: EchoOptions) -> Option<Result<()>> {
+            match short {
+                $($short => Some(echo_topic::<ipc_types::$payload>(names::$constant, opts)),)+
+                _ => None,
+            }
+        }
+    };
+}
+
+ipc_types::for_each_topic!(echo => echo_by_short_name);
 
 /// Prints what `open` yields, a topic or the merged navigation stream. Samples from before the
 /// start (a topic's history, kept for restarted services) are skipped: echo shows what comes.

@@ -288,14 +288,24 @@ impl Readable for HealthReport {
     }
 }
 
-/// Payloads shown in the default readable form.
-macro_rules! plain_readable {
-    ($($t:ident),*) => {
-        $(impl Readable for ipc_types::$t {})*
+/// Every payload of the topic table is [`Readable`]: those with a form of their own, written
+/// above, are named here once; every other one keeps the default form.
+macro_rules! readable {
+    (@one RawImu) => {};
+    (@one FusedImu) => {};
+    (@one NavState) => {};
+    (@one Truth) => {};
+    (@one Health) => {};
+    (@one HealthReport) => {};
+    (@one $payload:ident) => {
+        impl Readable for ipc_types::$payload {}
+    };
+    ($($payload:ident $kind:ident;)+) => {
+        $(readable!(@one $payload);)+
     };
 }
 
-plain_readable!(RawBaro, RawMag, RawAux, RawAirspeed, GnssFix, Altitude);
+ipc_types::for_each_topic!(payloads => readable);
 
 #[cfg(test)]
 mod tests {

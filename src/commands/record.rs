@@ -91,17 +91,14 @@ fn unstamped<T>(_: &T) -> Option<u64> {
 
 /// Every topic the topic table marks as recordable, with its place in the file.
 macro_rules! record_choices {
-    ($(
-        $payload:ident ($kind:ident) {
-            $(
-                $(#[$meta:meta])*
-                $constant:ident = $topic:literal
-                    $(, echo $echo:literal)?
-                    $(, record $short:literal at $rank:literal)?;
-            )+
-        }
-    )+) => {
-        [$($($(
+    (@time stamped $payload:ident) => {
+        stamped::<ipc_types::$payload>
+    };
+    (@time unstamped $payload:ident) => {
+        unstamped::<ipc_types::$payload>
+    };
+    ($($rank:literal $short:literal $constant:ident $payload:ident $kind:ident;)+) => {
+        [$(
             (
                 $rank,
                 TopicChoice {
@@ -114,19 +111,13 @@ macro_rules! record_choices {
                     },
                 },
             ),
-        )?)+)+]
-    };
-    (@time stamped $payload:ident) => {
-        stamped::<ipc_types::$payload>
-    };
-    (@time unstamped $payload:ident) => {
-        unstamped::<ipc_types::$payload>
+        )+]
     };
 }
 
 /// Every topic a recording can hold, in the order they are written to the file.
 fn all_choices() -> Vec<TopicChoice> {
-    let mut ranked = ipc_types::for_each_topic!(record_choices);
+    let mut ranked = ipc_types::for_each_topic!(record => record_choices);
     ranked.sort_by_key(|(rank, _)| *rank);
     ranked.into_iter().map(|(_, choice)| choice).collect()
 }
@@ -391,30 +382,35 @@ pub fn run(args: &crate::cli::RecordArgs) -> Result<()> {
 mod tests {
     use super::*;
 
+    /// The record entries of the topic table: rank, short name, topic.
+    macro_rules! record_entries {
+        ($($rank:literal $short:literal $constant:ident $payload:ident $kind:ident;)+) => {
+            [$(($rank, $short, names::$constant)),+]
+        };
+    }
+
     #[test]
     fn the_choices_are_in_the_order_a_recording_writes_its_channels() {
-        assert_eq!(
-            topic_names(),
-            [
-                "raw-imu",
-                "raw-baro",
-                "raw-mag",
-                "raw-aux",
-                "fused-imu",
-                "altitude",
-                "nav",
-                "nav-standby",
-                "truth",
-                "health",
-                "heartbeat",
-                "fault",
-                "sim-control",
-                "fusion-control",
-                "fusion-reply",
-                "raw-airspeed"
-            ]
-        );
+        let table = ipc_types::for_each_topic!(record => record_entries);
         let choices = all_choices();
+        assert_eq!(choices.len(), table.len());
+        // Each rank from 0 is given once, so the order of the channels is the table's ranks.
+        for (rank, choice) in choices.iter().enumerate() {
+            let entries: Vec<_> = table.iter().filter(|(r, ..)| *r == rank).collect();
+            assert_eq!(entries.len(), 1, "rank {rank}: {entries:?}");
+            let (_, short, topic) = entries[0];
+            assert_eq!(
+                (choice.short, choice.topic),
+                (*short, *topic),
+                "rank {rank}"
+            );
+        }
+        // Recordings have always begun with the raw sensors and held the standby lane and the
+        // health report at these places.
+        assert_eq!(
+            topic_names()[..4],
+            ["raw-imu", "raw-baro", "raw-mag", "raw-aux"]
+        );
         assert_eq!(choices[7].topic, names::NAV_LANES[1]);
         assert_eq!(choices[9].topic, names::HEALTH);
     }

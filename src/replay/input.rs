@@ -4,20 +4,82 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use ipc_types::{Health, NavState, RawAux, RawBaro, RawImu, RawMag, ServiceKind, names};
+use ipc_types::{
+    Health, NavState, RawAirspeed, RawAux, RawBaro, RawImu, RawMag, ServiceKind, names,
+};
+use rins_navigator::aiding::readings::{HeldPayload, Reading};
 use rins_recording::{RecordedMessage, Recording, read_file};
 
-/// One raw sample of a recording.
-#[derive(Debug, Clone, Copy)]
-pub enum RawSample {
-    /// An IMU frame.
-    Imu(RawImu),
-    /// A barometer sample.
-    Baro(RawBaro),
-    /// A magnetometer sample.
-    Mag(RawMag),
-    /// An auxiliary sample (temperatures, foot pressure).
-    Aux(RawAux),
+/// The raw topics a replay feeds, one line per topic: `Variant(Payload) = TOPIC,` makes the
+/// [`RawSample`] variant `Variant` of the `ipc_types::names` topic `TOPIC`. The lines under `held`
+/// are payloads the navigator holds as they come (see `rins_navigator::aiding::readings`); those
+/// under `stages` feed a stage (fusion, the altimeter) or none.
+macro_rules! raw_samples {
+    (
+        stages { $($(#[$sdoc:meta])* $stage:ident($stage_payload:ty) = $stage_topic:ident,)+ }
+        held { $($(#[$hdoc:meta])* $held:ident($held_payload:ty) = $held_topic:ident,)+ }
+    ) => {
+        /// One raw sample of a recording.
+        #[derive(Debug, Clone, Copy)]
+        pub enum RawSample {
+            $($(#[$sdoc])* $stage($stage_payload),)+
+            $($(#[$hdoc])* $held($held_payload),)+
+        }
+
+        impl RawSample {
+            /// The frame's header.
+            pub fn header(&self) -> &ipc_types::Header {
+                match self {
+                    $(Self::$stage(s) => &s.header,)+
+                    $(Self::$held(s) => &s.header,)+
+                }
+            }
+
+            /// The payload's layout version.
+            pub fn version(&self) -> u16 {
+                match self {
+                    $(Self::$stage(s) => s.version,)+
+                    $(Self::$held(s) => s.version,)+
+                }
+            }
+
+            /// The aiding reading the navigator holds, for a payload it takes as it comes.
+            pub fn held_reading(&self) -> Option<Reading> {
+                match self {
+                    $(Self::$held(s) => Some(s.reading()),)+
+                    _ => None,
+                }
+            }
+
+            /// The raw sample of message `m`, when its topic is one a replay feeds.
+            fn decode(
+                m: &RecordedMessage,
+            ) -> Option<Result<Self, rins_recording::DecodeError>> {
+                match &*m.topic {
+                    $(names::$stage_topic => Some(m.decode().map(Self::$stage)),)+
+                    $(names::$held_topic => Some(m.decode().map(Self::$held)),)+
+                    _ => None,
+                }
+            }
+        }
+    };
+}
+
+raw_samples! {
+    stages {
+        /// An IMU frame.
+        Imu(RawImu) = RAW_IMU,
+        /// A barometer sample (through the altimeter).
+        Baro(RawBaro) = RAW_BARO,
+        /// An auxiliary sample (temperatures, foot pressure).
+        Aux(RawAux) = RAW_AUX,
+    }
+    held {
+        /// A magnetometer sample.
+        Mag(RawMag) = RAW_MAG,
+        /// A pitot airspeed sample.
+        Airspeed(RawAirspeed) = RAW_AIRSPEED,
+    }
 }
 
 impl RawSample {
@@ -33,22 +95,12 @@ impl RawSample {
 
     /// The frame's device time, µs.
     pub fn device_time_us(&self) -> u64 {
-        match self {
-            Self::Imu(s) => s.header.origin_device_time_us,
-            Self::Baro(s) => s.header.origin_device_time_us,
-            Self::Mag(s) => s.header.origin_device_time_us,
-            Self::Aux(s) => s.header.origin_device_time_us,
-        }
+        self.header().origin_device_time_us
     }
 
     /// The frame's serial receive time, ns (CLOCK_MONOTONIC of the recording).
     pub fn rx_ns(&self) -> u64 {
-        match self {
-            Self::Imu(s) => s.header.origin_rx_ns,
-            Self::Baro(s) => s.header.origin_rx_ns,
-            Self::Mag(s) => s.header.origin_rx_ns,
-            Self::Aux(s) => s.header.origin_rx_ns,
-        }
+        self.header().origin_rx_ns
     }
 }
 
@@ -111,11 +163,11 @@ impl ReplayInput {
         m: &RecordedMessage,
         late_by_process: &mut HashMap<(usize, u32), u64>,
     ) -> Result<(), rins_recording::DecodeError> {
+        if let Some(sample) = RawSample::decode(m) {
+            self.raw.push(sample?);
+            return Ok(());
+        }
         match &*m.topic {
-            names::RAW_IMU => self.raw.push(RawSample::Imu(m.decode()?)),
-            names::RAW_BARO => self.raw.push(RawSample::Baro(m.decode()?)),
-            names::RAW_MAG => self.raw.push(RawSample::Mag(m.decode()?)),
-            names::RAW_AUX => self.raw.push(RawSample::Aux(m.decode()?)),
             t if t == names::NAV_LANES[0] => self.nav[0].push(m.decode()?),
             t if t == names::NAV_LANES[1] => self.nav[1].push(m.decode()?),
             names::HEARTBEAT => {
@@ -237,6 +289,32 @@ mod tests {
             "{text}"
         );
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn the_navigator_holds_magnetometer_and_airspeed_samples_as_they_come() {
+        let airspeed = RawSample::Airspeed(RawAirspeed {
+            header: header(10, 1000),
+            diff_pressure_pa: 250.0,
+            ..RawAirspeed::default()
+        });
+        match airspeed.held_reading() {
+            Some(Reading::Airspeed(r)) => {
+                assert_eq!((r.t_us, r.diff_pressure_pa), (1000, 250.0));
+            }
+            other => panic!("{other:?}"),
+        }
+        let mag = RawSample::Mag(RawMag {
+            header: header(10, 1000),
+            ..RawMag::default()
+        });
+        assert!(matches!(mag.held_reading(), Some(Reading::Mag(_))));
+        // The barometer goes through the altimeter first.
+        let baro = RawSample::Baro(RawBaro {
+            header: header(10, 1000),
+            ..RawBaro::default()
+        });
+        assert_eq!(baro.held_reading(), None);
     }
 
     #[test]

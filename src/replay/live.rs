@@ -11,8 +11,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
 use ipc_types::{
-    Altitude, ChannelState, FusedImu, Health, NavState, RawAux, RawBaro, RawImu, RawMag,
-    ServiceKind, names,
+    Altitude, ChannelState, FusedImu, Health, NavState, RawAirspeed, RawAux, RawBaro, RawImu,
+    RawMag, ServiceKind, names,
 };
 use rins_navigator::aiding::hold::HOLD_US;
 use rins_runtime::ipc::{
@@ -295,6 +295,7 @@ fn feed(
     let baro = TopicPublisher::<RawBaro>::new(node, names::RAW_BARO)?;
     let mag = TopicPublisher::<RawMag>::new(node, names::RAW_MAG)?;
     let aux = TopicPublisher::<RawAux>::new(node, names::RAW_AUX)?;
+    let airspeed = TopicPublisher::<RawAirspeed>::new(node, names::RAW_AIRSPEED)?;
     let mut tap = NavTap {
         lanes: [
             TopicSubscriber::new(node, names::NAV_LANES[0])?,
@@ -354,6 +355,7 @@ fn feed(
             RawSample::Baro(s) => baro.publish(*s)?,
             RawSample::Mag(s) => mag.publish(*s)?,
             RawSample::Aux(s) => aux.publish(*s)?,
+            RawSample::Airspeed(s) => airspeed.publish(*s)?,
         }
         tap.drain()?;
         if i % 1000 == 0 {
@@ -376,7 +378,7 @@ fn feed(
         }
     }
     drop(tap);
-    drop((imu, baro, mag, aux));
+    drop((imu, baro, mag, aux, airspeed));
     drop(tool);
     Ok(out)
 }

@@ -1,8 +1,9 @@
 //! The pipeline in one process, without IPC: the raw samples of a recording through the same
 //! library code the services run — fusion's fuser and message, the altimeter's estimator, each
-//! navigator lane's aiding hold and step — in the order the sensor block sent them. What the live
-//! pipeline publishes for a sample does not depend on when it arrived (the navigator holds aiding
-//! readings until the IMU stream passes their time), so this gives the same output.
+//! navigator lane's aiding hold (every held reading it subscribes to) and step — in the order the
+//! sensor block sent them. What the live pipeline publishes for a sample does not depend on when
+//! it arrived (the navigator holds aiding readings until the IMU stream passes their time), so
+//! this gives the same output.
 
 use ipc_types::{FusedImu, NavState, PAYLOAD_VERSION, RawImu};
 use rins_altimeter::AltitudeEstimator;
@@ -10,7 +11,7 @@ use rins_altimeter::service::altitude_message;
 use rins_fusion::ImuFuser;
 use rins_fusion::service::{fused_message, rejected_message};
 use rins_navigator::Navigator;
-use rins_navigator::aiding::readings::{AidingQueue, Reading};
+use rins_navigator::aiding::readings::{AidingQueue, HeldPayload, Reading};
 use rins_navigator::service::step;
 
 use super::input::{RawSample, ReplayInput};
@@ -33,6 +34,14 @@ impl Lane {
                 ..NavState::default()
             },
             out: Vec::new(),
+        }
+    }
+
+    /// What the navigator service does with an aiding reading: holds it, when it subscribes to
+    /// its topic.
+    fn on_reading(&mut self, r: Reading) {
+        if r.subscribed(self.nav.config()) {
+            self.aiding.hold(r, &mut self.nav);
         }
     }
 
@@ -94,30 +103,32 @@ impl OfflinePipeline {
         let total = input.raw.len().max(1);
         for (i, sample) in input.raw.iter().enumerate() {
             match sample {
-                RawSample::Imu(raw) if raw.version == PAYLOAD_VERSION => {
+                // Other payload versions are refused by the services too.
+                _ if sample.version() != PAYLOAD_VERSION => {}
+                RawSample::Imu(raw) => {
                     let fused = self.fuse(raw);
                     for lane in &mut self.lanes {
                         lane.on_fused(&fused);
                     }
                 }
-                RawSample::Baro(raw) if raw.version == PAYLOAD_VERSION => {
+                RawSample::Baro(raw) => {
                     let out = self
                         .altimeter
                         .update(raw.header.origin_device_time_us, raw.pressure_pa);
                     let alt = altitude_message(raw, &out);
                     for lane in &mut self.lanes {
-                        lane.aiding
-                            .hold(Reading::from_altitude(&alt), &mut lane.nav);
+                        lane.on_reading(alt.reading());
                     }
                 }
-                RawSample::Mag(raw) if raw.version == PAYLOAD_VERSION => {
-                    for lane in &mut self.lanes {
-                        lane.aiding.hold(Reading::from_mag(raw), &mut lane.nav);
+                other => {
+                    // The readings the navigator takes as they come; auxiliary samples feed no
+                    // stage.
+                    if let Some(r) = other.held_reading() {
+                        for lane in &mut self.lanes {
+                            lane.on_reading(r);
+                        }
                     }
                 }
-                // Auxiliary samples feed no stage; other payload versions are refused by the
-                // services too.
-                _ => {}
             }
             if i % 10_000 == 0 {
                 progress(i as f64 / total as f64);

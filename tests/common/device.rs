@@ -190,8 +190,7 @@ fn write_loop(
             sim.step(&mut out);
             frames.clear();
             raw.clear();
-            frames.push(out.imu);
-            frames.extend([out.baro, out.mag, out.aux].into_iter().flatten());
+            frames.extend(out.frames().into_iter().flatten().copied());
             tamper(DeviceTick {
                 t_s,
                 frames: &mut frames,

@@ -6,7 +6,8 @@
 use super::codec::decode_frame;
 use super::continuity::Continuity;
 use super::error::DecodeError;
-use super::frame::{DecodedFrame, Frame, FrameType};
+use super::frame::{DecodedFrame, Frame};
+use super::frame_type::FrameType;
 use super::layout::{FRAME_OVERHEAD, LEN_OFFSET, MAX_FRAME_LEN, SYNC};
 use super::resume_point::{ResumeError, ResumePoint};
 use super::seq_extend::{SeqExtender, SeqVerdict};

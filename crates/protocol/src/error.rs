@@ -2,7 +2,7 @@
 
 use core::fmt;
 
-use super::frame::FrameType;
+use crate::frame_type::FrameType;
 
 /// An IMU frame whose content breaks the format's limits: the same limits bind what is encoded
 /// and what is decoded, so both errors carry this one.
@@ -116,6 +116,58 @@ impl fmt::Display for ValueOutOfRange {
 }
 
 impl std::error::Error for ValueOutOfRange {}
+
+/// Contents a frame may not carry, whichever way it travels: what a frame type's sanity check
+/// ([`crate::SensorFrame::check_sane`]) refuses. Encoding and decoding report it as their own
+/// `Content` or `OutOfRange` error.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContentError {
+    /// The IMU frame's content breaks the format's limits.
+    Imu(ImuContentError),
+    /// A fixed-size frame carries a value no working sensor produces.
+    OutOfRange(ValueOutOfRange),
+}
+
+impl fmt::Display for ContentError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ContentError::Imu(e) => e.fmt(f),
+            ContentError::OutOfRange(e) => e.fmt(f),
+        }
+    }
+}
+
+impl std::error::Error for ContentError {}
+
+impl From<ImuContentError> for ContentError {
+    fn from(e: ImuContentError) -> Self {
+        ContentError::Imu(e)
+    }
+}
+
+impl From<ValueOutOfRange> for ContentError {
+    fn from(e: ValueOutOfRange) -> Self {
+        ContentError::OutOfRange(e)
+    }
+}
+
+impl From<ContentError> for EncodeError {
+    fn from(e: ContentError) -> Self {
+        match e {
+            ContentError::Imu(e) => EncodeError::Content(e),
+            ContentError::OutOfRange(e) => EncodeError::OutOfRange(e),
+        }
+    }
+}
+
+impl From<ContentError> for DecodeError {
+    fn from(e: ContentError) -> Self {
+        match e {
+            ContentError::Imu(e) => DecodeError::Content(e),
+            ContentError::OutOfRange(e) => DecodeError::OutOfRange(e),
+        }
+    }
+}
 
 impl From<ValueOutOfRange> for EncodeError {
     fn from(e: ValueOutOfRange) -> Self {

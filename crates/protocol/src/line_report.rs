@@ -6,7 +6,8 @@ use ipc_types::LinkError;
 
 use super::decoder::DecoderStats;
 use super::diagnosis::{likely_cause, link_error};
-use super::frame::{DecodedFrame, FrameType};
+use super::frame::DecodedFrame;
+use super::frame_type::FrameType;
 
 /// Frames of one type seen during a listen.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -3,7 +3,7 @@
 
 use core::fmt;
 
-use super::frame::FrameType;
+use super::frame_type::FrameType;
 
 /// The last extended sequence number of each frame type (indexed by [`FrameType::index`]) and
 /// the last extended device time, each with the wire value it was given to. A restarted

@@ -66,7 +66,7 @@ pub unsafe trait Recordable: Copy + 'static {
 
 /// Makes every payload of the topic table [`Recordable`].
 macro_rules! recordable {
-    ($($payload:ident ($kind:ident) { $($topics:tt)* })+) => {$(
+    ($($payload:ident $kind:ident;)+) => {$(
         // SAFETY: a `#[repr(C)]` payload of `ipc-types` made of integers, floats, arrays and
         // nested structs of those, with explicit padding fields; its layout is tested to have no
         // gap (`schema` tests).
@@ -78,7 +78,7 @@ macro_rules! recordable {
     )+};
 }
 
-ipc_types::for_each_topic!(recordable);
+ipc_types::for_each_topic!(payloads => recordable);
 
 #[cfg(test)]
 mod tests {
@@ -110,7 +110,7 @@ mod tests {
 
     /// Checks every payload of the topic table.
     macro_rules! check_every_payload {
-        ($($payload:ident ($kind:ident) { $($topics:tt)* })+) => {$(
+        ($($payload:ident $kind:ident;)+) => {$(
             check::<ipc_types::$payload>();
         )+};
     }
@@ -122,6 +122,6 @@ mod tests {
 
     #[test]
     fn every_recordable_has_its_own_layout() {
-        ipc_types::for_each_topic!(check_every_payload);
+        ipc_types::for_each_topic!(payloads => check_every_payload);
     }
 }

@@ -32,10 +32,7 @@ mod tests {
     use super::msg_text::collect_nested;
     use super::payloads::PAYLOAD_SIZES;
     use super::*;
-    use ipc_types::{
-        Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, GnssFix, Health,
-        HealthReport, NavState, RawAirspeed, RawAux, RawBaro, RawImu, RawMag, SimControl, Truth,
-    };
+    use ipc_types::{HealthReport, NavState};
 
     /// Every layout described, nested ones included.
     fn all_layouts() -> Vec<&'static StructLayout> {
@@ -132,24 +129,13 @@ mod tests {
             // implement, not to call.
             unsafe { <T as ZeroCopySend>::type_name() }
         }
-        let expected = [
-            name::<RawImu>(),
-            name::<RawBaro>(),
-            name::<RawMag>(),
-            name::<RawAux>(),
-            name::<GnssFix>(),
-            name::<FusedImu>(),
-            name::<Altitude>(),
-            name::<NavState>(),
-            name::<Truth>(),
-            name::<Health>(),
-            name::<HealthReport>(),
-            name::<FaultApplied>(),
-            name::<SimControl>(),
-            name::<FusionControl>(),
-            name::<FusionReply>(),
-            name::<RawAirspeed>(),
-        ];
+        /// The iceoryx2 type name of every payload, in the topic table's order.
+        macro_rules! type_names {
+            ($($payload:ident $kind:ident;)+) => {
+                [$(name::<ipc_types::$payload>()),+]
+            };
+        }
+        let expected = ipc_types::for_each_topic!(payloads => type_names);
         let ours: Vec<&str> = PAYLOADS.iter().map(|l| l.type_name).collect();
         assert_eq!(ours, expected);
         for layout in PAYLOADS {

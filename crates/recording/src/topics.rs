@@ -6,28 +6,19 @@ use crate::schema::{self, StructLayout};
 
 /// Lists every topic of the topic table with its payload's layout.
 macro_rules! topic_layouts {
-    ($(
-        $payload:ident ($kind:ident) {
-            $(
-                $(#[$meta:meta])*
-                $constant:ident = $topic:literal
-                    $(, echo $echo:literal)?
-                    $(, record $short:literal at $rank:literal)?;
-            )+
-        }
-    )+) => {
+    ($($(#[$doc:meta])* $constant:ident $topic:literal $payload:ident $kind:ident;)+) => {
         /// Every topic a recording may hold, with the layout of the payload it carries: the
         /// pipeline's outputs, both navigator lanes, supervision, and the commands with their
         /// answers.
-        pub static TOPICS: [(&str, &StructLayout); TOPIC_COUNT] = [$($(
+        pub static TOPICS: [(&str, &StructLayout); TOPIC_COUNT] = [$(
             (names::$constant, schema::layout_of::<ipc_types::$payload>()),
-        )+)+];
+        )+];
 
-        const TOPIC_COUNT: usize = [$($(names::$constant),+),+].len();
+        const TOPIC_COUNT: usize = [$(names::$constant),+].len();
     };
 }
 
-ipc_types::for_each_topic!(topic_layouts);
+ipc_types::for_each_topic!(topics => topic_layouts);
 
 /// The layout of the payload published on `topic`, `None` for a topic rins does not publish.
 pub fn layout_of_topic(topic: &str) -> Option<&'static StructLayout> {

@@ -100,7 +100,7 @@ impl OtherVersionWarning {
 /// Makes every payload of the topic table [`Versioned`], and those with the common header
 /// [`Stamped`].
 macro_rules! payload_traits {
-    ($($payload:ident ($kind:ident) { $($topics:tt)* })+) => {$(
+    ($($payload:ident $kind:ident;)+) => {$(
         payload_traits!(@$kind $payload);
     )+};
     (@stamped $payload:ident) => {
@@ -111,7 +111,7 @@ macro_rules! payload_traits {
     };
 }
 
-ipc_types::for_each_topic!(payload_traits);
+ipc_types::for_each_topic!(payloads => payload_traits);
 
 #[cfg(test)]
 mod tests {

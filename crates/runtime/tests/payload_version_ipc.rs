@@ -11,13 +11,10 @@ use ipc_types::{
     Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, GnssFix, Health, HealthReport,
     NavState, PAYLOAD_VERSION, RawAux, RawBaro, RawImu, RawMag, SimControl, Truth, names,
 };
-use rins_runtime::ipc::{
-    IpcNode, IpcSettings, SampleSource, TopicPublisher, TopicSubscriber, create_node,
-};
+use rins_runtime::ipc::{IpcNode, SampleSource, TopicPublisher, TopicSubscriber};
 use rins_runtime::payload::{Received, Versioned};
-use rins_runtime::shm_cleanup;
 use rins_runtime::stage_io::StageInput;
-use rins_runtime::tool_node::ToolNode;
+use rins_test_support::private_ipc::{OTHER_VERSIONS, on_private_node, on_tool_node};
 
 /// A payload the test can write with any version; `seq` tells the samples apart.
 trait TestPayload: Versioned + Debug + ZeroCopySend + Copy + 'static {
@@ -72,9 +69,6 @@ without_header!(
     FusionReply => request_id: u32,
     SimControl => channel: u8
 );
-
-/// Another build's version on either side of this one's.
-const OTHER_VERSIONS: [u16; 2] = [PAYLOAD_VERSION + 1, PAYLOAD_VERSION - 1];
 
 /// Publishes, on `topic`: another version, this build's (seq 2), another version, this build's
 /// (seq 4).
@@ -139,33 +133,6 @@ fn stage_input_rejects<T: TestPayload>(node: &IpcNode, topic: &'static str) {
     assert_eq!(counters.rejected, 4, "{topic}");
 }
 
-fn settings(tag: &str) -> IpcSettings {
-    let pid = std::process::id();
-    IpcSettings::new(
-        format!("rtv{tag}{pid}_"),
-        std::env::temp_dir()
-            .join(format!("rtv{tag}{pid}root/"))
-            .to_string_lossy()
-            .into_owned(),
-    )
-}
-
-fn clean(settings: &IpcSettings) {
-    shm_cleanup::remove_all(settings, true);
-    let _ = std::fs::remove_dir_all(&settings.root);
-    assert!(shm_cleanup::shm_entries(settings).is_empty());
-}
-
-/// Runs `check` on a node of its own on a private deployment, removed afterwards.
-fn on_private_node(tag: &str, check: impl FnOnce(&IpcNode)) {
-    let settings = settings(tag);
-    {
-        let node = create_node(tag, &settings).expect("node");
-        check(&node);
-    }
-    clean(&settings);
-}
-
 #[test]
 fn stage_inputs_count_and_set_apart_another_version() {
     on_private_node("st", |node| {
@@ -211,15 +178,11 @@ fn the_watchdog_readers_drop_another_version() {
 /// `rins echo` shows, from its own node.
 #[test]
 fn a_tools_readers_drop_another_version() {
-    let settings = settings("tl");
-    {
-        let tool = ToolNode::join_settings("echo", settings.clone()).expect("tool node");
-        let node = tool.node();
+    on_tool_node("tl", |node| {
         watchdog_readers_reject(node);
         plain_reader_rejects::<RawAux>(node, names::RAW_AUX);
         plain_reader_rejects::<GnssFix>(node, names::GNSS);
         plain_reader_rejects::<HealthReport>(node, names::HEALTH);
         plain_reader_rejects::<SimControl>(node, names::SIM_CONTROL);
-    }
-    clean(&settings);
+    });
 }

@@ -5,7 +5,7 @@
 use std::time::Duration;
 
 use anyhow::{Result, anyhow};
-use ipc_types::{Health, ServiceKind, Stage, names};
+use ipc_types::{Health, ServiceKind, Stage};
 use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{IpcNode, IpcSettings, create_node};
 use rins_runtime::service::{Service, ServiceContext};
@@ -18,25 +18,33 @@ use crate::line_watch::LineWatch;
 use crate::resume_file;
 use crate::resume_saver::ResumeSaver;
 use crate::to_ipc;
-use rins_protocol::{DecodedFrame, Decoder, DecoderStats, FrameType, Payload, link_error};
+use rins_protocol::{
+    DecodedFrame, Decoder, DecoderStats, FrameType, Payload, SensorFrame, frames, link_error,
+};
 use rins_serial_reader::presence::{Opened, Presence, Retry};
 use rins_serial_reader::reconnecting::{LineEvents, read_reconnecting};
 
-/// Generates [`Publishers`]: the topic of each frame type and the dispatch of a decoded frame to
-/// it, from one line per frame type: `Variant => field: Payload on TOPIC via conversion`.
+/// Generates [`Publishers`] from the protocol's list of frame types
+/// ([`rins_protocol::for_each_frame!`], whose grammar this matches): one publisher per frame type,
+/// a field named by the type's module, carrying its `SensorFrame::Ipc` payload on its
+/// `SensorFrame::TOPIC`; a new frame type needs no line here.
 macro_rules! raw_topics {
-    ($($variant:ident => $field:ident: $payload:ident on $topic:ident via $convert:path;)+) => {
+    ($($(#[$doc:meta])* $variant:ident = $byte:literal => $module:ident :: $frame:ident,)+) => {
         /// The topics acquisition publishes, one per frame type; each sample leaves stamped with
         /// the acquisition's publish time.
         struct Publishers {
-            $($field: StagePublisher<ipc_types::$payload>,)+
+            $($module: StagePublisher<<frames::$module::$frame as SensorFrame>::Ipc>,)+
         }
 
         impl Publishers {
             fn new(node: &IpcNode) -> Result<Self> {
                 let stage = Stage::Acquisition;
                 Ok(Self {
-                    $($field: StagePublisher::new(node, names::$topic, stage)?,)+
+                    $($module: StagePublisher::new(
+                        node,
+                        <frames::$module::$frame as SensorFrame>::TOPIC,
+                        stage,
+                    )?,)+
                 })
             }
 
@@ -45,7 +53,7 @@ macro_rules! raw_topics {
                 let header = to_ipc::origin_header(frame, rx_ns);
                 match &frame.payload {
                     $(Payload::$variant(f) => {
-                        self.$field.publish($convert(f, header))?;
+                        self.$module.publish(f.to_ipc(header))?;
                     })+
                 }
                 Ok(())
@@ -54,13 +62,7 @@ macro_rules! raw_topics {
     };
 }
 
-raw_topics! {
-    Imu => imu: RawImu on RAW_IMU via to_ipc::raw_imu;
-    Baro => baro: RawBaro on RAW_BARO via to_ipc::raw_baro;
-    Mag => mag: RawMag on RAW_MAG via to_ipc::raw_mag;
-    Aux => aux: RawAux on RAW_AUX via to_ipc::raw_aux;
-    Airspeed => airspeed: RawAirspeed on RAW_AIRSPEED via to_ipc::raw_airspeed;
-}
+rins_protocol::for_each_frame!(raw_topics);
 
 fn millis(d: Duration) -> u64 {
     u64::try_from(d.as_millis()).unwrap_or(u64::MAX)

@@ -2,8 +2,8 @@
 //! in chunks of any size (frames split across reads), and the conversion of each decoded frame to
 //! its IPC payload with its origin header.
 
-use rins_acquisition::to_ipc::{origin_header, raw_baro, raw_imu, raw_mag};
-use rins_protocol::{BaroFrame, Decoder, Frame, ImuFrame, MagFrame, Payload, encode};
+use rins_acquisition::to_ipc::origin_header;
+use rins_protocol::{BaroFrame, Decoder, Frame, ImuFrame, MagFrame, Payload, SensorFrame, encode};
 use rins_test_support::counting_alloc::{CountingAllocator, allocations_during};
 
 #[global_allocator]
@@ -67,13 +67,13 @@ fn decoding_and_converting_frames_does_not_allocate() {
                 let header = origin_header(&decoded, rx_ns);
                 match &decoded.payload {
                     Payload::Imu(f) => {
-                        imu += std::hint::black_box(raw_imu(f, header)).header.origin_seq
+                        imu += std::hint::black_box(f.to_ipc(header)).header.origin_seq
                     }
                     Payload::Baro(f) => {
-                        baro += std::hint::black_box(raw_baro(f, header)).header.origin_seq
+                        baro += std::hint::black_box(f.to_ipc(header)).header.origin_seq
                     }
                     Payload::Mag(f) => {
-                        mag += std::hint::black_box(raw_mag(f, header)).header.origin_seq
+                        mag += std::hint::black_box(f.to_ipc(header)).header.origin_seq
                     }
                     Payload::Aux(_) | Payload::Airspeed(_) => {}
                 }

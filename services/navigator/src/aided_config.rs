@@ -81,11 +81,6 @@ impl AidedConfig {
         on
     }
 
-    /// Each bucket's aiding bit in the navigation state, indexed by [`AidingSource`].
-    pub(crate) fn aiding_bits(&self) -> [u32; AidingSource::COUNT] {
-        self.per_bucket(|bucket| bucket.aiding_bit)
-    }
-
     /// Each bucket's integrity reason when its innovations are inconsistent, indexed by
     /// [`AidingSource`].
     pub(crate) fn inconsistency_reasons(&self) -> [u32; AidingSource::COUNT] {
@@ -109,7 +104,7 @@ mod tests {
     use crate::NavigatorConfig;
 
     #[test]
-    fn every_bucket_is_declared_by_exactly_one_source_with_distinct_bits() {
+    fn every_bucket_is_declared_by_exactly_one_source() {
         let config = NavigatorConfig::default().aided_config();
         let mut declared = [0; AidingSource::COUNT];
         for sensor in config.sensors() {
@@ -120,10 +115,5 @@ mod tests {
             assert!(sensor.buckets().iter().any(|b| b.source == sensor.source()));
         }
         assert_eq!(declared, [1; AidingSource::COUNT]);
-        let bits = config.aiding_bits();
-        for (i, bit) in bits.iter().enumerate() {
-            assert_eq!(bit.count_ones(), 1);
-            assert!(bits[..i].iter().all(|b| b != bit));
-        }
     }
 }

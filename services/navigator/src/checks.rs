@@ -12,19 +12,27 @@ pub(crate) fn positive(name: &'static str, value: f64) -> Result<(), (&'static s
     }
 }
 
-/// `value` of `table.field` is finite and passes `ok`; otherwise the error names the key, the
-/// value and `reason`.
-pub(crate) fn check_in(
-    table: &str,
-    field: &'static str,
-    value: f64,
-    ok: impl Fn(f64) -> bool,
-    reason: &'static str,
-) -> Result<(), ConfigError> {
-    // `is_finite` first so that NaN and infinities are always rejected whatever the range test says.
-    if value.is_finite() && ok(value) {
-        Ok(())
-    } else {
-        Err(ConfigError::new(field, value, reason).within(table))
+/// One settings table (`navigator`, `navigator.start`), whose range checks name their key within
+/// it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Table(pub(crate) &'static str);
+
+impl Table {
+    /// `value` of `table.field` is finite and passes `ok`; otherwise the error names the key, the
+    /// value and `reason`.
+    pub(crate) fn check(
+        self,
+        field: &'static str,
+        value: f64,
+        ok: impl Fn(f64) -> bool,
+        reason: &'static str,
+    ) -> Result<(), ConfigError> {
+        // `is_finite` first so that NaN and infinities are always rejected whatever the range
+        // test says.
+        if value.is_finite() && ok(value) {
+            Ok(())
+        } else {
+            Err(ConfigError::new(field, value, reason).within(self.0))
+        }
     }
 }

@@ -10,7 +10,7 @@ use crate::aiding::mag_heading::MagAidingConfig;
 use crate::aiding::tilt::TiltAidingConfig;
 use crate::aiding::zupt::ZuptConfig;
 use crate::alignment::AlignConfig;
-use crate::checks::check_in;
+use crate::checks::Table;
 use crate::ekf::EkfNoise;
 use crate::integrity::IntegrityConfig;
 use crate::mag_calibration::MagCalibration;
@@ -114,26 +114,20 @@ impl Default for NavigatorConfig {
     }
 }
 
-fn check(
-    field: &'static str,
-    value: f64,
-    ok: impl Fn(f64) -> bool,
-    reason: &'static str,
-) -> Result<(), ConfigError> {
-    check_in("navigator", field, value, ok, reason)
-}
+/// The `[navigator]` table, for the range checks of its own keys.
+const NAVIGATOR: Table = Table("navigator");
 
 impl NavigatorConfig {
     /// Checks every numeric field; the error names the first offending field and its value.
     pub fn validate(&self) -> Result<(), ConfigError> {
         let positive = |x: f64| x > 0.0;
-        check(
+        NAVIGATOR.check(
             "align_s",
             self.align_s,
             |x| x > 0.0 && x <= 600.0,
             "must be in (0, 600] s",
         )?;
-        check(
+        NAVIGATOR.check(
             "declination_deg",
             self.declination_deg,
             |x| x.abs() <= 180.0,
@@ -141,13 +135,13 @@ impl NavigatorConfig {
         )?;
         match (self.initial_latitude_deg, self.initial_longitude_deg) {
             (Some(lat), Some(lon)) => {
-                check(
+                NAVIGATOR.check(
                     "initial_latitude_deg",
                     lat,
                     |x| x.abs() <= 89.9,
                     "must be in [-89.9, 89.9] degrees (longitude is undefined at the poles)",
                 )?;
-                check(
+                NAVIGATOR.check(
                     "initial_longitude_deg",
                     lon,
                     |x| x.abs() <= 180.0,
@@ -172,43 +166,43 @@ impl NavigatorConfig {
                 .within("navigator"));
             }
         }
-        check(
+        NAVIGATOR.check(
             "initial_altitude_m",
             self.initial_altitude_m,
             |x| (-1000.0..=50_000.0).contains(&x),
             "must be in [-1000, 50000] m",
         )?;
-        check(
+        NAVIGATOR.check(
             "max_dt_s",
             self.max_dt_s,
             |x| x > 0.0 && x <= 10.0,
             "must be in (0, 10] s",
         )?;
-        check(
+        NAVIGATOR.check(
             "aiding_timeout_s",
             self.aiding_timeout_s,
             positive,
             "must be finite and > 0 s",
         )?;
-        check(
+        NAVIGATOR.check(
             "align_specific_force_tolerance_mps2",
             self.align_specific_force_tolerance_mps2,
             positive,
             "must be finite and > 0 m/s²",
         )?;
-        check(
+        NAVIGATOR.check(
             "align_max_rate_rps",
             self.align_max_rate_rps,
             positive,
             "must be finite and > 0 rad/s",
         )?;
-        check(
+        NAVIGATOR.check(
             "align_max_specific_force_std_mps2",
             self.align_max_specific_force_std_mps2,
             positive,
             "must be finite and > 0 m/s²",
         )?;
-        check(
+        NAVIGATOR.check(
             "align_max_rate_std_rps",
             self.align_max_rate_std_rps,
             positive,

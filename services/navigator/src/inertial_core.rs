@@ -2,9 +2,9 @@
 //! every IMU sample. It owns the filter, the stance detector, the records of the aiding sources
 //! and the integrity monitor; the aiding sources ([`crate::aiding`]) own their settings and
 //! state and reach the filter only through the `AidingContext` the core
-//! lends them: the tilt and zero-velocity updates on each IMU sample, the barometric heights,
-//! magnetometer samples and GNSS fixes through [`AidedNavigator::on_baro`],
-//! [`AidedNavigator::on_mag`] and [`AidedNavigator::on_gnss`].
+//! lends them: the tilt and zero-velocity updates on each IMU sample, the readings of their own
+//! topics (barometric heights, magnetometer samples, airspeeds) through
+//! [`AidedNavigator::on_reading`], and GNSS fixes through [`AidedNavigator::on_gnss`].
 //!
 //! Both profiles run it — a foot-mounted unit (pedestrian) and the airframe (uav); the offline
 //! evaluations and the live navigator share this one code path, so what the real recordings
@@ -17,6 +17,7 @@ use crate::aiding::context::{AidingContext, CorePhase, ImuNow};
 use crate::aiding::gnss::measurement::{GnssMeasurement, GnssOutcome};
 use crate::aiding::gnss::monitor::GnssMonitor;
 use crate::aiding::outcome::AidingOutcome;
+use crate::aiding::readings::Reading;
 use crate::aiding::records::SourceRecords;
 use crate::aiding::sources::AidingSources;
 pub use crate::aiding::zupt::ZuptConfig;
@@ -170,35 +171,11 @@ impl AidedNavigator {
         (ctx, &mut self.sources)
     }
 
-    /// One barometric height (m above mean sea level) with its variance (m²) at device time
-    /// `t_us` (see [`crate::aiding::baro`]).
-    pub fn on_baro(
-        &mut self,
-        t_us: u64,
-        height_m: f64,
-        variance_m2: f64,
-        valid: bool,
-    ) -> AidingOutcome {
+    /// One held aiding reading (a barometric height, a magnetometer sample, an airspeed: see
+    /// [`crate::aiding::readings`]), applied by its source.
+    pub fn on_reading(&mut self, r: Reading) -> AidingOutcome {
         let (mut ctx, sources) = self.lend();
-        sources
-            .baro
-            .on_reading(&mut ctx, t_us, height_m, variance_m2, valid)
-    }
-
-    /// One magnetometer sample (raw µT, body FRD) at device time `t_us` (see
-    /// `aiding/mag.rs`).
-    pub fn on_mag(&mut self, t_us: u64, raw_ut: [f64; 3]) -> AidingOutcome {
-        let (mut ctx, sources) = self.lend();
-        sources.mag.on_sample(&mut ctx, t_us, raw_ut)
-    }
-
-    /// One pitot differential pressure, Pa, at device time `t_us` (see
-    /// [`crate::aiding::airspeed`]).
-    pub fn on_airspeed(&mut self, t_us: u64, diff_pressure_pa: f64) -> AidingOutcome {
-        let (mut ctx, sources) = self.lend();
-        sources
-            .airspeed
-            .on_reading(&mut ctx, t_us, diff_pressure_pa)
+        r.apply(&mut ctx, sources)
     }
 
     /// One receiver fix (see [`crate::aiding::gnss`]).
@@ -324,18 +301,15 @@ impl AidedNavigator {
                         2,
                     );
                 }
+                // The stream as the sources that run on this sample see it: the stance is the
+                // previous sample's until the detector below has seen this one.
+                let imu = ImuNow {
+                    time_us: self.last_time_us,
+                    in_stance: self.in_stance,
+                    force,
+                };
                 if outcome.is_applied() && !self.attitude_recovery.is_lost() {
-                    let imu = ImuNow {
-                        time_us: self.last_time_us,
-                        in_stance: self.in_stance,
-                        force,
-                    };
-                    let mut ctx = AidingContext::new(
-                        CorePhase::Navigating(&mut *ekf),
-                        imu,
-                        &mut self.records,
-                        &mut self.integrity,
-                    );
+                    let mut ctx = lend_on_imu(ekf, &mut self.records, &mut self.integrity, imu);
                     self.sources
                         .tilt
                         .on_imu(&mut ctx, t_us, specific_force, &rate);
@@ -345,16 +319,10 @@ impl AidedNavigator {
                 self.in_stance = step.stance;
                 if step.stance && outcome.is_applied() {
                     let imu = ImuNow {
-                        time_us: self.last_time_us,
                         in_stance: self.in_stance,
-                        force,
+                        ..imu
                     };
-                    let mut ctx = AidingContext::new(
-                        CorePhase::Navigating(&mut *ekf),
-                        imu,
-                        &mut self.records,
-                        &mut self.integrity,
-                    );
+                    let mut ctx = lend_on_imu(ekf, &mut self.records, &mut self.integrity, imu);
                     step.zupt = self.sources.zupt.on_stance(&mut ctx, t_us);
                 }
                 if outcome.is_applied() {
@@ -442,4 +410,16 @@ impl AidedNavigator {
         self.records.start_navigating(self.last_time_us);
         self.phase = Phase::Navigating(ekf);
     }
+}
+
+/// The core as lent, while navigating, to an aiding source that runs on the IMU sample just
+/// propagated (tilt, zero velocity): the filter `ekf`, the records and integrity monitor its
+/// updates are booked in, and the stream as of that sample, `imu`.
+fn lend_on_imu<'a>(
+    ekf: &'a mut ErrorStateEkf,
+    records: &'a mut SourceRecords,
+    integrity: &'a mut IntegrityMonitor,
+    imu: ImuNow,
+) -> AidingContext<'a> {
+    AidingContext::new(CorePhase::Navigating(ekf), imu, records, integrity)
 }

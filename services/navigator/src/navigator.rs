@@ -20,7 +20,9 @@
 
 use ipc_types::{Integrity, NAV_STATES, NavMode, NavState, aiding, integrity_reason};
 
+use crate::aiding::baro::BaroReading;
 use crate::aiding::gnss::measurement::{GnssMeasurement, GnssOutcome};
+use crate::aiding::mag::MagReading;
 use crate::aiding::outcome::AidingOutcome;
 use crate::aiding::readings::{Reading, ReadingSink};
 use crate::alignment::{AlignError, Alignment};
@@ -297,7 +299,10 @@ impl Navigator {
 
     /// One magnetometer sample, µT, body FRD: the alignment heading, then heading updates.
     pub fn on_mag(&mut self, device_time_us: u64, field_ut: [f64; 3]) -> AidingOutcome {
-        self.core.on_mag(device_time_us, field_ut)
+        self.on_reading(Reading::Mag(MagReading {
+            t_us: device_time_us,
+            field_ut,
+        }))
     }
 
     /// One barometric height (m, positive up) with its variance (m²) at device time (µs);
@@ -309,14 +314,17 @@ impl Navigator {
         variance_m2: f64,
         valid: bool,
     ) -> AidingOutcome {
-        self.core
-            .on_baro(device_time_us, height_m, variance_m2, valid)
+        self.on_reading(Reading::Baro(BaroReading {
+            t_us: device_time_us,
+            height_m,
+            variance_m2,
+            valid,
+        }))
     }
 
-    /// One pitot differential pressure, Pa, at device time (µs) (see
-    /// [`crate::aiding::airspeed`]).
-    pub fn on_airspeed(&mut self, device_time_us: u64, diff_pressure_pa: f64) -> AidingOutcome {
-        self.core.on_airspeed(device_time_us, diff_pressure_pa)
+    /// One aiding reading of a topic of its own, applied now (see [`crate::aiding::readings`]).
+    pub fn on_reading(&mut self, r: Reading) -> AidingOutcome {
+        self.core.on_reading(r)
     }
 
     /// One GNSS receiver fix, measured at device time `t_us` (see [`AidedNavigator::on_gnss`]).
@@ -348,13 +356,12 @@ impl Navigator {
         if let Some(ekf) = ekf {
             let b = ekf.bias();
             (gyro_bias_rps, accel_bias_mps2) = (b.gyro_rps.into(), b.accel_mps2.into());
-            let bits = self.core.config().aiding_bits();
             for source in AidingSource::ALL {
                 let recent = self.core.last_accepted_us(source).is_some_and(|t| {
                     self.state_time_us <= t.saturating_add(self.aiding_timeout_us)
                 });
                 if recent {
-                    aiding_bits |= bits[source as usize];
+                    aiding_bits |= source.bit();
                 }
                 counts[source as usize] = ekf.counts(source);
             }
@@ -414,19 +421,7 @@ impl Navigator {
 
 impl ReadingSink for Navigator {
     fn take(&mut self, r: Reading) {
-        let _ = match r {
-            Reading::Baro {
-                t_us,
-                height_m,
-                variance_m2,
-                valid,
-            } => self.on_baro(t_us, height_m, variance_m2, valid),
-            Reading::Mag { t_us, field_ut } => self.on_mag(t_us, field_ut),
-            Reading::Airspeed {
-                t_us,
-                diff_pressure_pa,
-            } => self.on_airspeed(t_us, diff_pressure_pa),
-        };
+        let _ = self.on_reading(r);
     }
 }
 

@@ -1,4 +1,5 @@
-//! The navigator process: fused IMU drives the filter; altitude and magnetometer aid it.
+//! The navigator process: fused IMU drives the filter; the held aiding readings (altitude,
+//! magnetometer, airspeed: see [`crate::aiding::readings`]) and GNSS fixes aid it.
 //! A navigation state is published for every fused IMU sample, also while aligning, so consumers see
 //! a contiguous sequence.
 
@@ -6,8 +7,8 @@ use std::time::Duration;
 
 use anyhow::{Result, bail};
 use ipc_types::{
-    Altitude, FusedImu, GnssFix, Health, Integrity, NavMode, NavState, PAYLOAD_VERSION,
-    RawAirspeed, RawMag, ServiceKind, Stage, integrity_reason, names,
+    FusedImu, GnssFix, Health, Integrity, NavMode, NavState, PAYLOAD_VERSION, ServiceKind, Stage,
+    integrity_reason, names,
 };
 use rins_runtime::ipc::{IpcError, TopicSubscriber};
 use rins_runtime::service::{Service, ServiceContext};
@@ -17,8 +18,9 @@ use rins_runtime::stage_loop::{PipelineStage, StageLoop, StageTopics, Step};
 use crate::aiding::gnss::hold::GnssHold;
 use crate::aiding::gnss::monitor::{RejectReason, Transition};
 use crate::aiding::hold::HOLD_US;
-use crate::aiding::readings::{AidingQueue, Reading};
+use crate::aiding::readings::AidingQueue;
 use crate::ekf::AidingSource;
+use crate::held_inputs::HeldInputs;
 use crate::navigator::{Navigator, fused_sample_usable};
 use crate::takeover::Handover;
 
@@ -148,10 +150,8 @@ fn log_gnss(transition: Option<Transition>) {
 /// aiding topics read before each sample, the peer lane listened to while aligning.
 struct NavigatorStage {
     nav: Navigator,
-    alt_in: StageInput<Altitude>,
-    mag_in: StageInput<RawMag>,
-    /// Pitot airspeeds, when airspeed aiding is on.
-    airspeed_in: Option<StageInput<RawAirspeed>>,
+    /// The topics of the held aiding readings.
+    held_in: HeldInputs,
     /// Receiver fixes, when GNSS aiding is on.
     gnss_in: Option<StageInput<GnssFix>>,
     /// Fixes waiting for the IMU stream to place them.
@@ -179,15 +179,8 @@ impl PipelineStage for NavigatorStage {
     fn before_sample(&mut self, counters: &mut Health) -> Result<(), IpcError> {
         // Aiding is held, not applied: it meets the filter where the IMU stream passes its time.
         // Taken before every sample: a reading published before the sample's frame is in hand.
-        let (nav, queue) = (&mut self.nav, &mut self.aiding);
-        self.alt_in.drain(counters, |alt| {
-            queue.hold(Reading::from_altitude(&alt), nav)
-        })?;
-        self.mag_in
-            .drain(counters, |mag| queue.hold(Reading::from_mag(&mag), nav))?;
-        if let Some(airspeed_in) = &self.airspeed_in {
-            airspeed_in.drain(counters, |a| queue.hold(Reading::from_airspeed(&a), nav))?;
-        }
+        self.held_in
+            .drain(counters, &mut self.aiding, &mut self.nav)?;
         if let Some(gnss_in) = &self.gnss_in {
             let hold = &mut self.gnss_hold;
             gnss_in.drain(counters, |fix| hold.push(fix))?;
@@ -324,19 +317,14 @@ impl Service for NavigatorService {
             true => Some(StageInput::new(&node, names::GNSS)?),
             false => None,
         };
-        let airspeed_in = match self.navigator.config().airspeed.enabled {
-            true => Some(StageInput::new(&node, names::RAW_AIRSPEED)?),
-            false => None,
-        };
+        let held_in = HeldInputs::new(&node, self.navigator.config())?;
         let mut stage = NavigatorStage {
             gnss_in,
             gnss_hold: GnssHold::new(gnss.delay_s),
             gnss_transition: None,
             resets: self.navigator.resets(),
             nav: self.navigator,
-            alt_in: StageInput::new(&node, names::ALTITUDE)?,
-            mag_in: StageInput::new(&node, names::RAW_MAG)?,
-            airspeed_in,
+            held_in,
             peer_in,
             listening: false,
             handover: Handover::default(),

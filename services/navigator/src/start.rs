@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::aided_config::AidedConfig;
 use crate::attitude::quaternion_from_euler;
-use crate::checks::check_in;
+use crate::checks::Table;
 use crate::ekf::STATES;
 use crate::mechanisation::{ImuBias, NominalState};
 
@@ -58,58 +58,52 @@ pub struct StartState {
     pub variances: [f64; STATES],
 }
 
-fn check(
-    field: &'static str,
-    value: f64,
-    ok: impl Fn(f64) -> bool,
-    reason: &'static str,
-) -> Result<(), ConfigError> {
-    check_in("navigator.start", field, value, ok, reason)
-}
+/// The `[navigator.start]` table, for the range checks of its keys.
+const START: Table = Table("navigator.start");
 
 impl InFlightStart {
     /// Checks every value; the error names the key (`navigator.start.KEY`) and its value.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        check(
+        START.check(
             "time_s",
             self.time_s,
             |x| (0.0..=MAX_TIME_S).contains(&x),
             "must be a device time in [0, 1e12] s",
         )?;
-        check(
+        START.check(
             "roll_deg",
             self.roll_deg,
             |x| x.abs() <= 180.0,
             "must be in [-180, 180] degrees",
         )?;
-        check(
+        START.check(
             "pitch_deg",
             self.pitch_deg,
             |x| x.abs() <= 90.0,
             "must be in [-90, 90] degrees",
         )?;
-        check(
+        START.check(
             "heading_deg",
             self.heading_deg,
             |x| x.abs() <= 360.0,
             "must be in [-360, 360] degrees",
         )?;
         for v in self.velocity_ned_mps {
-            check(
+            START.check(
                 "velocity_ned_mps",
                 v,
                 |x| x.abs() <= MAX_SPEED_MPS,
                 "every entry must be in [-1000, 1000] m/s",
             )?;
         }
-        check(
+        START.check(
             "altitude_m",
             self.altitude_m,
             |x| (-1000.0..=50_000.0).contains(&x),
             "must be in [-1000, 50000] m",
         )?;
         for b in self.gyro_bias_dps.into_iter().flatten() {
-            check(
+            START.check(
                 "gyro_bias_dps",
                 b,
                 |x| x.abs() <= MAX_GYRO_BIAS_DPS,

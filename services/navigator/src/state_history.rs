@@ -27,12 +27,7 @@ const MIN_SPACING_US: u64 = 1_000;
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Entry {
     t_us: u64,
-    lat: f64,
-    lon: f64,
-    alt: f64,
-    velocity_ned: Vector3<f64>,
-    attitude: UnitQuaternion<f64>,
-    rate_body: Vector3<f64>,
+    state: PastState,
     totals: CorrectionTotals,
 }
 
@@ -70,6 +65,17 @@ impl PastState {
     /// `to − self` in local NED metres at this state's position.
     pub fn ned_to(&self, lat: f64, lon: f64, alt: f64) -> Vector3<f64> {
         Vector3::from(LocalOrigin::new(self.lat, self.lon, self.alt).ned(lat, lon, alt))
+    }
+
+    /// This state moved by `d` NED metres (the rest unchanged).
+    fn moved(&self, d: Vector3<f64>) -> Self {
+        let [lat, lon, alt] = LocalOrigin::new(self.lat, self.lon, self.alt).geodetic(d.into());
+        Self {
+            lat,
+            lon,
+            alt,
+            ..*self
+        }
     }
 }
 
@@ -116,15 +122,9 @@ impl StateHistory {
         if self.entries.len() == CAPACITY {
             self.entries.pop_front();
         }
-        let s = ekf.state();
         self.entries.push_back(Entry {
             t_us,
-            lat: s.lat,
-            lon: s.lon,
-            alt: s.alt,
-            velocity_ned: s.velocity_ned,
-            attitude: s.attitude,
-            rate_body,
+            state: PastState::now(ekf, rate_body),
             totals: *ekf.corrections(),
         });
     }
@@ -164,11 +164,8 @@ impl StateHistory {
 
 /// `a` moved on by `dt_s` at its velocity (north/east into latitude/longitude).
 fn extrapolate(a: &Entry, dt_s: f64) -> Entry {
-    let [lat, lon, alt] = moved(a, a.velocity_ned * dt_s);
     Entry {
-        lat,
-        lon,
-        alt,
+        state: a.state.moved(a.state.velocity_ned * dt_s),
         totals: CorrectionTotals {
             elapsed_s: a.totals.elapsed_s + dt_s,
             ..a.totals
@@ -181,24 +178,22 @@ fn extrapolate(a: &Entry, dt_s: f64) -> Entry {
 /// correction between them is rare and its share is below the interpolation's own error).
 fn interpolate(a: &Entry, b: &Entry, w: f64) -> Entry {
     let lerp = |x: f64, y: f64| x + w * (y - x);
+    let (sa, sb) = (&a.state, &b.state);
     Entry {
         t_us: a.t_us,
-        lat: lerp(a.lat, b.lat),
-        lon: a.lon + w * crate::attitude::wrap_pi(b.lon - a.lon),
-        alt: lerp(a.alt, b.alt),
-        velocity_ned: a.velocity_ned.lerp(&b.velocity_ned, w),
-        attitude: a.attitude.slerp(&b.attitude, w),
-        rate_body: a.rate_body.lerp(&b.rate_body, w),
+        state: PastState {
+            lat: lerp(sa.lat, sb.lat),
+            lon: sa.lon + w * crate::attitude::wrap_pi(sb.lon - sa.lon),
+            alt: lerp(sa.alt, sb.alt),
+            velocity_ned: sa.velocity_ned.lerp(&sb.velocity_ned, w),
+            attitude: sa.attitude.slerp(&sb.attitude, w),
+            rate_body: sa.rate_body.lerp(&sb.rate_body, w),
+        },
         totals: CorrectionTotals {
             elapsed_s: lerp(a.totals.elapsed_s, b.totals.elapsed_s),
             ..a.totals
         },
     }
-}
-
-/// The position of `e` moved by `d` NED metres.
-fn moved(e: &Entry, d: Vector3<f64>) -> [f64; 3] {
-    LocalOrigin::new(e.lat, e.lon, e.alt).geodetic(d.into())
 }
 
 /// `e` with the corrections made after it: see the module documentation.
@@ -207,13 +202,9 @@ fn corrected(e: &Entry, now: &CorrectionTotals) -> PastState {
     let dv = now.velocity_ned_mps - then.velocity_ned_mps;
     let dp = (now.position_ned_m - then.position_ned_m)
         - ((now.velocity_time - then.velocity_time) - dv * then.elapsed_s);
-    let [lat, lon, alt] = moved(e, dp);
+    let moved = e.state.moved(dp);
     PastState {
-        lat,
-        lon,
-        alt,
-        velocity_ned: e.velocity_ned + dv,
-        attitude: e.attitude,
-        rate_body: e.rate_body,
+        velocity_ned: moved.velocity_ned + dv,
+        ..moved
     }
 }

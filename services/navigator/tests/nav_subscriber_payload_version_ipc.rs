@@ -6,13 +6,9 @@
 
 use ipc_types::{NavMode, NavState, PAYLOAD_VERSION, names};
 use rins_navigator::lanes::NavSubscriber;
-use rins_runtime::ipc::{IpcNode, IpcSettings, SampleSource, TopicPublisher, create_node};
+use rins_runtime::ipc::{IpcNode, SampleSource, TopicPublisher};
 use rins_runtime::payload::Versioned;
-use rins_runtime::shm_cleanup;
-use rins_runtime::tool_node::ToolNode;
-
-/// Another build's version on either side of this one's.
-const OTHER_VERSIONS: [u16; 2] = [PAYLOAD_VERSION + 1, PAYLOAD_VERSION - 1];
+use rins_test_support::private_ipc::{OTHER_VERSIONS, on_private_node, on_tool_node};
 
 fn nav(lane: u8, version: u16, seq: u64) -> NavState {
     let mut s = NavState {
@@ -56,41 +52,14 @@ fn nav_subscriber_rejects(node: &IpcNode) {
     assert_eq!(sub.lane_totals(), [3, 3]);
 }
 
-fn settings(tag: &str) -> IpcSettings {
-    let pid = std::process::id();
-    IpcSettings::new(
-        format!("lnv{tag}{pid}_"),
-        std::env::temp_dir()
-            .join(format!("lnv{tag}{pid}root/"))
-            .to_string_lossy()
-            .into_owned(),
-    )
-}
-
-fn clean(settings: &IpcSettings) {
-    shm_cleanup::remove_all(settings, true);
-    let _ = std::fs::remove_dir_all(&settings.root);
-    assert!(shm_cleanup::shm_entries(settings).is_empty());
-}
-
 /// A service (mavlink, the watchdog) reads the stream from a node of its own.
 #[test]
 fn the_navigation_stream_drops_another_version_on_either_lane() {
-    let settings = settings("nv");
-    {
-        let node = create_node("nv", &settings).expect("node");
-        nav_subscriber_rejects(&node);
-    }
-    clean(&settings);
+    on_private_node("nv", nav_subscriber_rejects);
 }
 
 /// A tool (`rins echo nav`) reads it from the tool's node.
 #[test]
 fn a_tools_navigation_stream_drops_another_version() {
-    let settings = settings("tl");
-    {
-        let tool = ToolNode::join_settings("echo", settings.clone()).expect("tool node");
-        nav_subscriber_rejects(tool.node());
-    }
-    clean(&settings);
+    on_tool_node("tl", nav_subscriber_rejects);
 }

@@ -6,6 +6,7 @@ use crate::calibration_config::CalibrationConfig;
 use crate::error::{SimError, check_positive, check_range};
 use crate::sensor_model::mag::EarthField;
 use crate::sensor_model::{Environment, SensorModelConfig};
+use crate::slow_sensor_list::slow_sensor_list;
 use crate::trajectory::multirotor_config::MultirotorConfig;
 use crate::trajectory::{Scenario, TrajectoryStart};
 
@@ -123,6 +124,38 @@ impl Default for SimConfig {
     }
 }
 
+/// `check_slow_sensors`: the settings checks of the listed slower sensors (their CHECK; their
+/// BUILD is read by `slow_sensors.rs`), in list order.
+macro_rules! slow_sensor_checks {
+    ($($name:ident $(in mod $module:ident)?: fitted $build:expr, checked $check:expr;)*) => {
+        fn check_slow_sensors(config: &SimConfig) -> Result<(), SimError> {
+            $(check(config, $check)?;)*
+            Ok(())
+        }
+    };
+}
+
+slow_sensor_list!(slow_sensor_checks);
+
+/// Runs one entry's CHECK (a function, so that its closure's argument type is known).
+fn check(
+    config: &SimConfig,
+    check: impl FnOnce(&SimConfig) -> Result<(), SimError>,
+) -> Result<(), SimError> {
+    check(config)
+}
+
+/// Checks a slower sensor's frame rate, Hz: positive and at most the IMU rate the frames are
+/// scheduled on.
+fn check_rate(field: &'static str, rate_hz: f64, config: &SimConfig) -> Result<(), SimError> {
+    check_positive(
+        field,
+        rate_hz,
+        config.imu_rate_hz,
+        "must be > 0 and <= device.imu_rate_hz",
+    )
+}
+
 impl SimConfig {
     /// Checks every field; the error names the field (`sim.…`) and its value.
     pub fn validate(&self) -> Result<(), SimError> {
@@ -132,18 +165,8 @@ impl SimConfig {
             MAX_IMU_RATE_HZ,
             "must be > 0 and <= 100000",
         )?;
-        for (field, rate) in [
-            ("sim.baro_rate_hz", self.baro_rate_hz),
-            ("sim.mag_rate_hz", self.mag_rate_hz),
-            ("sim.aux_rate_hz", self.aux_rate_hz),
-        ] {
-            check_positive(
-                field,
-                rate,
-                self.imu_rate_hz,
-                "must be > 0 and <= device.imu_rate_hz",
-            )?;
-        }
+        // The slower sensors' own checks (their rates against the IMU's first of all).
+        check_slow_sensors(self)?;
         check_range(
             "sim.origin_latitude_deg",
             self.origin_latitude_deg,
@@ -221,7 +244,6 @@ impl SimConfig {
         self.gnss
             .validate(self.imu_rate_hz)
             .map_err(SimError::GnssReceiver)?;
-        self.airspeed.validate(self.imu_rate_hz)?;
         self.sensors.validate()
     }
 

@@ -24,6 +24,7 @@ pub mod service;
 pub mod sim_command;
 pub mod simulator;
 mod slow_sensor;
+mod slow_sensor_list;
 mod slow_sensors;
 mod streaming;
 pub mod trajectory;

@@ -1,9 +1,8 @@
 //! The simulator: one call per IMU period fills the frames the sensor block would send.
 //!
-//! The base tick is the IMU period. The slower sensors' frames ([`crate::slow_sensors`]:
-//! barometer, magnetometer, auxiliary, airspeed) are emitted on the ticks where
-//! `⌊k·rate/imu_rate⌋` advances (and on tick 0), so any rate up to the IMU rate works without
-//! drift and without requiring an integer ratio.
+//! The base tick is the IMU period. The frames of the slower sensors (those listed in
+//! `slow_sensor_list.rs`) are emitted on the ticks where `⌊k·rate/imu_rate⌋` advances (and on tick
+//! 0), so any rate up to the IMU rate works without drift and without requiring an integer ratio.
 
 use rins_protocol::{Frame, FrameType, ImuFrame, Payload};
 
@@ -53,39 +52,26 @@ impl Default for TruthSample {
 pub struct TickOutput {
     /// The IMU frame (every tick).
     pub imu: Frame,
-    /// Barometer frame, when one falls due on this tick.
-    pub baro: Option<Frame>,
-    /// Magnetometer frame, when one falls due.
-    pub mag: Option<Frame>,
-    /// Auxiliary (foot-pressure) frame, when one falls due.
-    pub aux: Option<Frame>,
-    /// Airspeed frame, when the sensor is fitted and one falls due.
-    pub airspeed: Option<Frame>,
+    /// The slower sensors' frames at their frame type's [`FrameType::index`], `None` where none
+    /// fell due (the IMU's slot stays `None`: its frame is `imu`). One slot per type, so a new
+    /// frame type needs no field here.
+    slow: [Option<Frame>; FrameType::COUNT],
     /// Truth at the IMU sample time.
     pub truth: TruthSample,
 }
 
 impl TickOutput {
-    /// Where a frame of type `frame` goes; `None` for the IMU's, filled every tick.
-    fn slot_mut(&mut self, frame: FrameType) -> Option<&mut Option<Frame>> {
+    /// The tick's frame of type `frame`, `None` where none fell due (or the sensor is not fitted).
+    pub fn frame(&self, frame: FrameType) -> Option<&Frame> {
         match frame {
-            FrameType::Imu => None,
-            FrameType::Baro => Some(&mut self.baro),
-            FrameType::Mag => Some(&mut self.mag),
-            FrameType::Aux => Some(&mut self.aux),
-            FrameType::Airspeed => Some(&mut self.airspeed),
+            FrameType::Imu => Some(&self.imu),
+            _ => self.slow[frame.index()].as_ref(),
         }
     }
 
     /// The frames of the tick in frame-type order, `None` where none fell due.
     pub fn frames(&self) -> [Option<&Frame>; FrameType::COUNT] {
-        FrameType::ALL.map(|t| match t {
-            FrameType::Imu => Some(&self.imu),
-            FrameType::Baro => self.baro.as_ref(),
-            FrameType::Mag => self.mag.as_ref(),
-            FrameType::Aux => self.aux.as_ref(),
-            FrameType::Airspeed => self.airspeed.as_ref(),
-        })
+        FrameType::ALL.map(|t| self.frame(t))
     }
 }
 
@@ -97,10 +83,7 @@ impl Default for TickOutput {
                 device_time_us: 0,
                 payload: Payload::Imu(ImuFrame::default()),
             },
-            baro: None,
-            mag: None,
-            aux: None,
-            airspeed: None,
+            slow: [None; FrameType::COUNT],
             truth: TruthSample::default(),
         }
     }
@@ -222,11 +205,7 @@ impl Simulator {
             payload: Payload::Imu(imu),
         };
 
-        for frame in FrameType::ALL {
-            if let Some(slot) = out.slot_mut(frame) {
-                *slot = None;
-            }
-        }
+        out.slow = [None; FrameType::COUNT];
         let at = SampleAt {
             t_s: t,
             truth: &truth,
@@ -238,8 +217,9 @@ impl Simulator {
             }
             let payload = sensor.sample(&at, &mut self.sensors);
             let frame = payload.frame_type();
-            if let Some(slot) = out.slot_mut(frame) {
-                *slot = Some(Frame {
+            // A slower sensor never sends the IMU's frame; were one to, it would not replace it.
+            if frame != FrameType::Imu {
+                out.slow[frame.index()] = Some(Frame {
                     seq: next(&mut self.seq[frame.index()]),
                     device_time_us,
                     payload,

@@ -1,5 +1,5 @@
 //! What the simulator asks of a sensor sampled slower than the IMU: its frame rate and one sample
-//! into its frame's payload. The list of such sensors is in `slow_sensors.rs`; each model
+//! into its frame's payload. The list of such sensors is in `slow_sensor_list.rs`; each model
 //! implements this trait beside its own code.
 
 use rins_protocol::Payload;

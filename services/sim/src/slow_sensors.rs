@@ -1,7 +1,6 @@
 //! The sensors sampled slower than the IMU — barometer, magnetometer, auxiliary (foot pressure),
-//! airspeed — each behind one small trait: its frame rate and one sample into its frame's payload.
-//! [`slow_sensors`] is the one list of them that the simulator steps; a new sensor is its model
-//! (with this trait implemented) and one line there.
+//! airspeed — each behind one small trait ([`SlowSensor`]: its frame rate and one sample into its
+//! frame's payload), fitted as the one list of them (`slow_sensor_list.rs`) says.
 //!
 //! Each sensor draws from its own random stream, so the order of the list changes no sample: a
 //! sensor that is not fitted draws nothing and leaves every other frame as it was.
@@ -10,21 +9,37 @@ use rins_protocol::{AuxFrame, BaroFrame, MagFrame, Payload};
 
 use crate::config::SimConfig;
 use crate::sensor_model::SensorModel;
-use crate::sensor_model::airspeed::AirspeedModel;
 use crate::slow_sensor::{SampleAt, SlowSensor};
+use crate::slow_sensor_list::slow_sensor_list;
 
-/// Every slower sensor `config` fits, one line each; `seed` seeds the ones with their own stream.
-pub(crate) fn slow_sensors(config: &SimConfig, seed: u64) -> Vec<Box<dyn SlowSensor>> {
-    let fitted: Vec<Option<Box<dyn SlowSensor>>> = vec![
-        Some(Box::new(Baro(config.baro_rate_hz))),
-        Some(Box::new(Mag(config.mag_rate_hz))),
-        Some(Box::new(Aux(config.aux_rate_hz))),
-        config.airspeed.enabled.then(|| {
-            Box::new(AirspeedModel::new(config.airspeed, config.qnh_pa, seed))
-                as Box<dyn SlowSensor>
-        }),
-    ];
-    fitted.into_iter().flatten().collect()
+/// [`slow_sensors`] of the listed sensors (their BUILD; their CHECK is read by `config.rs`).
+macro_rules! fitted_sensors {
+    ($($name:ident $(in mod $module:ident)?: fitted $build:expr, checked $check:expr;)*) => {
+        $($(use crate::sensor_model::$module;)?)*
+
+        /// Every slower sensor `config` fits, in list order; `seed` seeds the ones with their own
+        /// stream.
+        pub(crate) fn slow_sensors(config: &SimConfig, seed: u64) -> Vec<Box<dyn SlowSensor>> {
+            let mut fitted: Vec<Box<dyn SlowSensor>> = Vec::new();
+            $(
+                if let Some(sensor) = build(config, seed, $build) {
+                    fitted.push(Box::new(sensor));
+                }
+            )*
+            fitted
+        }
+    };
+}
+
+slow_sensor_list!(fitted_sensors);
+
+/// Runs one entry's BUILD (a function, so that its closure's argument types are known).
+fn build<S: SlowSensor + 'static>(
+    config: &SimConfig,
+    seed: u64,
+    build: impl FnOnce(&SimConfig, u64) -> Option<S>,
+) -> Option<S> {
+    build(config, seed)
 }
 
 /// The barometer at its rate, Hz, at the true altitude.

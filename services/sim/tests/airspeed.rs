@@ -1,7 +1,7 @@
 //! The pitot airspeed sensor in the frame stream: off by default and then invisible, on at its
 //! rate without touching any other frame, and reading the dynamic pressure of the true airspeed.
 
-use rins_protocol::{AirspeedFrame, Payload};
+use rins_protocol::{AirspeedFrame, Frame, FrameType, Payload};
 use rins_sim::sensor_model::airspeed::isa_density;
 use rins_sim::{SimConfig, Simulator, TickOutput};
 use rins_test_support::pyramid::optimal_pyramid_axes;
@@ -12,9 +12,17 @@ fn sim(config: &SimConfig) -> Simulator {
 }
 
 fn airspeed(out: &TickOutput) -> Option<AirspeedFrame> {
-    out.airspeed.map(|f| match f.payload {
+    out.frame(FrameType::Airspeed).map(|f| match f.payload {
         Payload::Airspeed(a) => a,
         other => panic!("expected an airspeed frame, got {other:?}"),
+    })
+}
+
+/// The tick's frames other than the airspeed sensor's.
+fn others(out: &TickOutput) -> [Option<Frame>; FrameType::COUNT] {
+    FrameType::ALL.map(|t| match t {
+        FrameType::Airspeed => None,
+        _ => out.frame(t).copied(),
     })
 }
 
@@ -30,12 +38,9 @@ fn off_by_default_and_on_it_changes_no_other_frame() {
     for _ in 0..2000 {
         off.step(&mut a);
         on.step(&mut b);
-        assert_eq!(a.airspeed, None);
-        assert_eq!(
-            (a.imu, a.baro, a.mag, a.aux, a.truth),
-            (b.imu, b.baro, b.mag, b.aux, b.truth)
-        );
-        frames.extend(b.airspeed);
+        assert_eq!(a.frame(FrameType::Airspeed), None);
+        assert_eq!((others(&a), a.truth), (others(&b), b.truth));
+        frames.extend(b.frame(FrameType::Airspeed).copied());
     }
     // 50 Hz over 2 s, numbered from 0 without a gap, stamped with the IMU's device time.
     assert_eq!(frames.len(), 100);

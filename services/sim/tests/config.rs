@@ -84,6 +84,9 @@ fn validation_errors_name_field_and_value() {
     assert!(error_of(|c| c.baro_rate_hz = -5.0).starts_with("sim.baro_rate_hz = -5: must be > 0"));
     assert!(error_of(|c| c.mag_rate_hz = 2000.0).contains("<= device.imu_rate_hz"));
     assert!(error_of(|c| c.aux_rate_hz = 0.0).starts_with("sim.aux_rate_hz = 0"));
+    // A sensor that is not fitted still has its settings checked.
+    assert!(error_of(|c| c.airspeed.rate_hz = 0.0).starts_with("sim.airspeed.rate_hz = 0"));
+    assert!(error_of(|c| c.airspeed.noise_pa = -1.0).starts_with("sim.airspeed.noise_pa = -1"));
     assert!(error_of(|c| c.origin_latitude_deg = 89.0).starts_with("sim.origin_latitude_deg = 89"));
     assert!(
         error_of(|c| c.origin_longitude_deg = 181.0).starts_with("sim.origin_longitude_deg = 181")

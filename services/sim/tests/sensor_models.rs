@@ -5,7 +5,7 @@ mod common;
 use nalgebra::{UnitQuaternion, Vector3};
 use proptest::prelude::*;
 use rins_earth::STANDARD_GRAVITY;
-use rins_protocol::{BaroFrame, ImuFrame, MagFrame, Payload};
+use rins_protocol::{BaroFrame, FrameType, ImuFrame, MagFrame, Payload};
 use rins_sim::sensor_model::baro::{isa_altitude_m, isa_pressure_pa};
 use rins_sim::sensor_model::{Environment, SensorModel};
 use rins_sim::{Scenario, SensorModelConfig, SimConfig, Simulator, TickOutput, TruthState};
@@ -219,7 +219,7 @@ fn mean_mag(heading_deg: f64, declination_deg: f64) -> Vector3<f64> {
     let mut count = 0.0;
     for _ in 0..10_000 {
         sim.step(&mut out);
-        if let Some(frame) = out.mag {
+        if let Some(frame) = out.frame(FrameType::Mag) {
             let Payload::Mag(mag) = frame.payload else {
                 panic!("not a mag frame")
             };

@@ -3,7 +3,7 @@
 mod common;
 
 use proptest::prelude::*;
-use rins_protocol::{Frame, ImuFrame, Payload};
+use rins_protocol::{Frame, FrameType, ImuFrame, Payload};
 use rins_sim::sensor_model::baro::isa_pressure_pa;
 use rins_sim::{
     ChannelFault, InertialSensor, Scenario, SimConfig, SimError, Simulator, TickOutput,
@@ -35,9 +35,9 @@ fn frames_are_scheduled_at_their_rates_with_contiguous_sequences() {
         assert_eq!(out.truth.device_time_us, u64::from(k) * 1000);
         assert_eq!(out.truth.imu_seq, u64::from(k));
         for (slot, list) in [
-            (&out.baro, &mut baro),
-            (&out.mag, &mut mag),
-            (&out.aux, &mut aux),
+            (out.frame(FrameType::Baro), &mut baro),
+            (out.frame(FrameType::Mag), &mut mag),
+            (out.frame(FrameType::Aux), &mut aux),
         ] {
             if let Some(f) = slot {
                 assert_eq!(f.device_time_us, out.imu.device_time_us);
@@ -54,7 +54,28 @@ fn frames_are_scheduled_at_their_rates_with_contiguous_sequences() {
     for (i, (k, seq)) in mag.iter().chain(aux.iter()).enumerate() {
         assert_eq!((*k, *seq), (10 * (i % 100) as u32, (i % 100) as u16));
     }
-    assert!(out.baro.is_none() && (s.time_s() - 1.0).abs() < 1e-12);
+    assert!(out.frame(FrameType::Baro).is_none() && (s.time_s() - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn the_first_tick_carries_every_fitted_sensor_in_frame_type_order() {
+    let mut config = SimConfig::default();
+    config.airspeed.enabled = true;
+    let mut s = sim(&config, 1);
+    let mut out = TickOutput::default();
+    s.step(&mut out);
+    // Every rate falls due on tick 0: one frame of each type, each first of its sequence.
+    let frames = out.frames();
+    for (t, frame) in FrameType::ALL.into_iter().zip(frames) {
+        let frame = frame.unwrap_or_else(|| panic!("no {t:?} frame on tick 0"));
+        assert_eq!(frame.payload.frame_type(), t);
+        assert_eq!((frame.seq, frame.device_time_us), (0, 0));
+        assert_eq!(out.frame(t), Some(frame));
+    }
+    // Off, the airspeed sensor leaves its place empty, even in an output that held its frame.
+    let mut s = sim(&SimConfig::default(), 1);
+    s.step(&mut out);
+    assert_eq!(out.frame(FrameType::Airspeed), None);
 }
 
 proptest! {
@@ -75,8 +96,8 @@ proptest! {
         let (mut baro, mut mag) = (0usize, 0usize);
         for _ in 0..n {
             s.step(&mut out);
-            baro += usize::from(out.baro.is_some());
-            mag += usize::from(out.mag.is_some());
+            baro += usize::from(out.frame(FrameType::Baro).is_some());
+            mag += usize::from(out.frame(FrameType::Mag).is_some());
         }
         let expected = (((n - 1) as f64) * baro_rate / f64::from(imu_rate)).floor() as usize + 1;
         prop_assert_eq!(baro, expected);
@@ -134,7 +155,7 @@ fn truth_sample_matches_trajectory_and_baro_follows_true_altitude() {
     for k in 0..cruise_tick + 1000 {
         s.step(&mut out);
         if k >= cruise_tick
-            && let Some(f) = out.baro
+            && let Some(f) = out.frame(FrameType::Baro)
         {
             let Payload::Baro(b) = f.payload else {
                 panic!()

@@ -7,7 +7,7 @@ mod common;
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use rins_earth::STANDARD_GRAVITY;
 use rins_earth::{meridian_radius, prime_vertical_radius};
-use rins_protocol::Payload;
+use rins_protocol::{FrameType, Payload};
 use rins_sim::trajectory::geodesy::geodetic_rates;
 use rins_sim::trajectory::walk::{
     self, COURSE_LENGTH_M, COURSE_WIDTH_M, FINAL_STAND_S, LIFT_M, LOAD_RAMP_S, PATH_LENGTH_M,
@@ -424,7 +424,9 @@ fn simulator_foot_pressure_frames_follow_the_load() {
     let (mut stance_frames, mut swing_frames) = (0, 0);
     while sim.time_s() < sim.trajectory().end_s() + 1.0 {
         sim.step(&mut out);
-        let Some(frame) = out.aux else { continue };
+        let Some(frame) = out.frame(FrameType::Aux) else {
+            continue;
+        };
         let Payload::Aux(aux) = frame.payload else {
             panic!("not an aux frame")
         };

@@ -22,9 +22,11 @@
 use ipc_types::NavMode;
 use rins_altimeter::{AltimeterConfig, AltitudeEstimator};
 use rins_fusion::{FusionConfig, ImuFuser, ImuSample};
+use rins_navigator::aiding::airspeed::AirspeedReading;
+use rins_navigator::aiding::readings::Reading;
 use rins_navigator::navigator::fused_sample_usable;
 use rins_navigator::{Navigator, NavigatorConfig};
-use rins_protocol::Payload;
+use rins_protocol::{FrameType, Payload};
 use rins_sim::{SimConfig, Simulator, TickOutput};
 
 /// Device seconds flown: take-off, climb and most of the first circuit pair's legs and turns.
@@ -77,22 +79,25 @@ fn fly(airspeed_aid: bool) -> FlightErrors {
     for _ in 0..ticks {
         sim.step(&mut tick);
         let t_us = tick.truth.device_time_us;
-        if let Some(frame) = &tick.baro
+        if let Some(frame) = tick.frame(FrameType::Baro)
             && let Payload::Baro(baro) = frame.payload
         {
             let a = altimeter.update(t_us, f64::from(baro.pressure_pa));
             let _ = navigator.on_baro(t_us, a.height_m, a.height_var, a.valid);
         }
-        if let Some(frame) = &tick.mag
+        if let Some(frame) = tick.frame(FrameType::Mag)
             && let Payload::Mag(mag) = frame.payload
         {
             let _ = navigator.on_mag(t_us, mag.field_nt.map(|nt| f64::from(nt) * 1e-3));
         }
-        if let Some(frame) = &tick.airspeed
+        if let Some(frame) = tick.frame(FrameType::Airspeed)
             && let Payload::Airspeed(a) = frame.payload
         {
             airspeed_frames += 1;
-            let _ = navigator.on_airspeed(t_us, f64::from(a.diff_pressure_pa));
+            let _ = navigator.on_reading(Reading::Airspeed(AirspeedReading {
+                t_us,
+                diff_pressure_pa: f64::from(a.diff_pressure_pa),
+            }));
         }
         let Payload::Imu(imu) = &tick.imu.payload else {
             unreachable!("every tick carries an IMU frame")

@@ -7,7 +7,7 @@ use super::field_type::layout_of;
 /// Lists every payload of the topic table, in its order; each is named from the table, so a new
 /// payload needs no line here.
 macro_rules! payload_lists {
-    ($($payload:ident ($kind:ident) { $($topics:tt)* })+) => {
+    ($($payload:ident $kind:ident;)+) => {
         /// Every top-level payload (each starts with `version`); the nested structs are reached
         /// through their fields.
         pub static PAYLOADS: [&StructLayout; PAYLOAD_COUNT] = [$(layout_of::<ipc_types::$payload>()),+];
@@ -20,7 +20,7 @@ macro_rules! payload_lists {
     };
 }
 
-ipc_types::for_each_topic!(payload_lists);
+ipc_types::for_each_topic!(payloads => payload_lists);
 
 /// The largest payload, bytes: what a fixed buffer must hold to carry any of them.
 pub const MAX_PAYLOAD: usize = {

@@ -13,14 +13,13 @@
 //! Readings arrive on their own topic, like the barometer's, and are applied to the filter's
 //! current state; one further than `max_lag_s` from the navigation time is dropped.
 
-use ipc_types::{aiding, integrity_reason as why};
+use ipc_types::{RawAirspeed, integrity_reason as why};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector1, Vector3};
-use rins_runtime::config_error::ConfigError;
 use serde::{Deserialize, Serialize};
 
 use crate::aiding::context::AidingContext;
 use crate::aiding::outcome::AidingOutcome;
-use crate::aiding::source::{AidingSensor, Bucket};
+use crate::aiding::source::stream_aiding_sensor;
 use crate::checks::positive;
 use crate::ekf::{ATT, AidingSource, Linearised, STATES, VEL};
 
@@ -82,38 +81,12 @@ impl AirspeedAidingConfig {
     }
 }
 
-impl AidingSensor for AirspeedAidingConfig {
-    fn source(&self) -> AidingSource {
-        AidingSource::Airspeed
-    }
-
-    fn buckets(&self) -> &'static [Bucket] {
-        &[Bucket {
-            source: AidingSource::Airspeed,
-            aiding_bit: aiding::AIRSPEED,
-            inconsistent: why::AIRSPEED_INCONSISTENT,
-        }]
-    }
-
-    fn enabled(&self) -> bool {
-        self.enabled
-    }
-
-    fn watched_for_staleness(&self) -> bool {
-        true
-    }
-
-    fn validate(&self) -> Result<(), ConfigError> {
-        self.check().map_err(|(field, value)| {
-            ConfigError::new(
-                field,
-                value,
-                "out of range (|offset_pa| <= 1000, others finite and > 0)",
-            )
-            .within("navigator.airspeed")
-        })
-    }
-}
+stream_aiding_sensor!(
+    AirspeedAidingConfig => Airspeed,
+    inconsistent: why::AIRSPEED_INCONSISTENT,
+    section: "navigator.airspeed",
+    range: "out of range (|offset_pa| <= 1000, others finite and > 0)",
+);
 
 /// The predicted body-x velocity `u = (Ĉᵀ v̂)_x` of attitude `c` (body → NED) and velocity `v`
 /// (NED), with its Jacobian in the filter's error convention (`C = (I + [δθ×]) Ĉ`,
@@ -128,6 +101,25 @@ pub fn body_x_velocity(c: &Matrix3<f64>, v: &Vector3<f64>) -> (f64, SMatrix<f64,
         h[(0, ATT + k)] = d_att[k];
     }
     (x.dot(v), h)
+}
+
+/// One pitot differential pressure.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AirspeedReading {
+    /// Device time, µs.
+    pub t_us: u64,
+    /// Differential pressure, Pa.
+    pub diff_pressure_pa: f64,
+}
+
+impl AirspeedReading {
+    /// A raw airspeed sample as the sensor block publishes it.
+    pub fn from_raw(airspeed: &RawAirspeed) -> Self {
+        Self {
+            t_us: airspeed.header.origin_device_time_us,
+            diff_pressure_pa: f64::from(airspeed.diff_pressure_pa),
+        }
+    }
 }
 
 /// The airspeed aiding: its settings (it keeps nothing between readings).
@@ -146,9 +138,12 @@ impl AirspeedAiding {
     pub(crate) fn on_reading(
         &self,
         ctx: &mut AidingContext<'_>,
-        t_us: u64,
-        diff_pressure_pa: f64,
+        r: AirspeedReading,
     ) -> AidingOutcome {
+        let AirspeedReading {
+            t_us,
+            diff_pressure_pa,
+        } = r;
         let c = self.config;
         if !diff_pressure_pa.is_finite() {
             return AidingOutcome::Skipped;

@@ -4,13 +4,12 @@
 //! rather than applied to the wrong epoch. The first valid reading is the altitude navigation
 //! starts from.
 
-use ipc_types::{aiding, integrity_reason as why};
-use rins_runtime::config_error::ConfigError;
+use ipc_types::{Altitude, integrity_reason as why};
 use serde::{Deserialize, Serialize};
 
 use crate::aiding::context::AidingContext;
 use crate::aiding::outcome::AidingOutcome;
-use crate::aiding::source::{AidingSensor, Bucket};
+use crate::aiding::source::stream_aiding_sensor;
 use crate::checks::positive;
 use crate::ekf::{AidingSource, POS, VEL};
 
@@ -60,31 +59,35 @@ impl BaroAidingConfig {
     }
 }
 
-impl AidingSensor for BaroAidingConfig {
-    fn source(&self) -> AidingSource {
-        AidingSource::Baro
-    }
+stream_aiding_sensor!(
+    BaroAidingConfig => Baro,
+    inconsistent: why::BARO_INCONSISTENT,
+    section: "navigator.baro",
+    range: "must be finite and > 0",
+);
 
-    fn buckets(&self) -> &'static [Bucket] {
-        &[Bucket {
-            source: AidingSource::Baro,
-            aiding_bit: aiding::BARO,
-            inconsistent: why::BARO_INCONSISTENT,
-        }]
-    }
+/// One barometric height as the altimeter publishes it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BaroReading {
+    /// Device time, µs.
+    pub t_us: u64,
+    /// Height above mean sea level, m.
+    pub height_m: f64,
+    /// Its variance, m².
+    pub variance_m2: f64,
+    /// The altimeter's validity flag.
+    pub valid: bool,
+}
 
-    fn enabled(&self) -> bool {
-        self.enabled
-    }
-
-    fn watched_for_staleness(&self) -> bool {
-        true
-    }
-
-    fn validate(&self) -> Result<(), ConfigError> {
-        self.check().map_err(|(field, value)| {
-            ConfigError::new(field, value, "must be finite and > 0").within("navigator.baro")
-        })
+impl BaroReading {
+    /// The altimeter's height.
+    pub fn from_altitude(alt: &Altitude) -> Self {
+        Self {
+            t_us: alt.header.origin_device_time_us,
+            height_m: alt.height_m,
+            variance_m2: alt.height_var,
+            valid: alt.valid != 0,
+        }
     }
 }
 
@@ -121,11 +124,14 @@ impl BaroAiding {
     pub(crate) fn on_reading(
         &mut self,
         ctx: &mut AidingContext<'_>,
-        t_us: u64,
-        height_m: f64,
-        variance_m2: f64,
-        valid: bool,
+        r: BaroReading,
     ) -> AidingOutcome {
+        let BaroReading {
+            t_us,
+            height_m,
+            variance_m2,
+            valid,
+        } = r;
         let c = self.config;
         if !valid || !height_m.is_finite() {
             return AidingOutcome::Skipped;

@@ -3,9 +3,8 @@
 //! update, HUPT, when `stance_only`). The measurement model and its adaptive noise are in
 //! [`crate::aiding::mag_heading`].
 
-use ipc_types::{aiding, integrity_reason as why};
+use ipc_types::{RawMag, integrity_reason as why};
 use nalgebra::Vector3;
-use rins_runtime::config_error::ConfigError;
 
 use crate::aiding::context::AidingContext;
 use crate::aiding::mag_heading::{
@@ -17,6 +16,25 @@ use crate::alignment::Alignment;
 use crate::attitude::{rotation_vector_to_quaternion, wrap_pi};
 use crate::ekf::{ATT, AidingSource};
 use crate::mag_calibration::MagCalibration;
+
+/// One raw magnetometer sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MagReading {
+    /// Device time, µs.
+    pub t_us: u64,
+    /// Raw field, µT, body FRD.
+    pub field_ut: [f64; 3],
+}
+
+impl MagReading {
+    /// A raw magnetometer sample as the sensor block publishes it.
+    pub fn from_raw(mag: &RawMag) -> Self {
+        Self {
+            t_us: mag.header.origin_device_time_us,
+            field_ut: mag.field_ut.map(f64::from),
+        }
+    }
+}
 
 impl AidingSensor for MagAidingConfig {
     /// Heading updates in stance only are booked as HUPT, the others as magnetometer updates.
@@ -33,12 +51,10 @@ impl AidingSensor for MagAidingConfig {
         &[
             Bucket {
                 source: AidingSource::Mag,
-                aiding_bit: aiding::MAG,
                 inconsistent: why::MAG_INCONSISTENT,
             },
             Bucket {
                 source: AidingSource::Hupt,
-                aiding_bit: aiding::HUPT,
                 inconsistent: why::ZUPT_INCONSISTENT,
             },
         ]
@@ -54,15 +70,15 @@ impl AidingSensor for MagAidingConfig {
         !self.stance_only
     }
 
-    fn validate(&self) -> Result<(), ConfigError> {
-        self.check().map_err(|(field, value)| {
-            ConfigError::new(
-                field,
-                value,
-                "out of range (inflation >= 1, max_rate_hz >= 0, others finite and > 0)",
-            )
-            .within("navigator.mag")
-        })
+    fn first_out_of_range(&self) -> Result<(), (&'static str, f64)> {
+        self.check()
+    }
+
+    fn section(&self) -> (&'static str, &'static str) {
+        (
+            "navigator.mag",
+            "out of range (inflation >= 1, max_rate_hz >= 0, others finite and > 0)",
+        )
     }
 }
 
@@ -116,12 +132,15 @@ impl MagAiding {
     /// One magnetometer sample (raw µT, body FRD) at device time `t_us`: calibrated, then used
     /// for the alignment heading, or as a heading update (only in stance, counted as HUPT, when
     /// `stance_only`).
-    pub(crate) fn on_sample(
+    pub(crate) fn on_reading(
         &mut self,
         ctx: &mut AidingContext<'_>,
-        t_us: u64,
-        raw_ut: [f64; 3],
+        r: MagReading,
     ) -> AidingOutcome {
+        let MagReading {
+            t_us,
+            field_ut: raw_ut,
+        } = r;
         if raw_ut.iter().any(|x| !x.is_finite()) {
             return AidingOutcome::Skipped;
         }

@@ -6,15 +6,13 @@ use rins_runtime::config_error::ConfigError;
 
 use crate::ekf::AidingSource;
 
-/// How the navigator reports one bucket of updates: the `ipc_types::aiding` bit that says it
-/// aids the solution, and the `ipc_types::integrity_reason` bit raised when its innovations are
+/// How the navigator reports one bucket of updates (its aiding bit is its source's,
+/// [`AidingSource::bit`]): the `ipc_types::integrity_reason` bit raised when its innovations are
 /// inconsistent (0: its verdicts never count).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Bucket {
     /// The bucket.
     pub(crate) source: AidingSource,
-    /// Its aiding bit in the navigation state.
-    pub(crate) aiding_bit: u32,
     /// Its reason bit when its innovations are inconsistent.
     pub(crate) inconsistent: u32,
 }
@@ -43,6 +41,66 @@ pub(crate) trait AidingSensor {
         true
     }
 
-    /// Its settings' first out-of-range value, named within its `[navigator.<source>]` section.
-    fn validate(&self) -> Result<(), ConfigError>;
+    /// `(field, value)` of its settings' first out-of-range value.
+    fn first_out_of_range(&self) -> Result<(), (&'static str, f64)>;
+
+    /// Its settings' section (`navigator.<source>`), and what is in range there in words, for the
+    /// error that names the first value out of range.
+    fn section(&self) -> (&'static str, &'static str);
+
+    /// Its settings' first out-of-range value, named within its section.
+    fn validate(&self) -> Result<(), ConfigError> {
+        let (section, range) = self.section();
+        self.first_out_of_range()
+            .map_err(|(field, value)| ConfigError::new(field, value, range).within(section))
+    }
 }
+
+/// Implements [`AidingSensor`] for the settings of a source whose readings arrive on a stream of
+/// their own (a silence is an outage), booked under one bucket, applied while the settings'
+/// `enabled` field is set and range-checked by their `check()` method (`(field, value)` of the
+/// first value out of range). Grammar, one invocation per settings type:
+///
+/// ```text
+/// stream_aiding_sensor!(SettingsType => AidingSourceVariant, inconsistent: REASON_BIT,
+///     section: "navigator.<source>", range: "what is in range, in words");
+/// ```
+macro_rules! stream_aiding_sensor {
+    (
+        $settings:ty => $source:ident,
+        inconsistent: $reason:expr,
+        section: $section:literal,
+        range: $range:literal $(,)?
+    ) => {
+        impl $crate::aiding::source::AidingSensor for $settings {
+            fn source(&self) -> $crate::ekf::AidingSource {
+                $crate::ekf::AidingSource::$source
+            }
+
+            fn buckets(&self) -> &'static [$crate::aiding::source::Bucket] {
+                &[$crate::aiding::source::Bucket {
+                    source: $crate::ekf::AidingSource::$source,
+                    inconsistent: $reason,
+                }]
+            }
+
+            fn enabled(&self) -> bool {
+                self.enabled
+            }
+
+            fn watched_for_staleness(&self) -> bool {
+                true
+            }
+
+            fn first_out_of_range(&self) -> Result<(), (&'static str, f64)> {
+                self.check()
+            }
+
+            fn section(&self) -> (&'static str, &'static str) {
+                ($section, $range)
+            }
+        }
+    };
+}
+
+pub(crate) use stream_aiding_sensor;

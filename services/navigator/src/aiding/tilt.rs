@@ -15,9 +15,7 @@
 //!
 //! One update per window of `window_s`; allocation-free.
 
-use ipc_types::aiding;
 use nalgebra::Vector3;
-use rins_runtime::config_error::ConfigError;
 use serde::{Deserialize, Serialize};
 
 use crate::aiding::context::AidingContext;
@@ -138,7 +136,6 @@ impl AidingSensor for TiltAidingConfig {
     fn buckets(&self) -> &'static [Bucket] {
         &[Bucket {
             source: AidingSource::Gravity,
-            aiding_bit: aiding::GRAVITY,
             inconsistent: 0,
         }]
     }
@@ -159,11 +156,12 @@ impl AidingSensor for TiltAidingConfig {
         false
     }
 
-    fn validate(&self) -> Result<(), ConfigError> {
-        self.check().map_err(|(field, value)| {
-            ConfigError::new(field, value, "must be finite and > 0 (the gains >= 0)")
-                .within("navigator.tilt")
-        })
+    fn first_out_of_range(&self) -> Result<(), (&'static str, f64)> {
+        self.check()
+    }
+
+    fn section(&self) -> (&'static str, &'static str) {
+        ("navigator.tilt", "must be finite and > 0 (the gains >= 0)")
     }
 }
 

@@ -1,13 +1,13 @@
 //! The zero-velocity update as an aiding source: a pseudo-measurement of zero velocity, applied
 //! whenever the stance detector fires (`[navigator.stance]`).
 
-use ipc_types::{aiding, integrity_reason as why};
+use ipc_types::integrity_reason as why;
 use rins_runtime::config_error::ConfigError;
 use serde::{Deserialize, Serialize};
 
 use crate::aiding::context::AidingContext;
 use crate::aiding::source::{AidingSensor, Bucket};
-use crate::checks::check_in;
+use crate::checks::{Table, positive};
 use crate::ekf::{AidingSource, UpdateOutcome};
 
 /// Settings of the zero-velocity aiding (`[navigator.zupt]`).
@@ -40,7 +40,6 @@ impl AidingSensor for ZuptConfig {
     fn buckets(&self) -> &'static [Bucket] {
         &[Bucket {
             source: AidingSource::Zupt,
-            aiding_bit: aiding::ZUPT,
             inconsistent: why::ZUPT_INCONSISTENT,
         }]
     }
@@ -54,23 +53,26 @@ impl AidingSensor for ZuptConfig {
         false
     }
 
+    fn first_out_of_range(&self) -> Result<(), (&'static str, f64)> {
+        positive("zupt.sigma_mps", self.sigma_mps)?;
+        positive("zupt.gate", self.gate)
+    }
+
     /// Its keys are named as `zupt.<key>` of `[navigator]`.
+    fn section(&self) -> (&'static str, &'static str) {
+        ("navigator", "must be finite and > 0")
+    }
+
+    /// As the default, with the unit of `sigma_mps` in its error.
     fn validate(&self) -> Result<(), ConfigError> {
         let positive = |x: f64| x > 0.0;
-        check_in(
-            "navigator",
+        Table("navigator").check(
             "zupt.sigma_mps",
             self.sigma_mps,
             positive,
             "must be finite and > 0 m/s",
         )?;
-        check_in(
-            "navigator",
-            "zupt.gate",
-            self.gate,
-            positive,
-            "must be finite and > 0",
-        )
+        Table("navigator").check("zupt.gate", self.gate, positive, "must be finite and > 0")
     }
 }
 

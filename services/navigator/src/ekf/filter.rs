@@ -11,53 +11,9 @@ use rins_earth::{meridian_radius, prime_vertical_radius};
 /// Smallest `cos φ` used when turning an east error into longitude.
 const MIN_COS_LATITUDE: f64 = 1e-6;
 
-/// Where a measurement comes from, for the accepted/rejected counts.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum AidingSource {
-    /// Barometric height (docs/design.md §6.5).
-    Baro = 0,
-    /// Magnetometer heading update (docs/design.md §6.5), whatever the stance.
-    Mag = 1,
-    /// Zero-velocity update in stance.
-    Zupt = 2,
-    /// Magnetometer heading update applied only in stance (pedestrian profile).
-    Hupt = 3,
-    /// Tilt from the specific force: its direction as gravity's (a quasi-static vehicle, or the
-    /// AHRS updates of `[navigator.tilt]`), or its body x/y part as rotor drag (multirotor).
-    Gravity = 4,
-    /// GNSS receiver position and velocity.
-    Gnss = 5,
-    /// Pitot airspeed as the body-x velocity (zero wind assumed).
-    Airspeed = 6,
-}
-
-impl AidingSource {
-    /// Number of sources, the length of per-source arrays.
-    pub const COUNT: usize = 7;
-    /// Every source, in index order.
-    pub const ALL: [AidingSource; Self::COUNT] = [
-        AidingSource::Baro,
-        AidingSource::Mag,
-        AidingSource::Zupt,
-        AidingSource::Hupt,
-        AidingSource::Gravity,
-        AidingSource::Gnss,
-        AidingSource::Airspeed,
-    ];
-
-    /// Lower-case name for logs and reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            AidingSource::Baro => "baro",
-            AidingSource::Mag => "mag",
-            AidingSource::Zupt => "zupt",
-            AidingSource::Hupt => "hupt",
-            AidingSource::Gravity => "gravity",
-            AidingSource::Gnss => "gnss",
-            AidingSource::Airspeed => "airspeed",
-        }
-    }
-}
+/// Where a measurement comes from, for the accepted/rejected counts: the sources of the
+/// navigation state's aiding bits and per-source counts, listed once in `ipc_types::aiding`.
+pub use ipc_types::aiding::AidingSourceId as AidingSource;
 
 /// Measurements of one source that passed and failed the innovation gate.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]

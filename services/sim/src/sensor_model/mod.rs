@@ -7,7 +7,6 @@
 //! and injecting a fault into one channel leaves the noise of every other channel unchanged.
 //! Samples are instantaneous values at the sample time (no anti-alias averaging).
 
-pub mod airspeed;
 pub mod baro;
 pub mod config;
 pub mod fault;
@@ -16,6 +15,17 @@ pub mod inertial;
 pub mod mag;
 mod temperature;
 pub mod vibration;
+
+/// The `pub mod` declarations of the listed slower sensors whose model has a file of its own.
+macro_rules! model_modules {
+    ($($name:ident $(in mod $module:ident)?: fitted $build:expr, checked $check:expr;)*) => {
+        $($(pub mod $module;)?)*
+    };
+}
+
+// The models of the slower sensors that have a file of their own (`airspeed`, …), declared by
+// their entries in the one list of the slower sensors (`slow_sensor_list.rs`).
+crate::slow_sensor_list::slow_sensor_list!(model_modules);
 
 use ipc_types::MAX_CHANNELS;
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};

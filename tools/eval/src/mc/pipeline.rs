@@ -5,7 +5,7 @@ use ipc_types::{ChannelState, MAX_CHANNELS, MAX_TEMPERATURES, NavMode};
 use rins_altimeter::AltitudeEstimator;
 use rins_fusion::{ImuFuser, ImuSample};
 use rins_navigator::{NavOutput, Navigator};
-use rins_protocol::{ImuFrame, Payload};
+use rins_protocol::{FrameType, ImuFrame, Payload};
 use rins_sim::{ChannelFault, InertialSensor, Simulator, TickOutput, TruthSample};
 
 use super::config::{McError, Prepared, PreparedSystem};
@@ -183,7 +183,7 @@ impl Pipeline {
     pub fn step(&mut self) {
         self.sim.step(&mut self.tick);
         let time_us = self.tick.truth.device_time_us;
-        if let Some(frame) = &self.tick.baro
+        if let Some(frame) = self.tick.frame(FrameType::Baro)
             && let Payload::Baro(baro) = frame.payload
         {
             let altitude = self.altimeter.update(time_us, f64::from(baro.pressure_pa));
@@ -194,7 +194,7 @@ impl Pipeline {
                 altitude.valid,
             );
         }
-        if let Some(frame) = &self.tick.mag
+        if let Some(frame) = self.tick.frame(FrameType::Mag)
             && let Payload::Mag(mag) = frame.payload
         {
             // The wire carries nanotesla, the navigator takes microtesla.

@@ -1,13 +1,11 @@
 //! Settings of the GNSS aiding (`[navigator.gnss]`): the receiver's antenna and latency, the
 //! measurement noise floors, and the consistency monitor's thresholds.
 
-use ipc_types::{aiding, integrity_reason as why};
-use rins_runtime::config_error::ConfigError;
+use ipc_types::integrity_reason as why;
 use serde::{Deserialize, Serialize};
 
-use crate::aiding::source::{AidingSensor, Bucket};
+use crate::aiding::source::stream_aiding_sensor;
 use crate::checks::positive;
-use crate::ekf::AidingSource;
 
 /// Settings of the GNSS position and velocity updates (`[navigator.gnss]`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -96,35 +94,9 @@ impl GnssAidingConfig {
     }
 }
 
-impl AidingSensor for GnssAidingConfig {
-    fn source(&self) -> AidingSource {
-        AidingSource::Gnss
-    }
-
-    fn buckets(&self) -> &'static [Bucket] {
-        &[Bucket {
-            source: AidingSource::Gnss,
-            aiding_bit: aiding::GNSS,
-            inconsistent: why::GNSS_INCONSISTENT,
-        }]
-    }
-
-    fn enabled(&self) -> bool {
-        self.enabled
-    }
-
-    fn watched_for_staleness(&self) -> bool {
-        true
-    }
-
-    fn validate(&self) -> Result<(), ConfigError> {
-        self.check().map_err(|(field, value)| {
-            ConfigError::new(
-                field,
-                value,
-                "out of range (delay_s in [0, 0.5], |lever_arm_m| <= 100, others finite and > 0)",
-            )
-            .within("navigator.gnss")
-        })
-    }
-}
+stream_aiding_sensor!(
+    GnssAidingConfig => Gnss,
+    inconsistent: why::GNSS_INCONSISTENT,
+    section: "navigator.gnss",
+    range: "out of range (delay_s in [0, 0.5], |lever_arm_m| <= 100, others finite and > 0)",
+);
