@@ -16,8 +16,8 @@ pub use data_args::{
     ImportCommand,
 };
 pub use eval_args::{
-    EvalCommand, EvalFdiArgs, EvalProfileArgs, EvalPyshoeArgs, EvalQuadrotorArgs, EvalXioArgs,
-    FootMethodArg, QuadrotorMode, SweepArgs,
+    EvalCommand, EvalFdiArgs, EvalGnssCapturesArgs, EvalProfileArgs, EvalPyshoeArgs,
+    EvalQuadrotorArgs, EvalXioArgs, FootMethodArg, QuadrotorMode, SweepArgs,
 };
 
 /// The `rins echo` topic help: every short name it accepts, in the topic table's order.

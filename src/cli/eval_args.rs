@@ -18,6 +18,20 @@ pub enum EvalCommand {
     /// Quadrotor flights, free inertial from the truth at the start: roll/pitch RMSE and height
     /// error of each IMU alone and of the four fused, UAV profile.
     Quadrotor(EvalQuadrotorArgs),
+    /// The GNSS decoder on real receivers' captures (NMEA, UBX): fix epochs published against
+    /// gpsd's decode of the same bytes, matched by the receiver's time, positions compared.
+    GnssCaptures(EvalGnssCapturesArgs),
+}
+
+/// Options of `rins eval gnss-captures`.
+#[derive(Debug, Args)]
+pub struct EvalGnssCapturesArgs {
+    /// Directory of captures: `NAME.log` (`#` comment lines, then the receiver's bytes) with
+    /// gpsd's decode `NAME.log.chk` beside each (crates/gnss-protocol/tests/captures).
+    pub dir: PathBuf,
+    /// One JSON object on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// What `rins eval quadrotor` runs.

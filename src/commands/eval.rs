@@ -1,5 +1,5 @@
-//! `rins eval fdi|pyshoe|xio|quadrotor`: loads the configuration, runs the evaluation from
-//! `rins-eval` with a progress bar and prints the report.
+//! `rins eval fdi|pyshoe|xio|quadrotor|gnss-captures`: loads the configuration, runs the
+//! evaluation from `rins-eval` with a progress bar and prints the report.
 
 use anyhow::{Context, Result};
 use rins_eval::fdi::{FdiRequest, draw_roc, evaluate, to_table};
@@ -7,8 +7,8 @@ use rins_eval::fdi::{FdiRequest, draw_roc, evaluate, to_table};
 use rins_eval::foot::FootMethod;
 
 use crate::cli::{
-    EvalFdiArgs, EvalProfileArgs, EvalPyshoeArgs, EvalQuadrotorArgs, EvalXioArgs, FootMethodArg,
-    QuadrotorMode,
+    EvalFdiArgs, EvalGnssCapturesArgs, EvalProfileArgs, EvalPyshoeArgs, EvalQuadrotorArgs,
+    EvalXioArgs, FootMethodArg, QuadrotorMode,
 };
 use crate::config;
 
@@ -175,4 +175,17 @@ pub fn run_quadrotor(args: &EvalQuadrotorArgs) -> Result<()> {
         &report,
         rins_eval::quadrotor_nav::report::to_table,
     )
+}
+
+pub fn run_gnss_captures(args: &EvalGnssCapturesArgs) -> Result<()> {
+    let mut bar = super::progress::Progress::new("eval gnss-captures");
+    let report = rins_eval::gnss_captures::evaluate(&args.dir, &mut |d, t| bar.set(d, t))?;
+    bar.finish();
+    for failure in &report.failures {
+        eprintln!(
+            "eval gnss-captures: {} not evaluated: {}",
+            failure.name, failure.reason
+        );
+    }
+    print(args.json, &report, rins_eval::gnss_captures::to_table)
 }

@@ -81,6 +81,9 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             EvalCommand::Pyshoe(args) => eval::run_pyshoe(&args).map(|()| ExitCode::SUCCESS),
             EvalCommand::Xio(args) => eval::run_xio(&args).map(|()| ExitCode::SUCCESS),
             EvalCommand::Quadrotor(args) => eval::run_quadrotor(&args).map(|()| ExitCode::SUCCESS),
+            EvalCommand::GnssCaptures(args) => {
+                eval::run_gnss_captures(&args).map(|()| ExitCode::SUCCESS)
+            }
         },
         Command::Import { what } => match what {
             ImportCommand::Quadrotor(args) => import::run_quadrotor(&args),

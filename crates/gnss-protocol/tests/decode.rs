@@ -59,7 +59,13 @@ fn a_bad_checksum_is_counted_and_the_sentence_not_used() {
     let corrupted = REFERENCE_EPOCH.replace("545.4", "745.4")
         + &with_checksum("GPRMC,123520,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W");
     let (fixes, d) = decode_all(corrupted.as_bytes());
-    assert!(fixes.is_empty());
+    // The epoch's RMC is left: a two-dimensional fix, nothing of the GGA (altitude) in it; the
+    // next RMC is an epoch of its own, complete as the receiver's epochs now go.
+    assert_eq!(fixes.len(), 2, "{:?}", d.stats());
+    for f in &fixes {
+        assert_eq!(f.fix_type, GnssFixType::Fix2d as u8);
+        assert!(f.altitude_m.is_nan());
+    }
     assert_eq!(d.stats().checksum_errors, 1);
 }
 

@@ -31,6 +31,7 @@ mod tests {
             malformed: 5,
             epochs: 6,
             epochs_without_fix: 1,
+            ..GnssDecoderStats::default()
         };
         let mut h = Health::default();
         fill(&mut h, &stats, 6);

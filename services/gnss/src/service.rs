@@ -94,7 +94,15 @@ impl LineEvents for Reader<'_> {
     }
 
     fn after_read(&mut self, counters: &mut Health) {
-        let quiet = monotonic_ns().saturating_sub(self.last_byte_ns) > self.stale_ns;
+        let now_ns = monotonic_ns();
+        // An epoch a sentence of which was lost is not held until the receiver speaks again.
+        let (publisher, published) = (&self.publisher, &mut self.published);
+        self.decoder
+            .close_quiet(now_ns, |fix| match publisher.publish(fix) {
+                Ok(_) => *published += 1,
+                Err(_) => counters.rejected += 1,
+            });
+        let quiet = now_ns.saturating_sub(self.last_byte_ns) > self.stale_ns;
         if quiet && counters.input_stale == 0 {
             counters.stale_input_episodes += 1;
             tracing::warn!(port = %self.path, "the GNSS receiver went quiet");

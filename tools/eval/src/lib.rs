@@ -5,6 +5,8 @@
 //!   from the same sensors, with and without a dead gyro channel.
 //! - [`fault_sweep`]: one fault per run injected into the configured chain in flight: detection,
 //!   isolation, and the attitude error while the navigator's integrity said ok.
+//! - [`gnss_captures`]: the GNSS decoder on real receivers' captures, against gpsd's decode of
+//!   the same bytes.
 //! - [`fdi`]: fault detection and isolation on the real quadrotor recordings (false alarms, and
 //!   faults injected into the data).
 //! - [`data`]: where each recorded data set is published and how it becomes the layout read here.
@@ -21,6 +23,7 @@ pub mod datasets;
 pub mod fault_sweep;
 pub mod fdi;
 pub mod foot;
+pub mod gnss_captures;
 pub mod import;
 pub mod installation;
 pub mod integrity_tally;

@@ -1,22 +1,45 @@
-//! NMEA sentences of one receiver epoch (GGA position, RMC or VTG velocity, GST accuracy) put
-//! together into one fix.
+//! NMEA sentences of one receiver epoch put together into one fix.
 //!
-//! Sentences of the same UTC time belong to one epoch; VTG carries no time and belongs to the
-//! epoch in progress. An epoch is complete as soon as its GGA and RMC are in, and its GST and VTG
-//! when the receiver has been seen to send them — so that a fix is not held back a whole period
-//! waiting for the next epoch's first sentence. An epoch left incomplete (a sentence lost) is
-//! published when a sentence of another time arrives; so is the very first epoch, before the
-//! decoder knows which sentences this receiver sends.
+//! **Which sentences make an epoch.** Sentences whose UTC times differ by less than
+//! [`SAME_EPOCH_US`] belong to one epoch (receivers round the same instant differently in
+//! different sentences: `014421.076` in GLL, `014421.08` in GGA). VTG carries no time and belongs
+//! to the epoch in progress.
+//!
+//! **When it is published.** An epoch is handed out
+//! - as soon as it holds every sentence (kind and talker) the two epochs before it held, so that
+//!   a fix is not held back a whole period waiting for the next epoch's first sentence;
+//! - otherwise when a sentence of another time arrives (a sentence was lost, or this is the first
+//!   epoch and the decoder does not know yet what the receiver sends);
+//! - otherwise when the receiver has sent nothing for it for [`EPOCH_QUIET_NS`], or at a flush
+//!   (the end of a recording): the last epoch is not lost.
+//!
+//! Its receive time is that of its last timed sentence, whenever it is handed out (not of a VTG:
+//! some receivers send the next epoch's VTG first, and the fix would be stamped a period late).
+//!
+//! **Which position.** A receiver may report one epoch from several talkers (GPGGA and GLGGA on
+//! SiRF V, GPGGA and GNGNS on a BeiDou receiver). The fix is one of them, never simply the last:
+//! - GGA/GNS reporting a satellite fix come first: the combined solution (talker GN) if there is
+//!   one, else the one using the most satellites (the first of equals);
+//! - RMC/GLL with a valid status are used only when no GGA/GNS of the epoch states a quality
+//!   (receivers that send only RMC, or a GGA with an empty quality field): a two-dimensional fix,
+//!   three-dimensional only when such a GGA/GNS of the epoch gives an altitude;
+//! - a GGA/GNS without altitude gives a two-dimensional fix;
+//! - the receiver's dead reckoning (GGA quality 6, mode E) is published as such, and manual input
+//!   or simulation (GGA 7, 8; mode M, S) as without a fix: neither is a satellite measurement.
+//!
+//! The satellite count is the combined solution's (GN) if the epoch has one, else the sum over
+//! the talkers' GGA/GNS: each of those counts the satellites of its own system.
+//!
+//! **Accuracy.** GST's σ when the receiver sends it; else [`UERE_M`] × HDOP (vertical 1.5 times
+//! that), and with no HDOP either, the HDOP of a poor geometry ([`HDOP_WHEN_UNREPORTED`]): a fix
+//! of unknown accuracy must not look good. A two-dimensional fix has no altitude and no vertical
+//! accuracy (NaN).
 
-use chrono::Timelike;
 use ipc_types::{GnssFix, GnssFixType, GnssProtocol, PAYLOAD_VERSION};
-use nmea::sentences::FixType;
-use nmea::{Error, ParseResult};
 
+use super::nmea_reading::{self, Position, Quality, Reading};
+use super::nmea_sentence::{self, Kind, NmeaStats, Refused, Talker, Used};
 use super::sanity::is_plausible;
-
-/// Metres per knot-second: 1852 m / 3600 s.
-const KNOT_MPS: f64 = 1852.0 / 3600.0;
 
 /// Horizontal σ per unit of HDOP when the receiver sends no GST, m: the user-equivalent range
 /// error of a single-frequency receiver.
@@ -28,198 +51,462 @@ const VERTICAL_PER_HORIZONTAL: f64 = 1.5;
 /// Speed σ assumed when the receiver reports none (NMEA has no field for it), m/s.
 pub const NMEA_SPEED_SIGMA_MPS: f64 = 0.2;
 
+/// HDOP taken when the epoch reports none: the bound of a "fair" geometry in the usual rating of
+/// dilution of precision (≤ 10 moderate, 10–20 fair), so that the fix counts as poor.
+pub const HDOP_WHEN_UNREPORTED: f64 = 10.0;
+
+/// Sentence times closer than this are one epoch, µs: receivers print one instant to 2 or 3
+/// decimals, rounded or truncated (≤ 10 ms apart), while the fastest NMEA output rates (20 Hz)
+/// are 50 ms apart.
+pub const SAME_EPOCH_US: u64 = 10_000;
+
+/// An epoch not yet complete is handed out once the receiver has sent nothing for it this long,
+/// ns: longer than the gaps within one epoch's burst of sentences, shorter than a receiver at
+/// 1 Hz leaves between epochs plus its burst.
+pub const EPOCH_QUIET_NS: u64 = 1_000_000_000;
+
+const DAY_US: u64 = 86_400_000_000;
+
 /// What became of one sentence.
+// Handed back by value and never stored: boxing the fixes would allocate per sentence.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SentenceOutcome {
-    /// Used; with the fix of an epoch it completed (or of the one it closed).
-    Used(Option<GnssFix>),
+    /// Used. `closed`: the fix of the epoch it closed (a sentence of a later time), if not
+    /// handed out yet; `completed`: the fix of the epoch it completed.
+    Used {
+        /// The previous epoch, closed by this sentence's time.
+        closed: Option<GnssFix>,
+        /// This sentence's epoch, now complete.
+        completed: Option<GnssFix>,
+    },
     /// The checksum did not match.
     Checksum,
-    /// Not readable as NMEA.
+    /// No checksum to check.
+    WithoutChecksum,
+    /// Not readable as an NMEA sentence.
     Unparsable,
-    /// A sentence of another kind.
+    /// Well-formed, but of a kind the decoder does not use or with nothing to use in it (counted
+    /// by kind in [`NmeaStats`]).
     Unsupported,
-    /// Values out of range.
+    /// A used kind whose fields are out of format or range.
     Malformed,
 }
 
+/// One position sentence of the epoch in progress.
+#[derive(Debug, Clone, Copy)]
+struct Report {
+    position: Position,
+    kind: Used,
+    /// Arrival order within the epoch.
+    arrival: u8,
+}
+
 /// The epoch being assembled.
+#[derive(Debug, Clone, Copy)]
+struct Epoch {
+    time_us: u64,
+    last_rx_ns: u64,
+    /// GGA or GNS (GGA kept over GNS), by talker.
+    full: [Option<Report>; Talker::COUNT],
+    /// RMC or GLL (RMC kept over GLL), by talker.
+    planar: [Option<Report>; Talker::COUNT],
+    vtg_velocity: Option<[f64; 2]>,
+    /// GST's horizontal and vertical σ.
+    accuracy: Option<[f64; 2]>,
+    /// The sentences it holds: one bit per kind and talker.
+    seen: u64,
+    arrivals: u8,
+    /// Handed out: later sentences of its time are not a new epoch.
+    published: bool,
+}
+
+/// Assembles the epochs of one receiver's NMEA output. Allocation-free.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct NmeaEpoch {
-    time_us: Option<u64>,
-    fix: Option<GnssFix>,
-    has_gga: bool,
-    has_rmc: bool,
-    has_gst: bool,
-    has_vtg: bool,
-    /// Already handed out: later sentences of the same time are not a new epoch.
-    published: bool,
-    sends_gst: bool,
-    sends_vtg: bool,
-    /// A whole epoch has been seen, so `sends_*` say what this receiver sends: until then an
-    /// epoch is complete only when the next one starts.
-    learned: bool,
+    epoch: Option<Epoch>,
+    /// The sentences of the last closed epoch and of the one before it.
+    last: u64,
+    before_last: u64,
+    stats: NmeaStats,
 }
 
 impl NmeaEpoch {
-    /// Takes one sentence as framed on the line (`$...*hh`, with or without `\r\n`).
-    pub fn push(&mut self, raw: &[u8]) -> SentenceOutcome {
-        let trimmed = trim_line_end(raw);
-        let parsed = match nmea::parse_bytes(trimmed) {
-            Ok(parsed) => parsed,
-            Err(Error::ChecksumMismatch { .. }) => return SentenceOutcome::Checksum,
-            Err(Error::Unsupported(_) | Error::Unknown(_)) => {
-                return SentenceOutcome::Unsupported;
-            }
-            Err(_) => return SentenceOutcome::Unparsable,
-        };
-        match parsed {
-            ParseResult::GGA(gga) => {
-                let Some(time_us) = gga.fix_time.map(time_of_day_us) else {
-                    return SentenceOutcome::Malformed;
-                };
-                let closed = self.begin(time_us);
-                let fix = self.fix_mut();
-                fix.fix_type = gga.fix_type.map_or(GnssFixType::NoFix, fix_type) as u8;
-                fix.satellites = gga.fix_satellites.map_or(0, |n| n.min(255) as u8);
-                fix.latitude_rad = gga.latitude.unwrap_or(f64::NAN).to_radians();
-                fix.longitude_rad = gga.longitude.unwrap_or(f64::NAN).to_radians();
-                fix.altitude_m = gga.altitude.map_or(f64::NAN, f64::from);
-                fix.hdop = gga.hdop.map_or(0.0, f64::from);
-                if fix.accuracy_reported == 0 {
-                    let sigma = fix.hdop * UERE_M;
-                    fix.horizontal_accuracy_m = sigma;
-                    fix.vertical_accuracy_m = sigma * VERTICAL_PER_HORIZONTAL;
-                }
-                if GnssFixType::from_u8(fix.fix_type).is_some_and(GnssFixType::is_3d)
-                    && !is_plausible(fix)
-                {
-                    *fix = GnssFix {
-                        receiver_time_us: time_us,
-                        ..GnssFix::default()
-                    };
-                    return SentenceOutcome::Malformed;
-                }
-                self.has_gga = true;
-                self.finish(closed)
-            }
-            ParseResult::RMC(rmc) => {
-                let Some(time_us) = rmc.fix_time.map(time_of_day_us) else {
-                    return SentenceOutcome::Malformed;
-                };
-                let closed = self.begin(time_us);
-                if let (Some(speed), Some(course)) = (rmc.speed_over_ground, rmc.true_course) {
-                    self.set_velocity(f64::from(speed), f64::from(course));
-                }
-                self.has_rmc = true;
-                self.finish(closed)
-            }
-            ParseResult::GST(gst) => {
-                let Some(time_us) = gst.time.map(time_of_day_us) else {
-                    return SentenceOutcome::Malformed;
-                };
-                let closed = self.begin(time_us);
-                self.sends_gst = true;
-                if let (Some(lat), Some(lon), Some(alt)) = (gst.lat_sd, gst.long_sd, gst.alt_sd) {
-                    let (lat, lon) = (f64::from(lat), f64::from(lon));
-                    let fix = self.fix_mut();
-                    fix.horizontal_accuracy_m = ((lat * lat + lon * lon) / 2.0).sqrt();
-                    fix.vertical_accuracy_m = f64::from(alt);
-                    fix.accuracy_reported = 1;
-                }
-                self.has_gst = true;
-                self.finish(closed)
-            }
-            ParseResult::VTG(vtg) => {
-                self.sends_vtg = true;
-                if self.time_us.is_none() || self.published {
-                    // No epoch in progress to belong to.
-                    return SentenceOutcome::Used(None);
-                }
-                if let (Some(speed), Some(course)) = (vtg.speed_over_ground, vtg.true_course) {
-                    self.set_velocity(f64::from(speed), f64::from(course));
-                }
-                self.has_vtg = true;
-                self.finish(None)
-            }
-            _ => SentenceOutcome::Unsupported,
-        }
+    /// What it set aside so far.
+    pub fn stats(&self) -> NmeaStats {
+        self.stats
     }
 
-    /// Starts the epoch of `time_us` unless it is the one in progress; returns the fix of the
-    /// epoch it closed, if that one had a position and was not handed out yet.
-    fn begin(&mut self, time_us: u64) -> Option<GnssFix> {
-        if self.time_us == Some(time_us) {
+    /// Takes one sentence as framed on the line (`$...*hh`, with or without `\r\n`), received at
+    /// `rx_ns`.
+    pub fn push(&mut self, raw: &[u8], rx_ns: u64) -> SentenceOutcome {
+        let sentence = match nmea_sentence::read(raw) {
+            Ok(s) => s,
+            Err(Refused::Checksum) => return SentenceOutcome::Checksum,
+            Err(Refused::WithoutChecksum) => {
+                self.stats.without_checksum += 1;
+                return SentenceOutcome::WithoutChecksum;
+            }
+            Err(Refused::Unreadable) => return SentenceOutcome::Unparsable,
+        };
+        let Kind::Used(kind) = sentence.kind else {
+            self.stats.count(sentence.kind);
+            return SentenceOutcome::Unsupported;
+        };
+        let Ok(reading) = nmea_reading::read(kind, sentence.fields) else {
+            return SentenceOutcome::Malformed;
+        };
+        let bit = 1u64 << (kind as usize * Talker::COUNT + sentence.talker as usize);
+        let closed = match reading {
+            Reading::Position(p) => {
+                let closed = self.begin(p.time_us, rx_ns);
+                self.with_epoch(|e| e.add(kind, sentence.talker, p));
+                closed
+            }
+            Reading::Accuracy {
+                time_us,
+                horizontal_m,
+                vertical_m,
+            } => {
+                let closed = self.begin(time_us, rx_ns);
+                self.with_epoch(|e| e.accuracy = Some([horizontal_m, vertical_m]));
+                closed
+            }
+            Reading::Velocity(velocity) => {
+                if self.epoch.is_none() {
+                    self.stats.nothing_to_use += 1;
+                    return SentenceOutcome::Unsupported;
+                }
+                // Its receive time is not the epoch's: a receiver that sends VTG before its
+                // epoch's timed sentences would have its epochs stamped a period late.
+                self.with_epoch(|e| {
+                    if !e.published {
+                        e.vtg_velocity = velocity.or(e.vtg_velocity);
+                    }
+                });
+                None
+            }
+            Reading::Nothing => {
+                self.stats.nothing_to_use += 1;
+                return SentenceOutcome::Unsupported;
+            }
+        };
+        let expected = self.last | self.before_last;
+        let complete = self.epoch.as_mut().is_some_and(|e| {
+            // Recorded even after the epoch was handed out: the next epochs wait for it.
+            e.seen |= bit;
+            expected != 0 && e.seen & expected == expected && e.has_position()
+        });
+        let completed = if complete { self.hand_out() } else { None };
+        SentenceOutcome::Used { closed, completed }
+    }
+
+    /// Hands out the epoch in progress if the receiver has sent nothing for it since a second
+    /// (`EPOCH_QUIET_NS`) before `now_ns`.
+    pub fn close_quiet(&mut self, now_ns: u64) -> Option<GnssFix> {
+        let epoch = self.epoch.as_ref()?;
+        if epoch.published || now_ns < epoch.last_rx_ns.saturating_add(EPOCH_QUIET_NS) {
             return None;
         }
-        let closed = self.fix.filter(|_| self.has_gga && !self.published);
-        *self = Self {
-            time_us: Some(time_us),
-            fix: Some(GnssFix {
-                version: PAYLOAD_VERSION,
-                protocol: GnssProtocol::Nmea as u8,
-                receiver_time_us: time_us,
-                speed_accuracy_mps: NMEA_SPEED_SIGMA_MPS,
-                ..GnssFix::default()
-            }),
-            sends_gst: self.sends_gst,
-            sends_vtg: self.sends_vtg,
-            learned: self.time_us.is_some(),
-            ..Self::default()
-        };
+        self.hand_out()
+    }
+
+    /// Hands out the epoch in progress, complete or not (at the end of the receiver's output).
+    pub fn flush(&mut self) -> Option<GnssFix> {
+        self.hand_out()
+    }
+
+    /// Makes the epoch in progress that of `time_us`: the same if of the same time, else a new
+    /// one; returns the fix of the one it closed if that was not handed out yet.
+    fn begin(&mut self, time_us: u64, rx_ns: u64) -> Option<GnssFix> {
+        let same = self
+            .epoch
+            .as_ref()
+            .is_some_and(|e| same_epoch(e.time_us, time_us));
+        let mut closed = None;
+        if !same {
+            closed = self.hand_out();
+            if let Some(old) = self.epoch.take() {
+                (self.before_last, self.last) = (self.last, old.seen);
+            }
+        }
+        let epoch = self.epoch.get_or_insert_with(|| Epoch::new(time_us, rx_ns));
+        if !epoch.published {
+            epoch.last_rx_ns = rx_ns;
+        }
         closed
     }
 
-    fn fix_mut(&mut self) -> &mut GnssFix {
-        self.fix.get_or_insert_with(GnssFix::default)
-    }
-
-    /// Ground speed (knots) and true course (degrees) as a NED velocity.
-    fn set_velocity(&mut self, knots: f64, course_deg: f64) {
-        let speed = knots * KNOT_MPS;
-        let course = course_deg.to_radians();
-        let fix = self.fix_mut();
-        fix.velocity_ned_mps = [speed * course.cos(), speed * course.sin(), 0.0];
-        fix.velocity_valid = 1;
-    }
-
-    /// The sentence was used: `closed` is the epoch it closed; the epoch in progress is handed
-    /// out too once it has everything this receiver sends.
-    fn finish(&mut self, closed: Option<GnssFix>) -> SentenceOutcome {
-        let complete = self.learned
-            && self.has_gga
-            && self.has_rmc
-            && (self.has_gst || !self.sends_gst)
-            && (self.has_vtg || !self.sends_vtg);
-        if closed.is_none() && complete && !self.published {
-            self.published = true;
-            return SentenceOutcome::Used(self.fix);
+    fn with_epoch(&mut self, change: impl FnOnce(&mut Epoch)) {
+        if let Some(epoch) = self.epoch.as_mut() {
+            change(epoch);
         }
-        SentenceOutcome::Used(closed)
+    }
+
+    /// The epoch in progress's fix, once: marks it handed out.
+    fn hand_out(&mut self) -> Option<GnssFix> {
+        let epoch = self.epoch.as_mut().filter(|e| !e.published)?;
+        epoch.published = true;
+        let rx_ns = epoch.last_rx_ns;
+        let Some(fix) = epoch.fix() else {
+            self.stats.epochs_without_position += 1;
+            return None;
+        };
+        if GnssFixType::from_u8(fix.fix_type).is_some_and(GnssFixType::is_3d) && !is_plausible(&fix)
+        {
+            self.stats.implausible_epochs += 1;
+            return Some(no_fix(fix.receiver_time_us, rx_ns));
+        }
+        Some(fix)
     }
 }
 
-/// The sentence without its line end.
-fn trim_line_end(raw: &[u8]) -> &[u8] {
-    let mut end = raw.len();
-    while end > 0 && matches!(raw[end - 1], b'\r' | b'\n') {
-        end -= 1;
+/// Whether two times of day are one epoch (across midnight too).
+fn same_epoch(a_us: u64, b_us: u64) -> bool {
+    let d = a_us.abs_diff(b_us) % DAY_US;
+    d.min(DAY_US - d) < SAME_EPOCH_US
+}
+
+impl Epoch {
+    fn new(time_us: u64, rx_ns: u64) -> Self {
+        Self {
+            time_us,
+            last_rx_ns: rx_ns,
+            full: [None; Talker::COUNT],
+            planar: [None; Talker::COUNT],
+            vtg_velocity: None,
+            accuracy: None,
+            seen: 0,
+            arrivals: 0,
+            published: false,
+        }
     }
-    &raw[..end]
+
+    fn add(&mut self, kind: Used, talker: Talker, position: Position) {
+        let (slot, preferred) = match kind {
+            Used::Gga | Used::Gns => (&mut self.full[talker as usize], Used::Gga),
+            _ => (&mut self.planar[talker as usize], Used::Rmc),
+        };
+        // A GGA is not replaced by the same talker's GNS, nor an RMC by its GLL.
+        if slot.is_some_and(|r| r.kind == preferred && kind != preferred) {
+            return;
+        }
+        *slot = Some(Report {
+            position,
+            kind,
+            arrival: self.arrivals,
+        });
+        self.arrivals = self.arrivals.saturating_add(1);
+    }
+
+    fn has_position(&self) -> bool {
+        self.full.iter().chain(&self.planar).any(Option::is_some)
+    }
+
+    /// The fix of the epoch, by the rules in the module's description; `None` without a
+    /// position sentence.
+    fn fix(&self) -> Option<GnssFix> {
+        let full_fix = best(&self.full, |p| p.quality.is_fix());
+        let stated = self
+            .full
+            .iter()
+            .flatten()
+            .any(|r| r.position.quality != Quality::Unknown);
+        let planar_fix = best(&self.planar, |p| p.quality.is_fix()).filter(|_| !stated);
+        let dead_reckoning = best(&self.full, |p| p.quality == Quality::DeadReckoning)
+            .or_else(|| best(&self.planar, |p| p.quality == Quality::DeadReckoning));
+        let any = best(&self.full, |_| true).or_else(|| best(&self.planar, |_| true))?;
+        let chosen = full_fix.or(planar_fix).or(dead_reckoning).unwrap_or(any);
+        let p = chosen.position;
+        let mut fix = no_fix(p.time_us, self.last_rx_ns);
+        fix.satellites = self.satellites();
+        let fix_type = match p.quality {
+            Quality::Fix(t) => t,
+            Quality::DeadReckoning => GnssFixType::DeadReckoning,
+            Quality::NoFix | Quality::Unknown => return Some(fix),
+        };
+        // A GGA/GNS that does not state its quality lends its altitude to the RMC/GLL.
+        let altitude = p.altitude_m.or_else(|| {
+            best(&self.full, |q| {
+                q.quality == Quality::Unknown && q.altitude_m.is_some()
+            })
+            .and_then(|r| r.position.altitude_m)
+        });
+        let hdop = p
+            .hdop
+            .or_else(|| best(&self.full, |q| q.hdop.is_some()).and_then(|r| r.position.hdop));
+        fix.fix_type = match (fix_type, altitude) {
+            (GnssFixType::DeadReckoning, _) => GnssFixType::DeadReckoning,
+            (t, Some(_)) => t,
+            (_, None) => GnssFixType::Fix2d,
+        } as u8;
+        fix.latitude_rad = p.latitude_deg.to_radians();
+        fix.longitude_rad = p.longitude_deg.to_radians();
+        fix.altitude_m = altitude.unwrap_or(f64::NAN);
+        fix.hdop = hdop.unwrap_or(0.0);
+        let [horizontal, vertical] = match self.accuracy {
+            Some(sigma) => {
+                fix.accuracy_reported = 1;
+                sigma
+            }
+            None => {
+                let h = hdop.unwrap_or(HDOP_WHEN_UNREPORTED) * UERE_M;
+                [h, h * VERTICAL_PER_HORIZONTAL]
+            }
+        };
+        fix.horizontal_accuracy_m = horizontal;
+        fix.vertical_accuracy_m = if altitude.is_some() {
+            vertical
+        } else {
+            f64::NAN
+        };
+        let rmc_velocity = best(&self.planar, |q| q.velocity_ne_mps.is_some())
+            .and_then(|r| r.position.velocity_ne_mps);
+        // RMC is timed, VTG is not: RMC's velocity is surely this epoch's.
+        if let Some([north, east]) = rmc_velocity
+            .or(self.vtg_velocity)
+            .filter(|_| fix_type != GnssFixType::DeadReckoning)
+        {
+            fix.velocity_ned_mps = [north, east, 0.0];
+            fix.velocity_valid = 1;
+        }
+        Some(fix)
+    }
+
+    /// The combined solution's count if there is one, else the sum of the systems' counts.
+    fn satellites(&self) -> u8 {
+        if let Some(gn) = self.full[Talker::Gn as usize] {
+            return gn.position.satellites.unwrap_or(0);
+        }
+        let sum: u32 = self
+            .full
+            .iter()
+            .flatten()
+            .map(|r| u32::from(r.position.satellites.unwrap_or(0)))
+            .sum();
+        sum.min(255) as u8
+    }
 }
 
-fn time_of_day_us(t: chrono::NaiveTime) -> u64 {
-    u64::from(t.num_seconds_from_midnight()) * 1_000_000 + u64::from(t.nanosecond() / 1_000)
+/// Of the reports that `wanted`: the combined solution's (GN), else the one using the most
+/// satellites, the first of equals.
+fn best(reports: &[Option<Report>], wanted: impl Fn(&Position) -> bool) -> Option<Report> {
+    let candidates = reports.iter().flatten().filter(|r| wanted(&r.position));
+    if let Some(gn) = reports[Talker::Gn as usize].filter(|r| wanted(&r.position)) {
+        return Some(gn);
+    }
+    candidates.copied().min_by_key(|r| {
+        (
+            core::cmp::Reverse(r.position.satellites.unwrap_or(0)),
+            r.arrival,
+        )
+    })
 }
 
-/// GGA's quality indicator as a fix type.
-fn fix_type(t: FixType) -> GnssFixType {
-    match t {
-        FixType::Gps | FixType::Pps => GnssFixType::Fix3d,
-        FixType::DGps => GnssFixType::Differential,
-        FixType::Rtk => GnssFixType::RtkFixed,
-        FixType::FloatRtk => GnssFixType::RtkFloat,
-        FixType::Estimated => GnssFixType::DeadReckoning,
-        FixType::Invalid | FixType::Manual | FixType::Simulation => GnssFixType::NoFix,
+/// An epoch without a fix.
+fn no_fix(time_us: u64, rx_ns: u64) -> GnssFix {
+    let mut fix = GnssFix {
+        version: PAYLOAD_VERSION,
+        protocol: GnssProtocol::Nmea as u8,
+        fix_type: GnssFixType::NoFix as u8,
+        receiver_time_us: time_us,
+        speed_accuracy_mps: NMEA_SPEED_SIGMA_MPS,
+        ..GnssFix::default()
+    };
+    fix.header.origin_rx_ns = rx_ns;
+    fix
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `$body*hh\r\n`.
+    fn sentence(body: &str) -> Vec<u8> {
+        let checksum = body.bytes().fold(0u8, |c, b| c ^ b);
+        format!("${body}*{checksum:02X}\r\n").into_bytes()
+    }
+
+    fn gga(time: &str, altitude: &str) -> Vec<u8> {
+        sentence(&format!(
+            "GPGGA,{time},4807.038,N,01131.000,E,1,08,0.9,{altitude},M,46.9,M,,"
+        ))
+    }
+
+    fn rmc(time: &str) -> Vec<u8> {
+        sentence(&format!(
+            "GPRMC,{time},A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W"
+        ))
+    }
+
+    fn fixes(outcome: SentenceOutcome) -> (Option<GnssFix>, Option<GnssFix>) {
+        match outcome {
+            SentenceOutcome::Used { closed, completed } => (closed, completed),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn an_epoch_is_handed_out_once_it_holds_what_the_epochs_before_it_held() {
+        let mut e = NmeaEpoch::default();
+        assert_eq!(fixes(e.push(&gga("123519", "545.4"), 1)), (None, None));
+        assert_eq!(fixes(e.push(&rmc("123519"), 2)), (None, None));
+        // The first epoch: complete only when the next begins.
+        let (closed, completed) = fixes(e.push(&gga("123520", "545.4"), 3));
+        let closed = closed.unwrap();
+        assert!(completed.is_none());
+        assert_eq!(closed.header.origin_rx_ns, 2);
+        assert_eq!(closed.fix_type, GnssFixType::Fix3d as u8);
+        assert_eq!(closed.velocity_valid, 1);
+        // The second: complete with its RMC, not a period later.
+        let (closed, completed) = fixes(e.push(&rmc("123520"), 4));
+        assert!(closed.is_none());
+        assert_eq!(completed.unwrap().receiver_time_us, 45_320_000_000);
+        // A late sentence of the same time is not a new epoch.
+        assert_eq!(fixes(e.push(&rmc("123520.004"), 5)), (None, None));
+        assert!(e.flush().is_none());
+    }
+
+    #[test]
+    fn a_vtg_belongs_to_the_epoch_in_progress_but_not_its_receive_time() {
+        let mut e = NmeaEpoch::default();
+        e.push(&gga("123519", "545.4"), 10);
+        e.push(&sentence("GPVTG,090.0,T,,M,10.0,N,18.5,K,A"), 20);
+        let fix = e.flush().unwrap();
+        assert_eq!(fix.header.origin_rx_ns, 10);
+        assert_eq!(fix.velocity_valid, 1);
+        assert!((fix.velocity_ned_mps[1] - 10.0 * 1852.0 / 3600.0).abs() < 1e-9);
+        // No epoch to belong to.
+        let mut e = NmeaEpoch::default();
+        let vtg = sentence("GPVTG,090.0,T,,M,10.0,N,18.5,K,A");
+        assert_eq!(e.push(&vtg, 1), SentenceOutcome::Unsupported);
+        assert_eq!(e.stats().nothing_to_use, 1);
+    }
+
+    #[test]
+    fn times_less_than_ten_milliseconds_apart_are_one_epoch_across_midnight_too() {
+        assert!(same_epoch(45_319_076_000, 45_319_080_000));
+        assert!(!same_epoch(45_319_000_000, 45_319_010_000));
+        assert!(same_epoch(DAY_US - 5_000, 0));
+        assert!(!same_epoch(DAY_US - 50_000, 0));
+    }
+
+    #[test]
+    fn an_implausible_fix_is_published_as_none_and_counted() {
+        let mut e = NmeaEpoch::default();
+        e.push(&gga("123519", "60000.0"), 1);
+        let fix = e.flush().unwrap();
+        assert_eq!(fix.fix_type, GnssFixType::NoFix as u8);
+        assert_eq!(e.stats().implausible_epochs, 1);
+    }
+
+    #[test]
+    fn an_epoch_of_only_accuracy_is_not_published_and_is_counted() {
+        let mut e = NmeaEpoch::default();
+        e.push(&sentence("GPGST,123519.00,1.8,,,,1.7,1.3,2.2"), 1);
+        let (closed, _) = fixes(e.push(&gga("123520", "545.4"), 2));
+        assert!(closed.is_none());
+        assert_eq!(e.stats().epochs_without_position, 1);
+        assert!(e.flush().is_some());
     }
 }

@@ -1,33 +1,30 @@
 //! UBX NAV-PVT (the u-blox receiver's position, velocity and time solution) as a fix.
 
-use ipc_types::{GnssFix, GnssFixType, GnssProtocol, PAYLOAD_VERSION};
+use ipc_types::{GnssFix, GnssProtocol, PAYLOAD_VERSION};
 use ublox::nav_pvt::common::NavPvtFlags;
 use ublox::nav_pvt::proto23::NavPvtRef;
 
-/// The fix a NAV-PVT frame reports; not checked for plausibility (see [`super::is_plausible`]).
+use super::ubx_fix_type::{SolutionStatus, fix_type};
+
+/// The fix a NAV-PVT frame reports, typed by the UBX fix-type rule (`ubx_fix_type`: what the
+/// receiver says, never better); not checked for plausibility (see [`super::is_plausible`]). The
+/// receiver time is iTOW, in µs.
 pub fn fix_from_nav_pvt(pvt: &NavPvtRef<'_>) -> GnssFix {
     let flags = pvt.flags();
-    let fix_ok = flags.contains(NavPvtFlags::GPS_FIX_OK);
-    let fix_type = match (fix_ok, pvt.fix_type()) {
-        (false, _) => GnssFixType::NoFix,
-        (true, ublox::GnssFixType::Fix3D | ublox::GnssFixType::GPSPlusDeadReckoning) => {
-            if flags.contains(NavPvtFlags::CARR_SOLN_FIXED) {
-                GnssFixType::RtkFixed
-            } else if flags.contains(NavPvtFlags::CARR_SOLN_FLOAT) {
-                GnssFixType::RtkFloat
-            } else if flags.contains(NavPvtFlags::DIFF_SOLN) {
-                GnssFixType::Differential
-            } else {
-                GnssFixType::Fix3d
-            }
-        }
-        (true, ublox::GnssFixType::Fix2D) => GnssFixType::Fix2d,
-        (true, ublox::GnssFixType::DeadReckoningOnly) => GnssFixType::DeadReckoning,
-        (true, _) => GnssFixType::NoFix,
+    let carrier = if flags.contains(NavPvtFlags::CARR_SOLN_FIXED) {
+        2
+    } else {
+        u8::from(flags.contains(NavPvtFlags::CARR_SOLN_FLOAT))
+    };
+    let status = SolutionStatus {
+        gps_fix: pvt.fix_type() as u8,
+        fix_ok: flags.contains(NavPvtFlags::GPS_FIX_OK),
+        differential: flags.contains(NavPvtFlags::DIFF_SOLN),
+        carrier,
     };
     GnssFix {
         version: PAYLOAD_VERSION,
-        fix_type: fix_type as u8,
+        fix_type: fix_type(status) as u8,
         satellites: pvt.num_satellites(),
         protocol: GnssProtocol::Ubx as u8,
         velocity_valid: 1,
