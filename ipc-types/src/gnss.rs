@@ -81,13 +81,14 @@ pub struct GnssFix {
     pub latitude_rad: f64,
     /// Longitude, radians (WGS84).
     pub longitude_rad: f64,
-    /// Altitude above mean sea level, metres.
+    /// Altitude above mean sea level, metres; NaN on a 2-D fix whose receiver gave no height
+    /// (an RMC-only epoch, a u-blox NAV-SOL without NAV-POSLLH).
     pub altitude_m: f64,
     /// Velocity NED, m/s (valid when `velocity_valid`).
     pub velocity_ned_mps: [f64; 3],
     /// Horizontal position accuracy, 1σ per axis, metres.
     pub horizontal_accuracy_m: f64,
-    /// Vertical position accuracy, 1σ, metres.
+    /// Vertical position accuracy, 1σ, metres; NaN where the altitude is.
     pub vertical_accuracy_m: f64,
     /// Speed accuracy, 1σ per axis, m/s.
     pub speed_accuracy_mps: f64,

@@ -49,6 +49,11 @@ pub struct ReferenceEpoch {
     pub lon_deg: f64,
     /// Altitude above mean sea level, metres (`altMSL`, else `alt`), when reported.
     pub alt_msl_m: Option<f64>,
+    /// The receiver's own Earth-centred, Earth-fixed position (`ecefx`, `ecefy`, `ecefz`), m,
+    /// when reported. For a u-blox receiver that reports NAV-SOL alone gpsd repeats the first
+    /// epoch's latitude and longitude while these follow the receiver, so they are the
+    /// receiver's position where both are present.
+    pub ecef_m: Option<[f64; 3]>,
 }
 
 /// What a `.chk` file yields.
@@ -103,12 +108,18 @@ pub fn reference_epochs(chk: &str) -> Reference {
             .get("altMSL")
             .or_else(|| value.get("alt"))
             .and_then(Value::as_f64);
+        let axis = |key: &str| value.get(key).and_then(Value::as_f64);
+        let ecef_m = match (axis("ecefx"), axis("ecefy"), axis("ecefz")) {
+            (Some(x), Some(y), Some(z)) => Some([x, y, z]),
+            _ => None,
+        };
         reference.epochs.push(ReferenceEpoch {
             time,
             mode: mode.min(3) as u8,
             lat_deg,
             lon_deg,
             alt_msl_m,
+            ecef_m,
         });
     }
     reference
@@ -254,7 +265,8 @@ mod tests {
             "{\"class\":\"SKY\",\"time\":\"2017-07-19T08:50:00.000Z\"}\n",
             "{\"class\":\"TPV\",\"mode\":1,\"time\":\"2017-07-19T08:50:00.000Z\"}\n",
             "{\"class\":\"TPV\",\"mode\":3,\"time\":\"2017-07-19T08:50:00.800Z\",",
-            "\"lat\":-34.9062263,\"lon\":138.6081197,\"altMSL\":28.895,\"alt\":28.8}\n",
+            "\"lat\":-34.9062263,\"lon\":138.6081197,\"altMSL\":28.895,\"alt\":28.8,",
+            "\"ecefx\":-3933349.97,\"ecefy\":3466291.61,\"ecefz\":-3629303.21}\n",
             "{\"class\":\"TPV\",\"mode\":3,\"time\":\"2017-07-19T08:50:00.800Z\",",
             "\"lat\":-34.0,\"lon\":138.0}\n",
             "{\"class\":\"TPV\",\"mode\":2,\"time\":\"2017-07-19T08:50:01.000Z\",",
@@ -273,7 +285,14 @@ mod tests {
             (3, -34.9062263, 138.6081197)
         );
         assert_eq!(first.alt_msl_m, Some(28.895));
+        assert_eq!(
+            first.ecef_m,
+            Some([-3_933_349.97, 3_466_291.61, -3_629_303.21])
+        );
         let second = reference.epochs[1];
-        assert_eq!((second.mode, second.alt_msl_m), (2, None));
+        assert_eq!(
+            (second.mode, second.alt_msl_m, second.ecef_m),
+            (2, None, None)
+        );
     }
 }

@@ -209,10 +209,17 @@ pub fn to_table(r: &CapturesReport) -> String {
             t.silent
         );
     }
+    // gpsd's latitude and longitude repeat the first epoch for some u-blox receivers while its
+    // ECEF follows them: say which positions a fix is measured from.
+    let _ = writeln!(
+        s,
+        "\n<=1cm: horizontal distance from gpsd's latitude and longitude, or from its ECEF \
+         position (WGS84) where its report carries one and that is nearer"
+    );
     if !r.silent_captures.is_empty() {
         let _ = writeln!(
             s,
-            "\nsilent (bytes in, nothing used): {}",
+            "silent (bytes in, nothing used): {}",
             r.silent_captures.join(", ")
         );
     }

@@ -13,6 +13,10 @@ const EARTH_RADIUS_M: f64 = 6_371_008.8;
 /// above the resolution either decoder keeps (NMEA's 1e-4 to 1e-7 minutes, UBX's 1e-7°, about
 /// 1 cm at most), far below any receiver's error.
 pub const AGREE_M: f64 = 0.01;
+/// WGS84 semi-major axis, m.
+const WGS84_A_M: f64 = 6_378_137.0;
+/// WGS84 flattening.
+const WGS84_F: f64 = 1.0 / 298.257_223_563;
 
 /// How one capture's published fixes compare with its reference epochs.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
@@ -89,12 +93,7 @@ pub fn score(reference: &[ReferenceEpoch], fixes: &[GnssFix]) -> Score {
         taken[i] = true;
         result.matched += 1;
         let epoch = &reference[i];
-        let horizontal = haversine_m(
-            fix.latitude_rad,
-            fix.longitude_rad,
-            epoch.lat_deg.to_radians(),
-            epoch.lon_deg.to_radians(),
-        );
+        let horizontal = horizontal_m(fix, epoch);
         if horizontal <= AGREE_M {
             result.within_1cm += 1;
         }
@@ -105,6 +104,56 @@ pub fn score(reference: &[ReferenceEpoch], fixes: &[GnssFix]) -> Score {
         }
     }
     result
+}
+
+/// Horizontal distance of a fix from its reference epoch, m: from gpsd's latitude and longitude,
+/// or from its ECEF position where it reports one, whichever is nearer. gpsd's two positions of
+/// one report can disagree: for a receiver sending NAV-SOL alone its latitude and longitude repeat
+/// an earlier epoch's while the ECEF follows the receiver; where a receiver sends NAV-PVT and a
+/// separate ECEF message, the ECEF may be another message's. A fix that agrees with either is a
+/// reading of the same bytes.
+fn horizontal_m(fix: &GnssFix, epoch: &ReferenceEpoch) -> f64 {
+    let geodetic = haversine_m(
+        fix.latitude_rad,
+        fix.longitude_rad,
+        epoch.lat_deg.to_radians(),
+        epoch.lon_deg.to_radians(),
+    );
+    match epoch.ecef_m {
+        Some(ecef) => geodetic.min(horizontal_from_ecef_m(
+            fix.latitude_rad,
+            fix.longitude_rad,
+            ecef,
+        )),
+        None => geodetic,
+    }
+}
+
+/// Horizontal distance, m, of the point at geodetic `lat`, `lon` (radians, WGS84) from an ECEF
+/// position `ecef` (m): the height is taken from `ecef` itself (its component along the local
+/// vertical at `lat`, `lon`), so that only the horizontal difference is left. A fix whose height
+/// is above mean sea level, or missing, is thereby compared on its horizontal position alone.
+pub fn horizontal_from_ecef_m(lat: f64, lon: f64, ecef: [f64; 3]) -> f64 {
+    let base = ecef_from_geodetic(lat, lon, 0.0);
+    let up = [lat.cos() * lon.cos(), lat.cos() * lon.sin(), lat.sin()];
+    let h: f64 = (0..3).map(|i| (ecef[i] - base[i]) * up[i]).sum();
+    let at_height = ecef_from_geodetic(lat, lon, h);
+    (0..3)
+        .map(|i| (ecef[i] - at_height[i]).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// ECEF position, m, of geodetic `lat`, `lon` (radians) and height `h` above the WGS84
+/// ellipsoid (m).
+fn ecef_from_geodetic(lat: f64, lon: f64, h: f64) -> [f64; 3] {
+    let e2 = WGS84_F * (2.0 - WGS84_F);
+    let n = WGS84_A_M / (1.0 - e2 * lat.sin().powi(2)).sqrt();
+    [
+        (n + h) * lat.cos() * lon.cos(),
+        (n + h) * lat.cos() * lon.sin(),
+        (n * (1.0 - e2) + h) * lat.sin(),
+    ]
 }
 
 /// The larger, a NaN counting as larger than anything (a position that is not a number is the
@@ -136,6 +185,7 @@ mod tests {
             lat_deg,
             lon_deg,
             alt_msl_m: Some(100.0),
+            ecef_m: None,
         }
     }
 
@@ -212,5 +262,43 @@ mod tests {
         assert_eq!((s.matched, s.within_1cm), (1, 0));
         assert!(s.worst_horizontal_m.unwrap().is_nan());
         assert_eq!(worst(Some(f64::NAN), 3.0).to_bits(), f64::NAN.to_bits());
+    }
+
+    #[test]
+    fn a_point_1_cm_east_of_an_ecef_position_is_1_cm_away() {
+        let (lat, lon) = (53.563_f64.to_radians(), (-113.44_f64).to_radians());
+        let at = ecef_from_geodetic(lat, lon, 635.0);
+        assert!(horizontal_from_ecef_m(lat, lon, at) < 1e-6);
+        let east = [-lon.sin(), lon.cos(), 0.0];
+        let moved = [0, 1, 2].map(|i| at[i] + 0.01 * east[i]);
+        let d = horizontal_from_ecef_m(lat, lon, moved);
+        assert!((d - 0.01).abs() < 1e-6, "{d}");
+    }
+
+    #[test]
+    fn height_does_not_count_against_an_ecef_position() {
+        let (lat, lon) = ((-34.9_f64).to_radians(), 138.6_f64.to_radians());
+        let up = [lat.cos() * lon.cos(), lat.cos() * lon.sin(), lat.sin()];
+        let base = ecef_from_geodetic(lat, lon, 28.0);
+        let raised = [0, 1, 2].map(|i| base[i] + 10.0 * up[i]);
+        let d = horizontal_from_ecef_m(lat, lon, raised);
+        assert!(d < 1e-6, "{d}");
+    }
+
+    #[test]
+    fn an_ecef_reference_is_compared_beside_its_latitude_and_longitude() {
+        // gpsd's latitude and longitude are a kilometre off (a repeated first epoch); its ECEF is
+        // the fix's own position.
+        let (lat, lon) = (45.0_f64, 7.0_f64);
+        let mut reference = epoch("2019-01-07T10:00:00Z", lat + 0.01, lon);
+        reference.ecef_m = Some(ecef_from_geodetic(
+            lat.to_radians(),
+            lon.to_radians(),
+            300.0,
+        ));
+        let fixes = [fix(GnssProtocol::Nmea, 36_000_000_000, lat, lon)];
+        let s = score(&[reference], &fixes);
+        assert_eq!((s.matched, s.within_1cm), (1, 1));
+        assert!(s.worst_horizontal_m.unwrap() < 1e-6);
     }
 }
