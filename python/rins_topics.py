@@ -238,7 +238,7 @@ def subscribe_nav(node, timeout_s: float = 0.0, config: "SelectorConfig | None" 
 # --- generated from the Rust layouts: do not edit ---
 
 #: Layout version every payload carries in `version`.
-PAYLOAD_VERSION = 8
+PAYLOAD_VERSION = 9
 
 # Topic names.
 RAW_IMU = "rins/raw/imu"
@@ -246,6 +246,7 @@ RAW_BARO = "rins/raw/baro"
 RAW_MAG = "rins/raw/mag"
 RAW_AUX = "rins/raw/aux"
 GNSS = "rins/gnss"
+GNSS_LINK = "rins/gnss/link"
 FUSED_IMU = "rins/fused/imu"
 ALTITUDE = "rins/altitude"
 NAV_STATE = "rins/nav/state"
@@ -267,6 +268,7 @@ SHORT_NAMES = {
     "raw-mag": "rins/raw/mag",
     "raw-aux": "rins/raw/aux",
     "gnss": "rins/gnss",
+    "gnss-link": "rins/gnss/link",
     "fused-imu": "rins/fused/imu",
     "altitude": "rins/altitude",
     "nav": "rins/nav/state",
@@ -679,6 +681,53 @@ class GnssFix(ctypes.Structure):
         return "rins::GnssFix"
 
 
+class GnssLinkReport(ctypes.Structure):
+    """`rins::GnssLinkReport`: 248 bytes, aligned to 8."""
+
+    _fields_ = [
+        ("version", ctypes.c_uint16),
+        ("heard", ctypes.c_uint8),
+        ("silent", ctypes.c_uint8),
+        ("quiet", ctypes.c_uint8),
+        ("_pad", ctypes.c_uint8 * 3),
+        ("now_ns", ctypes.c_uint64),
+        ("bytes", ctypes.c_uint64),
+        ("reconnects", ctypes.c_uint64),
+        ("sentences_used", ctypes.c_uint64),
+        ("ubx_frames_used", ctypes.c_uint64),
+        ("unused_gsv", ctypes.c_uint64),
+        ("unused_gsa", ctypes.c_uint64),
+        ("unused_zda", ctypes.c_uint64),
+        ("unused_txt", ctypes.c_uint64),
+        ("unused_gbs", ctypes.c_uint64),
+        ("unused_other_nmea", ctypes.c_uint64),
+        ("unused_proprietary", ctypes.c_uint64),
+        ("unused_other_messages", ctypes.c_uint64),
+        ("nothing_to_use", ctypes.c_uint64),
+        ("checksum_errors", ctypes.c_uint64),
+        ("without_checksum", ctypes.c_uint64),
+        ("malformed", ctypes.c_uint64),
+        ("oversized", ctypes.c_uint64),
+        ("wrong_length", ctypes.c_uint64),
+        ("resyncs", ctypes.c_uint64),
+        ("unframed_bytes", ctypes.c_uint64),
+        ("lines_crlf", ctypes.c_uint64),
+        ("lines_lf", ctypes.c_uint64),
+        ("epochs", ctypes.c_uint64),
+        ("epochs_without_fix", ctypes.c_uint64),
+        ("published", ctypes.c_uint64),
+        ("publish_failures", ctypes.c_uint64),
+        ("ubx_late", ctypes.c_uint64),
+        ("nmea_epochs_superseded", ctypes.c_uint64),
+        ("silent_episodes", ctypes.c_uint64),
+    ]
+
+    @staticmethod
+    def type_name() -> str:
+        """The iceoryx2 type name of the Rust payload."""
+        return "rins::GnssLinkReport"
+
+
 class FusedImu(ctypes.Structure):
     """`rins::FusedImu`: 232 bytes, aligned to 8."""
 
@@ -898,7 +947,7 @@ class NavReport(ctypes.Structure):
 
 
 class HealthReport(ctypes.Structure):
-    """`rins::HealthReport`: 376 bytes, aligned to 8."""
+    """`rins::HealthReport`: 624 bytes, aligned to 8."""
 
     _fields_ = [
         ("version", ctypes.c_uint16),
@@ -910,6 +959,7 @@ class HealthReport(ctypes.Structure):
         ("link", LinkReport),
         ("redundancy", RedundancyReport),
         ("nav", NavReport),
+        ("gnss", GnssLinkReport),
     ]
 
     @staticmethod
@@ -1016,6 +1066,7 @@ TOPIC_PAYLOADS = {
     RAW_MAG: RawMag,
     RAW_AUX: RawAux,
     GNSS: GnssFix,
+    GNSS_LINK: GnssLinkReport,
     FUSED_IMU: FusedImu,
     ALTITUDE: Altitude,
     NAV_STATE: NavState,

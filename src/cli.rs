@@ -98,6 +98,8 @@ pub enum Command {
     /// CRC failures, malformed frames, discarded bytes, the last decode error and a verdict.
     /// With --scan, listen at each standard baud rate and say which gives valid frames (a
     /// pseudo-terminal, such as the simulator's, ignores the rate: it shows frames at every one).
+    /// With --gnss, the same for a GNSS receiver's line (NMEA sentences, UBX frames): epochs and
+    /// their fixes, every decoder counter, the last fix and a verdict.
     Probe(ProbeArgs),
     /// Print every sample of a topic.
     Echo {
@@ -368,17 +370,24 @@ pub struct ProbeArgs {
     /// The serial device, e.g. /dev/ttyUSB0.
     #[arg(long)]
     pub port: PathBuf,
-    /// Line speed, baud (default: acquisition.baud of the built-in configuration, 921600).
+    /// Line speed, baud (default: acquisition.baud of the built-in configuration, 921600; with
+    /// --gnss, gnss.baud, 115200).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub baud: Option<u32>,
-    /// How long to listen, s (> 0, <= 3600); with --scan, at each rate (default 3, with --scan 1).
+    /// How long to listen, s (> 0, <= 3600); with --scan, at each rate (default 3, with --scan 1,
+    /// with --gnss --scan 2: a receiver sends one burst a second).
     #[arg(long, allow_negative_numbers = true)]
     pub seconds: Option<f64>,
     /// Try the standard baud rates, 9600 to 921600, then 1500000, 2000000 and 3000000 where the
     /// driver accepts them, and say which gives valid frames. A pseudo-terminal ignores the rate,
-    /// so on one every rate shows frames.
+    /// so on one every rate shows frames. With --gnss: 4800 (NMEA's own rate) to 921600, and the
+    /// rate with the most used sentences and frames wins.
     #[arg(long, conflicts_with = "baud")]
     pub scan: bool,
+    /// The device is a GNSS receiver: read it with the gnss service's decoder (NMEA 0183, u-blox
+    /// UBX) instead of the sensor block's.
+    #[arg(long)]
+    pub gnss: bool,
     /// One JSON object on stdout instead of the report.
     #[arg(long)]
     pub json: bool,

@@ -187,6 +187,8 @@ pub struct HealthReport {
     pub redundancy: RedundancyReport,
     /// The navigation solution in use, from the lane the consumers follow.
     pub nav: NavReport,
+    /// The GNSS receiver's line, from the `gnss` service's last report (not heard without one).
+    pub gnss: crate::GnssLinkReport,
 }
 
 /// The serial line as acquisition last reported it ([`HealthReport::link`]). Counters count

@@ -18,6 +18,7 @@ mod altitude;
 mod control;
 mod fused;
 mod gnss;
+mod gnss_link;
 mod header;
 mod health;
 mod nav;
@@ -33,6 +34,7 @@ pub use altitude::*;
 pub use control::*;
 pub use fused::*;
 pub use gnss::*;
+pub use gnss_link::*;
 pub use header::*;
 pub use health::*;
 pub use nav::*;
@@ -40,7 +42,7 @@ pub use raw::*;
 pub use truth::*;
 
 /// Version of every payload layout in this crate. Bump it on any layout change.
-pub const PAYLOAD_VERSION: u16 = 8;
+pub const PAYLOAD_VERSION: u16 = 9;
 
 /// Up to this many single-axis channels per sensor type (gyro, accelerometer).
 pub const MAX_CHANNELS: usize = 16;

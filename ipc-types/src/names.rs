@@ -41,6 +41,7 @@ mod tests {
                 "raw-mag",
                 "raw-aux",
                 "gnss",
+                "gnss-link",
                 "fused-imu",
                 "altitude",
                 "nav",
@@ -50,7 +51,7 @@ mod tests {
                 "raw-airspeed"
             ]
         );
-        assert_eq!(TOPICS[7], ("nav", "rins/nav/state"));
+        assert_eq!(TOPICS[8], ("nav", "rins/nav/state"));
         assert_eq!(NAV_LANES, ["rins/nav/state", "rins/nav/state/standby"]);
     }
 }

@@ -64,6 +64,10 @@ macro_rules! for_each_topic {
                 /// GNSS receiver epochs ([`crate::GnssFix`]), from the `gnss` service.
                 GNSS = "rins/gnss", echo "gnss";
             }
+            GnssLinkReport (unstamped) {
+                /// The `gnss` service's once-a-second line counters ([`crate::GnssLinkReport`]).
+                GNSS_LINK = "rins/gnss/link", echo "gnss-link", record "gnss-link" at 16;
+            }
             FusedImu (stamped) {
                 /// Fused body rate and specific force ([`crate::FusedImu`]), from fusion.
                 FUSED_IMU = "rins/fused/imu", echo "fused-imu", record "fused-imu" at 4;

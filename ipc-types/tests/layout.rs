@@ -1,13 +1,13 @@
 //! The payload layouts are the contract between processes built at different times: their size
 //! and alignment must not change without a new [`PAYLOAD_VERSION`]. The figures are the layouts of
-//! version 8.
+//! version 9.
 
 use std::mem::{align_of, offset_of, size_of};
 
 use rins_ipc_types::{
-    Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, GnssFix, Header, Health,
-    HealthReport, LinkReport, NavReport, NavState, PAYLOAD_VERSION, RawAirspeed, RawAux, RawBaro,
-    RawImu, RawMag, RedundancyReport, ServiceHealth, SimControl, Truth,
+    Altitude, FaultApplied, FusedImu, FusionControl, FusionReply, GnssFix, GnssLinkReport, Header,
+    Health, HealthReport, LinkReport, NavReport, NavState, PAYLOAD_VERSION, RawAirspeed, RawAux,
+    RawBaro, RawImu, RawMag, RedundancyReport, ServiceHealth, SimControl, Truth,
 };
 
 /// Size and alignment in bytes of `T`.
@@ -16,8 +16,8 @@ fn layout<T>() -> (usize, usize) {
 }
 
 #[test]
-fn the_layouts_are_those_of_version_8() {
-    assert_eq!(PAYLOAD_VERSION, 8);
+fn the_layouts_are_those_of_version_9() {
+    assert_eq!(PAYLOAD_VERSION, 9);
 }
 
 #[test]
@@ -42,7 +42,8 @@ fn every_payload_keeps_its_size_and_alignment() {
     assert_eq!(layout::<LinkReport>(), (56, 8));
     assert_eq!(layout::<RedundancyReport>(), (88, 4));
     assert_eq!(layout::<NavReport>(), (16, 4));
-    assert_eq!(layout::<HealthReport>(), (376, 8));
+    assert_eq!(layout::<GnssLinkReport>(), (248, 8));
+    assert_eq!(layout::<HealthReport>(), (624, 8));
 }
 
 /// A reader checks the version before anything else, so it must sit at the same place in every
@@ -66,8 +67,9 @@ fn the_version_leads_every_payload_and_the_header_stays_in_place() {
         offset_of!(FusionReply, version),
         offset_of!(Health, version),
         offset_of!(HealthReport, version),
+        offset_of!(GnssLinkReport, version),
     ];
-    assert_eq!(version, [0; 16]);
+    assert_eq!(version, [0; 17]);
     let header = [
         offset_of!(RawBaro, header),
         offset_of!(RawMag, header),

@@ -32,6 +32,19 @@ pub struct EvalGnssCapturesArgs {
     /// One JSON object on stdout instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Play each capture at line pace through a pseudo-terminal to a running `rins service gnss`
+    /// (a private IPC root and prefix per capture) and score the fixes it publishes, with the
+    /// bytes it read and the differences to the in-process decoder's fixes.
+    #[arg(long)]
+    pub live: bool,
+    /// With `--live`: line rate the bytes are written at, baud (10 bits per byte).
+    #[arg(long, value_name = "B", default_value_t = 115_200, requires = "live",
+          value_parser = clap::value_parser!(u32).range(300..=4_000_000))]
+    pub baud: u32,
+    /// With `--live`: captures played at once, each with its own terminal and service.
+    #[arg(long, value_name = "N", default_value_t = 4, requires = "live",
+          value_parser = clap::value_parser!(u16).range(1..=64))]
+    pub jobs: u16,
 }
 
 /// What `rins eval quadrotor` runs.

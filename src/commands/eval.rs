@@ -178,6 +178,24 @@ pub fn run_quadrotor(args: &EvalQuadrotorArgs) -> Result<()> {
 }
 
 pub fn run_gnss_captures(args: &EvalGnssCapturesArgs) -> Result<()> {
+    if args.live {
+        let options = super::eval_live::GnssLiveOptions {
+            baud: args.baud,
+            jobs: usize::from(args.jobs),
+        };
+        let report = super::eval_live::gnss_captures(&args.dir, options)?;
+        for failure in &report.report.failures {
+            eprintln!(
+                "eval gnss-captures --live: {} not evaluated: {}",
+                failure.name, failure.reason
+            );
+        }
+        return print(
+            args.json,
+            &report,
+            rins_eval::gnss_captures::live::to_live_table,
+        );
+    }
     let mut bar = super::progress::Progress::new("eval gnss-captures");
     let report = rins_eval::gnss_captures::evaluate(&args.dir, &mut |d, t| bar.set(d, t))?;
     bar.finish();

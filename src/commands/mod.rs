@@ -16,6 +16,8 @@ mod latency;
 mod mc;
 mod plot;
 mod probe;
+mod probe_gnss;
+mod probe_gnss_report;
 mod progress;
 mod readmit;
 mod record;

@@ -1,6 +1,7 @@
 //! `rins probe --port PATH [--baud B] [--seconds S] [--scan] [--json]`: listens to a serial device
 //! with acquisition's driver and decoder and says what is on the line, or, with `--scan`, which
-//! standard baud rate carries the device's frames. Needs no running pipeline.
+//! standard baud rate carries the device's frames. Needs no running pipeline. With `--gnss`, the
+//! device is a GNSS receiver: see `probe_gnss`.
 
 use anyhow::{Result, bail};
 use rins_acquisition::config::AcquisitionConfig;
@@ -22,12 +23,23 @@ const FAST_BAUDS: [u32; 3] = [1_500_000, 2_000_000, 3_000_000];
 const MAX_SECONDS: f64 = 3600.0;
 
 pub fn run(args: &ProbeArgs) -> Result<()> {
-    let default_s = if args.scan { 1.0 } else { 3.0 };
+    // A receiver sends one burst a second: a scan listens long enough to catch one whole.
+    let default_s = match (args.scan, args.gnss) {
+        (true, true) => 2.0,
+        (true, false) => 1.0,
+        (false, _) => 3.0,
+    };
     let seconds = args.seconds.unwrap_or(default_s);
     if !(seconds.is_finite() && seconds > 0.0 && seconds <= MAX_SECONDS) {
         bail!("--seconds {seconds}: must be > 0 and <= {MAX_SECONDS}");
     }
     let port = args.port.to_string_lossy().into_owned();
+    if args.gnss && args.scan {
+        return super::probe_gnss::scan(&port, seconds, args.json);
+    }
+    if args.gnss {
+        return super::probe_gnss::run(&port, args.baud, seconds, args.json);
+    }
     if args.scan {
         return scan(&port, seconds, args.json);
     }

@@ -11,6 +11,7 @@ use rins_runtime::ipc::TopicSubscriber;
 use rins_runtime::payload::OtherVersionWarning;
 use rins_runtime::setup_guard::SetupGuard;
 use rins_runtime::tool_node::ToolNode;
+use rins_watchdog::gnss_line::{self, GnssRow};
 use rins_watchdog::redundancy_view::{
     NavView, RedundancyView, SensorRow, nav_view, redundancy_view,
 };
@@ -42,6 +43,8 @@ pub struct StatusReport {
     /// `None` before the first fused sample.
     pub redundancy: Option<RedundancyView>,
     pub link: Option<status_link::LinkRow>,
+    /// `None` without a gnss service, or before its first report.
+    pub gnss: Option<GnssRow>,
 }
 
 /// The printable form of a report; entries with unknown codes are named by their number.
@@ -70,6 +73,7 @@ pub fn rows(report: &HealthReport) -> StatusReport {
         navigation: nav_view(&report.nav),
         redundancy: redundancy_view(&report.redundancy),
         link: status_link::link_row(&report.link),
+        gnss: gnss_line::gnss_row(&report.gnss),
     }
 }
 
@@ -109,6 +113,7 @@ pub fn table(report: &StatusReport) -> String {
         None => out.push_str("redundancy   no fused output yet\n"),
     }
     out.push_str(&status_link::link_line(report.link.as_ref()));
+    out.push_str(&gnss_line::gnss_lines(report.gnss.as_ref()));
     out
 }
 

@@ -1,10 +1,13 @@
 //! The decoder on receiver output: published example sentences, a NAV-PVT frame laid out byte
 //! by byte, the simulated receiver's own output, and hostile bytes.
 
+mod common;
+
+use common::{simulated_epoch as epoch, simulated_stream};
 use ipc_types::{GnssFix, GnssFixType, GnssProtocol};
 use proptest::prelude::*;
 use rins_gnss_protocol::decode::GnssDecoder;
-use rins_gnss_protocol::encode::{write_nav_pvt, write_nmea_epoch};
+use rins_gnss_protocol::encode::{write_nmea_epoch, write_ubx_frame};
 
 fn decode_all(bytes: &[u8]) -> (Vec<GnssFix>, GnssDecoder) {
     let mut d = GnssDecoder::new();
@@ -85,15 +88,7 @@ fn reference_nav_pvt() -> Vec<u8> {
     put(52, &(-2_200i32).to_le_bytes()); // velE
     put(56, &300i32.to_le_bytes()); // velD
     put(68, &150u32.to_le_bytes()); // sAcc mm/s
-    let mut frame = vec![0xB5, 0x62, 0x01, 0x07, 92, 0];
-    frame.extend_from_slice(&p);
-    let (mut a, mut b) = (0u8, 0u8);
-    for &x in &frame[2..] {
-        a = a.wrapping_add(x);
-        b = b.wrapping_add(a);
-    }
-    frame.extend_from_slice(&[a, b]);
-    frame
+    ubx_frame(0x01, 0x07, &p)
 }
 
 #[test]
@@ -115,6 +110,32 @@ fn a_nav_pvt_frame_makes_one_fix_with_the_receivers_accuracies() {
     assert!((f.speed_accuracy_mps - 0.15).abs() < 1e-9);
 }
 
+/// A UBX frame of `payload` with its checksum.
+fn ubx_frame(class: u8, id: u8, payload: &[u8]) -> Vec<u8> {
+    let mut frame = Vec::new();
+    write_ubx_frame(class, id, payload, &mut frame);
+    frame
+}
+
+#[test]
+fn a_protocol_14_nav_pvt_of_84_bytes_makes_the_same_fix_as_the_92_byte_form() {
+    // u-blox 7 firmware ends NAV-PVT after pDOP and its reserved bytes; later ones add headVeh,
+    // magDec and magAcc, which the fix does not use.
+    let long = reference_nav_pvt();
+    let mut payload = long[6..6 + 92].to_vec();
+    payload[84..].copy_from_slice(&[0x10, 0x27, 0, 0, 0x2C, 0x01, 0x64, 0]);
+    let (from_long, _) = decode_all(&ubx_frame(0x01, 0x07, &payload));
+    let (from_short, d) = decode_all(&ubx_frame(0x01, 0x07, &payload[..84]));
+    assert_eq!(from_short.len(), 1, "{:?}", d.stats());
+    assert_eq!(from_short, from_long);
+    assert_eq!(from_short[0].fix_type, GnssFixType::Fix3d as u8);
+    let s = d.stats();
+    assert_eq!(
+        (s.ubx_frames, s.malformed, s.framing.wrong_length),
+        (1, 0, 0)
+    );
+}
+
 #[test]
 fn a_nav_pvt_with_a_corrupted_byte_is_a_checksum_error() {
     let mut frame = reference_nav_pvt();
@@ -126,48 +147,12 @@ fn a_nav_pvt_with_a_corrupted_byte_is_a_checksum_error() {
 
 #[test]
 fn an_implausible_value_under_a_valid_checksum_is_malformed() {
-    let mut frame = reference_nav_pvt();
-    frame[6 + 28..6 + 32].copy_from_slice(&1_900_000_000i32.to_le_bytes()); // lat 190°
-    let n = frame.len();
-    let (mut a, mut b) = (0u8, 0u8);
-    for &x in &frame[2..n - 2] {
-        a = a.wrapping_add(x);
-        b = b.wrapping_add(a);
-    }
-    frame[n - 2] = a;
-    frame[n - 1] = b;
-    let (fixes, d) = decode_all(&frame);
+    let good = reference_nav_pvt();
+    let mut payload = good[6..good.len() - 2].to_vec();
+    payload[28..32].copy_from_slice(&1_900_000_000i32.to_le_bytes()); // lat 190°
+    let (fixes, d) = decode_all(&ubx_frame(0x01, 0x07, &payload));
     assert!(fixes.is_empty());
     assert_eq!(d.stats().malformed, 1);
-}
-
-fn epoch(i: u64) -> GnssFix {
-    GnssFix {
-        receiver_time_us: 45_296_000_000 + i * 200_000,
-        fix_type: GnssFixType::Fix3d as u8,
-        satellites: 11,
-        latitude_rad: (-33.8688 + i as f64 * 1e-6).to_radians(),
-        longitude_rad: (151.2093 - i as f64 * 1e-6).to_radians(),
-        altitude_m: 58.25 + i as f64,
-        velocity_ned_mps: [3.0, -4.0, 0.5],
-        horizontal_accuracy_m: 1.5,
-        vertical_accuracy_m: 3.0,
-        speed_accuracy_mps: 0.1,
-        hdop: 0.8,
-        ..GnssFix::default()
-    }
-}
-
-fn simulated_stream(n: u64, ubx: bool) -> Vec<u8> {
-    let mut out = Vec::new();
-    for i in 0..n {
-        if ubx {
-            write_nav_pvt(&epoch(i), &mut out);
-        } else {
-            write_nmea_epoch(&epoch(i), &mut out);
-        }
-    }
-    out
 }
 
 #[test]

@@ -247,6 +247,33 @@ fn a_gga_without_altitude_is_a_two_dimensional_fix() {
 }
 
 #[test]
+fn gsa_mode_2_makes_a_two_dimensional_fix_with_the_receivers_altitude() {
+    // Garmin GPS 25LP and Foretrex 201: GGA quality 1 or 2 with an altitude, then GSA mode 2, in
+    // every epoch with a fix. gpsd reports most of those epochs 3-D from the GGA's altitude; they
+    // are matched all the same.
+    // The Foretrex sends 4 GSA before its first timed sentence: no epoch to place them in.
+    let captures = [
+        ("garmin25lp.log", 10, 746.1, 0),
+        ("foretrex-201.log", 7, -9.1, 4),
+    ];
+    for (name, epochs, altitude, gsa_unused) in captures {
+        let (fixes, stats) = decode(&capture(name), true);
+        assert_all_matched(name, &fixes, 1e-3);
+        let counted = (stats.malformed, stats.nmea.gsa);
+        assert_eq!(counted, (0, gsa_unused), "{name}: {stats:?}");
+        let positioned: Vec<_> = fixes.iter().filter(|f| has_position(f)).collect();
+        assert_eq!(positioned.len(), epochs, "{name}");
+        for f in positioned {
+            assert_eq!(f.fix_type, GnssFixType::Fix2d as u8, "{name}: {f:?}");
+            assert!(
+                f.altitude_m == altitude && f.vertical_accuracy_m.is_nan(),
+                "{f:?}"
+            );
+        }
+    }
+}
+
+#[test]
 fn simulation_and_dead_reckoning_are_never_a_satellite_fix() {
     // Garmin GPSmap 76S in simulator mode: GGA quality 8, RMC status V mode S. gpsd reports
     // these as 3-D fixes; they are not measurements.
@@ -276,8 +303,8 @@ fn simulation_and_dead_reckoning_are_never_a_satellite_fix() {
 
 #[test]
 fn valid_sentences_not_used_are_counted_by_kind_and_are_not_malformed() {
-    // SkyTraq: PSTI (proprietary), GSV and GSA of GPS and BeiDou, ZDA, with GGA, GLL, GST, RMC
-    // and VTG.
+    // SkyTraq: PSTI (proprietary), GSV of GPS and BeiDou, ZDA, with GGA, GLL, GST, RMC, VTG and
+    // GSA (its fix mode is used; every one of them follows a timed sentence of its epoch).
     let name = "skytraq-dgps.log";
     let (fixes, stats) = decode(&capture(name), true);
     assert_all_matched(name, &fixes, 1e-3);
@@ -286,14 +313,14 @@ fn valid_sentences_not_used_are_counted_by_kind_and_are_not_malformed() {
     let n = stats.nmea;
     assert_eq!(n.proprietary, count(&|s| s.starts_with("$P")), "{stats:?}");
     assert_eq!(n.gsv, count(&|s| s[3..].starts_with("GSV")), "{stats:?}");
-    assert_eq!(n.gsa, count(&|s| s[3..].starts_with("GSA")), "{stats:?}");
+    assert_eq!(n.gsa, 0, "{stats:?}");
     assert_eq!(n.zda, count(&|s| s[3..].starts_with("ZDA")), "{stats:?}");
     assert_eq!(
         stats.unsupported,
-        n.proprietary + n.gsv + n.gsa + n.zda,
+        n.proprietary + n.gsv + n.zda,
         "{stats:?}"
     );
-    let used = ["GGA", "GLL", "GST", "RMC", "VTG"];
+    let used = ["GGA", "GLL", "GST", "RMC", "VTG", "GSA"];
     let used = count(&|s| used.iter().any(|u| s[3..].starts_with(u)));
     assert_eq!(stats.sentences, used, "{stats:?}");
     assert_eq!(

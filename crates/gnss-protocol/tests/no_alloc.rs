@@ -6,31 +6,13 @@
 
 mod common;
 
-use common::capture;
-use ipc_types::{GnssFix, GnssFixType};
+use common::{capture, simulated_epoch as epoch};
 use rins_gnss_protocol::decode::GnssDecoder;
 use rins_gnss_protocol::encode::{write_nav_pvt, write_nmea_epoch};
 use rins_test_support::counting_alloc::{CountingAllocator, allocations_during};
 
 #[global_allocator]
 static ALLOCATOR: CountingAllocator = CountingAllocator;
-
-fn epoch(i: u64) -> GnssFix {
-    GnssFix {
-        receiver_time_us: 45_296_000_000 + i * 200_000,
-        fix_type: GnssFixType::Fix3d as u8,
-        satellites: 11,
-        latitude_rad: (-33.8688 + i as f64 * 1e-6).to_radians(),
-        longitude_rad: (151.2093 - i as f64 * 1e-6).to_radians(),
-        altitude_m: 58.25 + i as f64,
-        velocity_ned_mps: [3.0, -4.0, 0.5],
-        horizontal_accuracy_m: 1.5,
-        vertical_accuracy_m: 3.0,
-        speed_accuracy_mps: 0.1,
-        hdop: 0.8,
-        ..GnssFix::default()
-    }
-}
 
 #[test]
 fn decoding_nmea_and_ubx_does_not_allocate() {

@@ -5,11 +5,11 @@
 mod common;
 
 use chrono::{NaiveDate, NaiveDateTime, Timelike};
-use common::capture;
+use common::{capture, simulated_epoch as epoch};
 use ipc_types::{GnssFix, GnssFixType, GnssProtocol};
 use proptest::prelude::*;
 use rins_gnss_protocol::decode::{GnssDecoder, GnssDecoderStats, is_plausible};
-use rins_gnss_protocol::encode::{write_nav_pvt, write_nmea_epoch};
+use rins_gnss_protocol::encode::{write_nav_pvt, write_nmea_epoch, write_ubx_frame};
 
 const WEEK_MS: i64 = 604_800_000;
 
@@ -344,15 +344,8 @@ fn time_only_solutions_are_not_positions() {
 
 /// A UBX frame around `payload`, with its checksum.
 fn frame(class: u8, id: u8, payload: &[u8]) -> Vec<u8> {
-    let mut f = vec![0xB5, 0x62, class, id];
-    f.extend_from_slice(&(payload.len() as u16).to_le_bytes());
-    f.extend_from_slice(payload);
-    let (mut a, mut b) = (0u8, 0u8);
-    for &x in &f[2..] {
-        a = a.wrapping_add(x);
-        b = b.wrapping_add(a);
-    }
-    f.extend_from_slice(&[a, b]);
+    let mut f = Vec::new();
+    write_ubx_frame(class, id, payload, &mut f);
     f
 }
 
@@ -619,23 +612,6 @@ fn a_time_of_week_going_back_far_or_wrapping_starts_a_new_epoch() {
     let times: Vec<u64> = fixes.iter().map(|f| f.receiver_time_us / 1_000).collect();
     assert_eq!(times, [604_799_900, 0, 100, 5_000, 2_000], "{stats:?}");
     assert_eq!(stats.ubx_late, 1);
-}
-
-fn epoch(i: u64) -> GnssFix {
-    GnssFix {
-        receiver_time_us: 45_296_000_000 + i * 200_000,
-        fix_type: GnssFixType::Fix3d as u8,
-        satellites: 11,
-        latitude_rad: (-33.8688f64).to_radians(),
-        longitude_rad: 151.2093f64.to_radians(),
-        altitude_m: 58.25,
-        velocity_ned_mps: [3.0, -4.0, 0.5],
-        horizontal_accuracy_m: 1.5,
-        vertical_accuracy_m: 3.0,
-        speed_accuracy_mps: 0.1,
-        hdop: 0.8,
-        ..GnssFix::default()
-    }
 }
 
 #[test]

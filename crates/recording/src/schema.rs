@@ -170,9 +170,9 @@ mod tests {
         let sizes: Vec<usize> = PAYLOADS.iter().map(|l| l.size).collect();
         assert_eq!(sizes, PAYLOAD_SIZES);
         assert_eq!(Some(MAX_PAYLOAD), sizes.iter().copied().max());
-        // The navigation state, with a count pair per aiding source, outgrew the health report.
-        assert_eq!(MAX_PAYLOAD, size_of::<NavState>());
-        assert!(size_of::<NavState>() > size_of::<HealthReport>());
+        // The health report, with the GNSS line's counters, is the largest.
+        assert_eq!(MAX_PAYLOAD, size_of::<HealthReport>());
+        assert!(size_of::<HealthReport>() > size_of::<NavState>());
     }
 
     #[test]

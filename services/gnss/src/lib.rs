@@ -4,4 +4,5 @@
 
 pub mod config;
 pub mod counters;
+pub mod link_report;
 pub mod service;

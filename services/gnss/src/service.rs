@@ -5,10 +5,10 @@
 use std::time::Duration;
 
 use anyhow::{Result, anyhow};
-use ipc_types::{GnssFix, Health, ServiceKind, Stage, names};
+use ipc_types::{GnssFix, GnssLinkReport, Health, ServiceKind, Stage, names};
 use rins_gnss_protocol::decode::GnssDecoder;
 use rins_runtime::clock::monotonic_ns;
-use rins_runtime::ipc::create_node;
+use rins_runtime::ipc::{TopicPublisher, create_node};
 use rins_runtime::service::{Service, ServiceContext};
 use rins_runtime::service_loop::ServiceLoop;
 use rins_runtime::stage_io::StagePublisher;
@@ -17,6 +17,10 @@ use rins_serial_reader::reconnecting::{LineEvents, read_reconnecting};
 
 use crate::config::GnssConfig;
 use crate::counters;
+use crate::link_report::{ServiceCounts, Silence, SilentLine, link_report};
+
+/// How often the line report is published, ns: with the heartbeat.
+const REPORT_PERIOD_NS: u64 = 1_000_000_000;
 
 /// The gnss process: reads the configured receiver until a stop is requested.
 pub struct GnssService {
@@ -31,6 +35,7 @@ impl Service for GnssService {
         })?;
         let node = create_node(ServiceKind::Gnss.name(), &ctx.settings)?;
         let publisher = StagePublisher::<GnssFix>::new(&node, names::GNSS, Stage::Acquisition)?;
+        let link_publisher = TopicPublisher::<GnssLinkReport>::new(&node, names::GNSS_LINK)?;
         let service = ServiceLoop::new(&node, ServiceKind::Gnss, &ctx.shutdown)?;
         let mut reader = Reader {
             simulator_link: ctx.settings.in_run_dir(std::path::Path::new(&path)),
@@ -39,11 +44,22 @@ impl Service for GnssService {
             last_byte_ns: monotonic_ns(),
             publisher,
             decoder: GnssDecoder::new(),
-            published: 0,
+            counts: ServiceCounts::default(),
+            link_publisher,
+            silence: SilentLine::default(),
+            next_report_ns: 0,
         };
         let mut buf = [0u8; 1024];
         read_reconnecting(&path, &self.config.line(), service, &mut buf, &mut reader)?;
-        tracing::info!(epochs = reader.published, "gnss stopped");
+        // The receiver's last epoch, complete or not, then the final counts, for whoever reads
+        // the line's figures at the end of a run.
+        let (publisher, counts) = (&reader.publisher, &mut reader.counts);
+        let mut counters = Health::default();
+        reader.decoder.flush(monotonic_ns(), |fix| {
+            publish(publisher, fix, counts, &mut counters)
+        });
+        reader.report(monotonic_ns());
+        tracing::info!(epochs = reader.counts.published, "gnss stopped");
         Ok(())
     }
 }
@@ -60,7 +76,33 @@ struct Reader<'a> {
     last_byte_ns: u64,
     publisher: StagePublisher<GnssFix>,
     decoder: GnssDecoder,
-    published: u64,
+    counts: ServiceCounts,
+    link_publisher: TopicPublisher<GnssLinkReport>,
+    silence: SilentLine,
+    next_report_ns: u64,
+}
+
+impl Reader<'_> {
+    /// Judges the line's silence and publishes the line report.
+    fn report(&mut self, now_ns: u64) {
+        let stats = self.decoder.stats();
+        match self.silence.observe(&stats, now_ns) {
+            Silence::Began => tracing::warn!(
+                port = %self.path,
+                bytes = stats.bytes,
+                checksum_errors = stats.checksum_errors,
+                unframed_bytes = stats.framing.unframed_bytes,
+                "the GNSS line carries bytes but no usable sentence or frame: check the receiver's \
+                 baud rate and protocol (rins probe --gnss listens to it)"
+            ),
+            Silence::Ended => tracing::info!(port = %self.path, "usable GNSS messages again"),
+            Silence::Unchanged => {}
+        }
+        let report = link_report(&stats, &self.counts, &self.silence, now_ns);
+        if self.link_publisher.publish(report).is_err() {
+            self.counts.publish_failures += 1;
+        }
+    }
 }
 
 impl LineEvents for Reader<'_> {
@@ -85,33 +127,50 @@ impl LineEvents for Reader<'_> {
     fn bytes(&mut self, bytes: &[u8], counters: &mut Health) {
         let rx_ns = monotonic_ns();
         self.last_byte_ns = rx_ns;
-        let (publisher, published) = (&self.publisher, &mut self.published);
-        self.decoder
-            .push(bytes, rx_ns, |fix| match publisher.publish(fix) {
-                Ok(_) => *published += 1,
-                Err(_) => counters.rejected += 1,
-            });
+        let (publisher, counts) = (&self.publisher, &mut self.counts);
+        self.decoder.push(bytes, rx_ns, |fix| {
+            publish(publisher, fix, counts, counters)
+        });
     }
 
     fn after_read(&mut self, counters: &mut Health) {
         let now_ns = monotonic_ns();
         // An epoch a sentence of which was lost is not held until the receiver speaks again.
-        let (publisher, published) = (&self.publisher, &mut self.published);
+        let (publisher, counts) = (&self.publisher, &mut self.counts);
         self.decoder
-            .close_quiet(now_ns, |fix| match publisher.publish(fix) {
-                Ok(_) => *published += 1,
-                Err(_) => counters.rejected += 1,
-            });
+            .close_quiet(now_ns, |fix| publish(publisher, fix, counts, counters));
         let quiet = now_ns.saturating_sub(self.last_byte_ns) > self.stale_ns;
         if quiet && counters.input_stale == 0 {
             counters.stale_input_episodes += 1;
             tracing::warn!(port = %self.path, "the GNSS receiver went quiet");
         }
         counters.input_stale = u8::from(quiet);
-        counters::fill(counters, &self.decoder.stats(), self.published);
+        counters::fill(counters, &self.decoder.stats(), self.counts.published);
+        self.counts.quiet = quiet;
+        self.counts.reconnects = counters.reconnects;
+        if now_ns >= self.next_report_ns {
+            self.next_report_ns = now_ns + REPORT_PERIOD_NS;
+            self.report(now_ns);
+        }
     }
 
     fn lost(&mut self, e: &std::io::Error, _: Duration, _: &Presence) {
         tracing::warn!(port = %self.path, error = %e, "GNSS receiver lost: reopening with backoff");
+    }
+}
+
+/// Publishes one epoch, counting it, or counting its failure.
+fn publish(
+    publisher: &StagePublisher<GnssFix>,
+    fix: GnssFix,
+    counts: &mut ServiceCounts,
+    counters: &mut Health,
+) {
+    match publisher.publish(fix) {
+        Ok(_) => counts.published += 1,
+        Err(_) => {
+            counts.publish_failures += 1;
+            counters.rejected += 1;
+        }
     }
 }

@@ -98,6 +98,7 @@ impl HealthPublisher {
         report.redundancy = monitor.redundancy_report(now_ns);
         report.nav = monitor.nav_report(now_ns);
         report.link = link_report(monitor);
+        report.gnss = monitor.last_gnss_link;
         self.publisher.publish(report)?;
         Ok(Some(report))
     }

@@ -7,6 +7,7 @@ pub mod deployment_checks;
 pub mod device_counters;
 pub mod error_stats;
 pub mod fault_tracking;
+pub mod gnss_line;
 pub mod health_publisher;
 pub mod health_report;
 pub mod horizontal;

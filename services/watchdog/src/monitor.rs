@@ -3,8 +3,8 @@
 
 use anyhow::Result;
 use ipc_types::{
-    Altitude, FaultApplied, FusedImu, Health, Integrity, LinkReport, NavMode, NavReport, NavState,
-    RawBaro, RawImu, RawMag, RedundancyReport, ServiceKind, Truth, names,
+    Altitude, FaultApplied, FusedImu, GnssLinkReport, Health, Integrity, LinkReport, NavMode,
+    NavReport, NavState, RawBaro, RawImu, RawMag, RedundancyReport, ServiceKind, Truth, names,
 };
 use rins_navigator::lanes::NavSubscriber;
 use rins_runtime::clock::monotonic_ns;
@@ -47,6 +47,9 @@ pub struct Monitor {
     truth: TopicSubscriber<Truth>,
     health: TopicSubscriber<Health>,
     fault_events: TopicSubscriber<FaultApplied>,
+    gnss_link: TopicSubscriber<GnssLinkReport>,
+    /// The gnss service's latest line report (not heard before the first).
+    pub last_gnss_link: GnssLinkReport,
     /// Samples seen per topic of [`COUNTED`], since start.
     pub totals: [u64; COUNTED.len()],
     /// Navigation samples missing from the merged stream.
@@ -87,6 +90,8 @@ impl Monitor {
             truth: TopicSubscriber::new(node, names::TRUTH)?,
             health: TopicSubscriber::new(node, names::HEARTBEAT)?,
             fault_events: TopicSubscriber::new(node, names::SIM_FAULT_APPLIED)?,
+            gnss_link: TopicSubscriber::new(node, names::GNSS_LINK)?,
+            last_gnss_link: GnssLinkReport::default(),
             totals: [0; COUNTED.len()],
             nav_gaps: SeqGaps::default(),
             last_nav: None,
@@ -168,6 +173,7 @@ impl Monitor {
             + self.truth.rejected()
             + self.health.rejected()
             + self.fault_events.rejected()
+            + self.gnss_link.rejected()
     }
 
     /// Takes everything queued on every topic.
@@ -198,6 +204,9 @@ impl Monitor {
         }
         while let Some(h) = self.health.receive()? {
             self.on_health(&h);
+        }
+        while let Some(g) = self.gnss_link.receive()? {
+            self.last_gnss_link = g;
         }
         Ok(())
     }

@@ -78,5 +78,6 @@ pub fn summarise(
         processes: usage,
         faults: monitor.faults.records().to_vec(),
         false_alarms: monitor.faults.false_alarms(),
+        gnss: crate::gnss_line::gnss_row(&monitor.last_gnss_link),
     }
 }

@@ -174,4 +174,8 @@ pub struct Summary {
     /// Channels leaving Ok, or faults detected but not isolated, on a sensor type with no
     /// injected fault active, counted as events.
     pub false_alarms: u64,
+    /// The GNSS receiver's line at the end of the run, every counter of the gnss service's last
+    /// report (absent without a gnss service, or when it never reported).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gnss: Option<crate::gnss_line::GnssRow>,
 }

@@ -69,6 +69,9 @@ pub fn summary_text(s: &Summary) -> String {
         };
         out.push_str(&format!("  horizontal end-point error: {err:.2} m{of}\n"));
     }
+    if let Some(gnss) = &s.gnss {
+        out.push_str(&crate::gnss_line::summary_line(gnss));
+    }
     if !s.faults.is_empty() || s.false_alarms > 0 {
         let isolated = s
             .faults
@@ -151,6 +154,7 @@ mod tests {
             pipeline_wakeups_per_frame: 0.0,
             faults: Vec::new(),
             false_alarms: 0,
+            gnss: None,
         }
     }
 

@@ -4,6 +4,7 @@
 //! library code run in this process on the same frames, fusion's view of the frames, and the
 //! scratch directory the configurations and logs go to.
 
+mod gnss_captures;
 mod pyshoe;
 mod quadrotor;
 
@@ -21,6 +22,7 @@ use rins_runtime::shutdown::Shutdown;
 
 use super::progress::Progress;
 
+pub use gnss_captures::{GnssLiveOptions, gnss_captures};
 pub use pyshoe::pyshoe;
 pub use quadrotor::quadrotor_ahrs;
 

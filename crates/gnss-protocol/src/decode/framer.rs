@@ -25,9 +25,16 @@ use ublox::proto23::Proto23;
 /// sky. A declared length above this is a corrupted header, whatever the class.
 pub const MAX_UBX_PAYLOAD: usize = <Proto23 as UbxProtocol>::MAX_PAYLOAD_LEN as usize;
 
-/// NAV-PVT, the message the decoder uses, has one length in every protocol version it reads: a
-/// NAV-PVT header declaring another is corrupted, and is refused without waiting for its bytes.
-const NAV_PVT: (u8, u8, usize) = (0x01, 0x07, 92);
+/// NAV-PVT, the message the decoder uses, and its lengths: 92 bytes from protocol 15 on, 84 in
+/// u-blox 7 firmware (protocol 14, without headVeh, magDec and magAcc). A NAV-PVT header
+/// declaring another is corrupted, and is refused without waiting for its bytes.
+const NAV_PVT: (u8, u8, [usize; 2]) = (0x01, 0x07, [NAV_PVT_LEN, NAV_PVT_PROTO14_LEN]);
+
+/// NAV-PVT's payload length from UBX protocol 15 on.
+pub const NAV_PVT_LEN: usize = 92;
+
+/// NAV-PVT's payload length in UBX protocol 14 (u-blox 7): the first 84 bytes of the later form.
+pub const NAV_PVT_PROTO14_LEN: usize = 84;
 
 /// The longest sentence taken, from `$` to the line end inclusive. NMEA 0183 allows 82 bytes, but
 /// receivers exceed it (u-blox's high-precision GGA, proprietary PUBX sentences); a sentence's
@@ -85,7 +92,7 @@ pub struct FramingStats {
     /// corrupted. Also counted as malformed by the decoder.
     pub oversized: u64,
     /// UBX headers declaring a length within that bound but not their message's (a NAV-PVT of
-    /// another length than 92), or one whose claimed bytes hold a whole frame or sentence:
+    /// another length than 92 or 84), or one whose claimed bytes hold a whole frame or sentence:
     /// corrupted. Also counted as malformed by the decoder.
     pub wrong_length: u64,
     /// Bytes in no sentence or good UBX frame handed on: another protocol's output (RTCM, a
@@ -275,7 +282,7 @@ impl Framer {
         if declared > MAX_UBX_PAYLOAD {
             return refused(Kind::UbxOversized);
         }
-        if (class, id) == (NAV_PVT.0, NAV_PVT.1) && declared != NAV_PVT.2 {
+        if (class, id) == (NAV_PVT.0, NAV_PVT.1) && !NAV_PVT.2.contains(&declared) {
             return refused(Kind::UbxWrongLength);
         }
         let total = UBX_HEADER + declared + UBX_CHECKSUM;
@@ -585,6 +592,13 @@ mod tests {
         let (items, s) = frame(&[0xB5, 0x62, 0x01, 0x07, 93, 0]);
         assert_eq!(items, vec!["UbxBadLength"]);
         assert_eq!((s.oversized, s.wrong_length), (0, 1));
+    }
+
+    #[test]
+    fn a_nav_pvt_of_protocol_14_is_framed() {
+        let (items, s) = frame(&ubx_frame(0x01, 0x07, &[0; NAV_PVT_PROTO14_LEN]));
+        assert_eq!(items, vec!["UBX 01 07 84"]);
+        assert_eq!(s.wrong_length, 0);
     }
 
     #[test]

@@ -25,7 +25,7 @@ use ublox::UbxProtocol;
 use ublox::proto23::Proto23;
 
 pub use epoch_source::EpochSource;
-pub use nmea_epoch::{NmeaEpoch, SentenceOutcome};
+pub use nmea_epoch::{EPOCH_QUIET_NS, NmeaEpoch, SAME_EPOCH_US, SentenceOutcome};
 pub use nmea_sentence::NmeaStats;
 pub use sanity::is_plausible;
 pub use ubx_epoch::{FrameOutcome, UbxEpoch};
@@ -36,7 +36,7 @@ pub use ubx_pvt::fix_from_nav_pvt;
 pub struct GnssDecoderStats {
     /// Bytes taken in.
     pub bytes: u64,
-    /// NMEA sentences with a good checksum that were used (GGA, GNS, RMC, GLL, GST, VTG).
+    /// NMEA sentences with a good checksum that were used (GGA, GNS, RMC, GLL, GST, VTG, GSA).
     pub sentences: u64,
     /// UBX navigation frames taken into an epoch (NAV-PVT, HNR-PVT, NAV-SOL, NAV-POSLLH,
     /// NAV-VELNED, NAV-DOP, NAV-EOE; see [`UbxEpoch`]).
@@ -45,7 +45,7 @@ pub struct GnssDecoderStats {
     pub checksum_errors: u64,
     /// NMEA sentences the parser could not read, and UBX frames it refused.
     pub unparsable: u64,
-    /// Well-formed messages of other kinds (GSV, GSA, other UBX classes, `!` encapsulation
+    /// Well-formed messages of other kinds (GSV, ZDA, other UBX classes, `!` encapsulation
     /// sentences such as AIS): passed by.
     pub unsupported: u64,
     /// Messages whose values are out of range or not numbers, and UBX headers declaring a length
@@ -85,6 +85,8 @@ pub struct GnssDecoder {
     source: EpochSource,
     seq: u64,
     stats: GnssDecoderStats,
+    /// Receive time of the last UBX frame taken into an epoch, ns.
+    ubx_last_rx_ns: u64,
 }
 
 impl GnssDecoder {
@@ -111,12 +113,15 @@ impl GnssDecoder {
         self.publish_pending(ubx, nmea, rx_ns, &mut on_epoch);
     }
 
-    /// Hands out an NMEA epoch the receiver has sent nothing for since
-    /// a second (`EPOCH_QUIET_NS`) before `now_ns`, complete or not (a sentence of it was
-    /// lost and the receiver went quiet). [`Self::push`] does this first.
+    /// Hands out an NMEA or UBX epoch the receiver has sent nothing for since a second
+    /// (`EPOCH_QUIET_NS`) before `now_ns`, complete or not (a message of it was lost and the
+    /// receiver went quiet), stamped with the receive time of its last message. [`Self::push`]
+    /// does this first.
     pub fn close_quiet(&mut self, now_ns: u64, mut on_epoch: impl FnMut(GnssFix)) {
         let nmea = self.nmea.close_quiet(now_ns);
-        self.publish_pending(None, nmea, now_ns, &mut on_epoch);
+        let ubx_quiet = now_ns >= self.ubx_last_rx_ns.saturating_add(EPOCH_QUIET_NS);
+        let ubx = if ubx_quiet { self.ubx.flush() } else { None };
+        self.publish_pending(ubx, nmea, self.ubx_last_rx_ns, &mut on_epoch);
     }
 
     fn publish_pending(
@@ -153,16 +158,20 @@ impl GnssDecoder {
             source,
             seq,
             stats,
+            ubx_last_rx_ns,
         } = self;
         let mut emit = |fix: GnssFix, rx_ns: u64, stats: &mut GnssDecoderStats| {
             on_epoch(stamp(fix, rx_ns, seq, stats));
         };
         framer.push(bytes, |item| match item {
             Framed::Ubx { class, id, payload } => {
+                let mut padded = [0u8; framer::NAV_PVT_LEN];
+                let payload = pad_proto14_nav_pvt(class, id, payload, &mut padded);
                 match <Proto23 as UbxProtocol>::match_packet(class, id, payload) {
                     Ok(packet) => match ubx.push(&packet) {
                         FrameOutcome::Used { closed, completed } => {
                             stats.ubx_frames += 1;
+                            *ubx_last_rx_ns = rx_ns;
                             for fix in [closed, completed].into_iter().flatten() {
                                 source.ubx_published();
                                 emit(fix, rx_ns, stats);
@@ -202,6 +211,21 @@ impl GnssDecoder {
             },
         });
     }
+}
+
+/// `payload`, or a protocol 14 NAV-PVT's 84 bytes copied into `padded` (its later fields
+/// headVeh, magDec, magAcc zero, unused by the decoder): the parser reads the 92-byte form only.
+fn pad_proto14_nav_pvt<'a>(
+    class: u8,
+    id: u8,
+    payload: &'a [u8],
+    padded: &'a mut [u8; framer::NAV_PVT_LEN],
+) -> &'a [u8] {
+    if (class, id) != (0x01, 0x07) || payload.len() != framer::NAV_PVT_PROTO14_LEN {
+        return payload;
+    }
+    padded[..payload.len()].copy_from_slice(payload);
+    padded
 }
 
 /// `fix` stamped with its receive time and the next sequence number, and counted.

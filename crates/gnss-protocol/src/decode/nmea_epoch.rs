@@ -2,8 +2,8 @@
 //!
 //! **Which sentences make an epoch.** Sentences whose UTC times differ by less than
 //! [`SAME_EPOCH_US`] belong to one epoch (receivers round the same instant differently in
-//! different sentences: `014421.076` in GLL, `014421.08` in GGA). VTG carries no time and belongs
-//! to the epoch in progress.
+//! different sentences: `014421.076` in GLL, `014421.08` in GGA). VTG and GSA carry no time and
+//! belong to the epoch in progress.
 //!
 //! **When it is published.** An epoch is handed out
 //! - as soon as it holds every sentence (kind and talker) the two epochs before it held, so that
@@ -24,6 +24,10 @@
 //!   (receivers that send only RMC, or a GGA with an empty quality field): a two-dimensional fix,
 //!   three-dimensional only when such a GGA/GNS of the epoch gives an altitude;
 //! - a GGA/GNS without altitude gives a two-dimensional fix;
+//! - the fix mode of the epoch's GSA (any talker; the best of several) overrides a satellite
+//!   fix's: mode 2 makes it two-dimensional (the altitude the receiver gave is kept: it is the
+//!   one it holds, not a measurement), mode 1 makes it no fix; without GSA a GGA/GNS fix with an
+//!   altitude is three-dimensional. Dead reckoning is not a satellite fix and keeps its type;
 //! - the receiver's dead reckoning (GGA quality 6, mode E) is published as such, and manual input
 //!   or simulation (GGA 7, 8; mode M, S) as without a fix: neither is a satellite measurement.
 //!
@@ -32,12 +36,12 @@
 //!
 //! **Accuracy.** GST's σ when the receiver sends it; else [`UERE_M`] × HDOP (vertical 1.5 times
 //! that), and with no HDOP either, the HDOP of a poor geometry ([`HDOP_WHEN_UNREPORTED`]): a fix
-//! of unknown accuracy must not look good. A two-dimensional fix has no altitude and no vertical
-//! accuracy (NaN).
+//! of unknown accuracy must not look good. A two-dimensional fix has no vertical accuracy (NaN),
+//! and no altitude unless a GSA made it two-dimensional.
 
 use ipc_types::{GnssFix, GnssFixType, GnssProtocol, PAYLOAD_VERSION};
 
-use super::nmea_reading::{self, Position, Quality, Reading};
+use super::nmea_reading::{self, FixMode, Position, Quality, Reading};
 use super::nmea_sentence::{self, Kind, NmeaStats, Refused, Talker, Used};
 use super::sanity::is_plausible;
 
@@ -112,6 +116,8 @@ struct Epoch {
     /// RMC or GLL (RMC kept over GLL), by talker.
     planar: [Option<Report>; Talker::COUNT],
     vtg_velocity: Option<[f64; 2]>,
+    /// The best fix mode of its GSA.
+    fix_mode: Option<FixMode>,
     /// GST's horizontal and vertical σ.
     accuracy: Option<[f64; 2]>,
     /// The sentences it holds: one bit per kind and talker.
@@ -184,6 +190,17 @@ impl NmeaEpoch {
                         e.vtg_velocity = velocity.or(e.vtg_velocity);
                     }
                 });
+                None
+            }
+            Reading::FixMode(mode) => {
+                let Some(epoch) = self.epoch.as_mut() else {
+                    self.stats.gsa += 1;
+                    return SentenceOutcome::Unsupported;
+                };
+                // A receiver sends one GSA per satellite system: the epoch's mode is the best.
+                if !epoch.published {
+                    epoch.fix_mode = epoch.fix_mode.max(Some(mode));
+                }
                 None
             }
             Reading::Nothing => {
@@ -275,6 +292,7 @@ impl Epoch {
             full: [None; Talker::COUNT],
             planar: [None; Talker::COUNT],
             vtg_velocity: None,
+            fix_mode: None,
             accuracy: None,
             seen: 0,
             arrivals: 0,
@@ -320,10 +338,11 @@ impl Epoch {
         let p = chosen.position;
         let mut fix = no_fix(p.time_us, self.last_rx_ns);
         fix.satellites = self.satellites();
-        let fix_type = match p.quality {
-            Quality::Fix(t) => t,
-            Quality::DeadReckoning => GnssFixType::DeadReckoning,
-            Quality::NoFix | Quality::Unknown => return Some(fix),
+        let fix_type = match (p.quality, self.fix_mode) {
+            (Quality::Fix(_), Some(FixMode::NoFix)) => return Some(fix),
+            (Quality::Fix(t), _) => t,
+            (Quality::DeadReckoning, _) => GnssFixType::DeadReckoning,
+            (Quality::NoFix | Quality::Unknown, _) => return Some(fix),
         };
         // A GGA/GNS that does not state its quality lends its altitude to the RMC/GLL.
         let altitude = p.altitude_m.or_else(|| {
@@ -335,11 +354,14 @@ impl Epoch {
         let hdop = p
             .hdop
             .or_else(|| best(&self.full, |q| q.hdop.is_some()).and_then(|r| r.position.hdop));
-        fix.fix_type = match (fix_type, altitude) {
+        let two_d = self.fix_mode == Some(FixMode::TwoD);
+        let fix_type = match (fix_type, altitude) {
             (GnssFixType::DeadReckoning, _) => GnssFixType::DeadReckoning,
+            (_, Some(_)) if two_d => GnssFixType::Fix2d,
             (t, Some(_)) => t,
             (_, None) => GnssFixType::Fix2d,
-        } as u8;
+        };
+        fix.fix_type = fix_type as u8;
         fix.latitude_rad = p.latitude_deg.to_radians();
         fix.longitude_rad = p.longitude_deg.to_radians();
         fix.altitude_m = altitude.unwrap_or(f64::NAN);
@@ -355,10 +377,10 @@ impl Epoch {
             }
         };
         fix.horizontal_accuracy_m = horizontal;
-        fix.vertical_accuracy_m = if altitude.is_some() {
-            vertical
-        } else {
+        fix.vertical_accuracy_m = if fix_type == GnssFixType::Fix2d || altitude.is_none() {
             f64::NAN
+        } else {
+            vertical
         };
         let rmc_velocity = best(&self.planar, |q| q.velocity_ne_mps.is_some())
             .and_then(|r| r.position.velocity_ne_mps);
@@ -489,6 +511,70 @@ mod tests {
         assert!(!same_epoch(45_319_000_000, 45_319_010_000));
         assert!(same_epoch(DAY_US - 5_000, 0));
         assert!(!same_epoch(DAY_US - 50_000, 0));
+    }
+
+    /// Garmin GPS 25LP (GPSD project regression logs): RMC, GGA with quality 1 and an altitude,
+    /// then GSA.
+    const GARMIN_RMC: &str =
+        "$GPRMC,120327,A,4221.3872,N,01322.0800,E,000.0,000.0,150305,001.4,E*75\r\n";
+    const GARMIN_GGA: &str =
+        "$GPGGA,120327,4221.3872,N,01322.0800,E,1,03,3.1,746.1,M,44.2,M,,*41\r\n";
+    const GSA_2D: &str = "$GPGSA,A,2,01,03,,14,,,,,,,,,3.1,3.1,*1A\r\n";
+    /// A CH-4711 before its first fix.
+    const GSA_NO_FIX: &str = "$GPGSA,A,1,,,,,,,,,,,,,00.0,00.0,00.0*00\r\n";
+    /// A Garmin GPSmap 76S reporting a 3-D fix.
+    const GSA_3D: &str = "$GPGSA,A,3,03,07,08,11,13,16,19,23,24,28,,,3.6,2.0,3.0*3A\r\n";
+
+    fn epoch_with(gsa: &[&str]) -> (GnssFix, NmeaStats) {
+        let mut e = NmeaEpoch::default();
+        for (i, s) in [GARMIN_RMC, GARMIN_GGA].iter().chain(gsa).enumerate() {
+            let outcome = e.push(s.as_bytes(), i as u64);
+            assert!(matches!(outcome, SentenceOutcome::Used { .. }), "{s}");
+        }
+        (e.flush().unwrap(), e.stats())
+    }
+
+    #[test]
+    fn a_gsa_of_the_epoch_states_its_fix_mode() {
+        let (fix, _) = epoch_with(&[]);
+        assert_eq!(fix.fix_type, GnssFixType::Fix3d as u8);
+        // Mode 2: two-dimensional, with the altitude the receiver holds and no vertical σ.
+        let (fix, _) = epoch_with(&[GSA_2D]);
+        assert_eq!(fix.fix_type, GnssFixType::Fix2d as u8);
+        assert_eq!(fix.altitude_m, 746.1);
+        assert!(fix.vertical_accuracy_m.is_nan());
+        assert!((fix.horizontal_accuracy_m - 3.1 * UERE_M).abs() < 1e-9);
+        assert!((fix.latitude_rad.to_degrees() - (42.0 + 21.3872 / 60.0)).abs() < 1e-12);
+        // Mode 1: no fix, whatever the GGA's quality.
+        let (fix, _) = epoch_with(&[GSA_NO_FIX]);
+        assert_eq!(fix.fix_type, GnssFixType::NoFix as u8);
+        assert!(fix.latitude_rad == 0.0 && fix.satellites == 3);
+        // Several GSA (one per satellite system): the best mode.
+        let (fix, _) = epoch_with(&[GSA_NO_FIX, GSA_2D]);
+        assert_eq!(fix.fix_type, GnssFixType::Fix2d as u8);
+        let (fix, _) = epoch_with(&[GSA_2D, GSA_3D, GSA_NO_FIX]);
+        assert_eq!(fix.fix_type, GnssFixType::Fix3d as u8);
+        assert!((fix.vertical_accuracy_m - 3.1 * UERE_M * VERTICAL_PER_HORIZONTAL).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_gsa_with_no_epoch_in_progress_is_counted_and_not_used() {
+        let mut e = NmeaEpoch::default();
+        assert_eq!(e.push(GSA_2D.as_bytes(), 1), SentenceOutcome::Unsupported);
+        assert_eq!(e.stats().gsa, 1);
+        // It does not carry over to the next epoch.
+        e.push(GARMIN_GGA.as_bytes(), 2);
+        assert_eq!(e.flush().unwrap().fix_type, GnssFixType::Fix3d as u8);
+    }
+
+    #[test]
+    fn a_gsa_after_its_epoch_was_handed_out_changes_nothing() {
+        let mut e = NmeaEpoch::default();
+        e.push(GARMIN_GGA.as_bytes(), 1);
+        let fix = e.flush().unwrap();
+        assert_eq!(fix.fix_type, GnssFixType::Fix3d as u8);
+        assert_eq!(fixes(e.push(GSA_NO_FIX.as_bytes(), 2)), (None, None));
+        assert!(e.flush().is_none());
     }
 
     #[test]

@@ -48,6 +48,17 @@ impl Quality {
     }
 }
 
+/// The fix mode a GSA states, worst first.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum FixMode {
+    /// 1: no fix.
+    NoFix,
+    /// 2: two-dimensional (the altitude held, not measured).
+    TwoD,
+    /// 3: three-dimensional.
+    ThreeD,
+}
+
 /// A position sentence (GGA, GNS, RMC, GLL).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Position {
@@ -85,7 +96,10 @@ pub enum Reading {
     },
     /// VTG: ground velocity north and east, m/s, when it gives one; it has no time.
     Velocity(Option<[f64; 2]>),
-    /// A timed sentence without its time, or a GST without σ: nothing to place or use.
+    /// GSA: the fix mode of the solution; it has no time.
+    FixMode(FixMode),
+    /// A timed sentence without its time, a GST without σ, a GSA without its mode: nothing to
+    /// place or use.
     Nothing,
 }
 
@@ -98,6 +112,7 @@ pub fn read(kind: Used, mut f: Fields<'_>) -> Result<Reading, BadField> {
         Used::Gll => gll(&mut f),
         Used::Gst => gst(&mut f),
         Used::Vtg => vtg(&mut f),
+        Used::Gsa => gsa(&mut f),
     }
 }
 
@@ -205,6 +220,18 @@ fn vtg(f: &mut Fields<'_>) -> Result<Reading, BadField> {
         (Some(speed), Some(course)) if quality.is_fix() => Some(ground_velocity(speed, course)?),
         _ => None,
     }))
+}
+
+/// `selection,mode,satellite×12,PDOP,HDOP,VDOP[,system]`: selection M (manual) or A (automatic),
+/// mode 1 (no fix), 2 (2-D) or 3 (3-D).
+fn gsa(f: &mut Fields<'_>) -> Result<Reading, BadField> {
+    f.flag(b"MA")?;
+    Ok(match f.flag(b"123")? {
+        None => Reading::Nothing,
+        Some(b'1') => Reading::FixMode(FixMode::NoFix),
+        Some(b'2') => Reading::FixMode(FixMode::TwoD),
+        Some(_) => Reading::FixMode(FixMode::ThreeD),
+    })
 }
 
 /// The NMEA 2.3+ mode letter (absent in older sentences: the status alone says valid).
@@ -446,5 +473,28 @@ mod tests {
             reading(Used::Vtg, "090.0,X,,M,10.0,N,18.5,K"),
             Err(BadField)
         );
+    }
+
+    #[test]
+    fn gsa_states_the_fix_mode() {
+        // Garmin GPS 25LP, CH-4711, Garmin GPSmap 76S (GPSD project regression logs).
+        assert_eq!(
+            reading(Used::Gsa, "A,2,01,03,,14,,,,,,,,,3.1,3.1,"),
+            Ok(Reading::FixMode(FixMode::TwoD))
+        );
+        assert_eq!(
+            reading(Used::Gsa, "A,1,,,,,,,,,,,,,00.0,00.0,00.0"),
+            Ok(Reading::FixMode(FixMode::NoFix))
+        );
+        assert_eq!(
+            reading(Used::Gsa, "A,3,03,07,08,11,13,16,19,23,24,28,,,3.6,2.0,3.0"),
+            Ok(Reading::FixMode(FixMode::ThreeD))
+        );
+        assert_eq!(
+            reading(Used::Gsa, "A,,,,,,,,,,,,,,,,"),
+            Ok(Reading::Nothing)
+        );
+        assert_eq!(reading(Used::Gsa, "A,4,,,,,,,,,,,,,,,"), Err(BadField));
+        assert!(FixMode::ThreeD > FixMode::TwoD && FixMode::TwoD > FixMode::NoFix);
     }
 }

@@ -23,11 +23,13 @@ pub enum Used {
     Gst,
     /// Course and speed over ground (no time).
     Vtg,
+    /// DOP and active satellites: the fix mode (no time).
+    Gsa,
 }
 
 impl Used {
     /// How many kinds there are (for per-kind tables).
-    pub const COUNT: usize = 6;
+    pub const COUNT: usize = 7;
 }
 
 /// The talker of a sentence, as far as combining several in one epoch needs it.
@@ -67,15 +69,16 @@ impl Talker {
 }
 
 /// What the NMEA side set aside, by kind. Well-formed sentences with a good checksum that the
-/// decoder does not use: satellites in view (GSV), DOP and active satellites (GSA), date (ZDA),
-/// text (TXT) and fault detection (GBS) are what receivers send most besides the position; other
+/// decoder does not use: satellites in view (GSV), date (ZDA), text (TXT) and fault detection
+/// (GBS) are what receivers send most besides the position and DOP (GSA); other
 /// standard sentences (route, waypoint, heading, depth, …) and proprietary ones (`$P…`: PGRME,
 /// PSTI, PMTK, PUBX, …) are counted together.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
 pub struct NmeaStats {
     /// GSV: satellites in view.
     pub gsv: u64,
-    /// GSA: DOP and active satellites.
+    /// GSA (DOP and active satellites, read for its fix mode) with no epoch in progress to place
+    /// it in: sent before the receiver's first timed sentence. Not used.
     pub gsa: u64,
     /// ZDA: date and time.
     pub zda: u64,
@@ -108,8 +111,6 @@ pub enum Kind {
     Used(Used),
     /// Satellites in view.
     Gsv,
-    /// DOP and active satellites.
-    Gsa,
     /// Date and time.
     Zda,
     /// Text.
@@ -128,7 +129,6 @@ impl NmeaStats {
         let counter = match kind {
             Kind::Used(_) => &mut self.nothing_to_use,
             Kind::Gsv => &mut self.gsv,
-            Kind::Gsa => &mut self.gsa,
             Kind::Zda => &mut self.zda,
             Kind::Txt => &mut self.txt,
             Kind::Gbs => &mut self.gbs,
@@ -227,7 +227,7 @@ fn kind_of(formatter: &[u8]) -> Kind {
         b"GST" => Kind::Used(Used::Gst),
         b"VTG" => Kind::Used(Used::Vtg),
         b"GSV" => Kind::Gsv,
-        b"GSA" => Kind::Gsa,
+        b"GSA" => Kind::Used(Used::Gsa),
         b"ZDA" => Kind::Zda,
         b"TXT" => Kind::Txt,
         b"GBS" => Kind::Gbs,
@@ -260,7 +260,11 @@ mod tests {
         // A doubled `$`, and no line end.
         assert_eq!(kind(&format!("${}", gga.trim_end())), kind(gga));
         let cases = [
-            ("BDGSA,A,3,,,,,,,,,,,,,1.2,0.7,1.0", Talker::Gb, Kind::Gsa),
+            (
+                "BDGSA,A,3,,,,,,,,,,,,,1.2,0.7,1.0",
+                Talker::Gb,
+                Kind::Used(Used::Gsa),
+            ),
             ("QZGSV,1,1,01,193,45,120,40", Talker::Gq, Kind::Gsv),
             ("GNZDA,012520.00,12,04,2019,00,00", Talker::Gn, Kind::Zda),
             (

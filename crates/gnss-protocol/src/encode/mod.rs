@@ -8,7 +8,7 @@ mod nmea_writer;
 mod ubx_writer;
 
 pub use nmea_writer::write_nmea_epoch;
-pub use ubx_writer::write_nav_pvt;
+pub use ubx_writer::{write_nav_pvt, write_ubx_frame};
 
 /// The fix type of `fix`, a number this build does not know read as no fix.
 fn fix_type(fix: &ipc_types::GnssFix) -> ipc_types::GnssFixType {

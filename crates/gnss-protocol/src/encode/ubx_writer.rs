@@ -53,10 +53,19 @@ pub fn write_nav_pvt(epoch: &GnssFix, out: &mut Vec<u8>) {
             &((epoch.hdop * 150.0).round() as u16).to_le_bytes(),
         );
     }
+    write_ubx_frame(0x01, 0x07, &p, out);
+}
+
+/// Appends one UBX frame of `class`, `id` and `payload` to `out`: sync, header, payload and the
+/// checksum over class, id, length and payload. A payload longer than a UBX length field holds
+/// (65 535 bytes) is cut there.
+pub fn write_ubx_frame(class: u8, id: u8, payload: &[u8], out: &mut Vec<u8>) {
+    let len = u16::try_from(payload.len()).unwrap_or(u16::MAX);
+    let payload = &payload[..usize::from(len)];
     let start = out.len();
-    out.extend_from_slice(&[0xB5, 0x62, 0x01, 0x07]);
-    out.extend_from_slice(&(PAYLOAD_LEN as u16).to_le_bytes());
-    out.extend_from_slice(&p);
+    out.extend_from_slice(&[0xB5, 0x62, class, id]);
+    out.extend_from_slice(&len.to_le_bytes());
+    out.extend_from_slice(payload);
     let (mut a, mut b) = (0u8, 0u8);
     for &byte in &out[start + 2..] {
         a = a.wrapping_add(byte);

@@ -103,9 +103,19 @@ layout! {
         heard, mode, lane, integrity, aiding, integrity_reasons, age_ms,
     }
 
+    /// [`GnssLinkReport`], on [`ipc_types::names::GNSS_LINK`] and nested in [`HealthReport`].
+    pub static GNSS_LINK_REPORT: GnssLinkReport = "GnssLinkReport" {
+        version, heard, silent, quiet, _pad as pad0, now_ns, bytes, reconnects, sentences_used,
+        ubx_frames_used, unused_gsv, unused_gsa, unused_zda, unused_txt, unused_gbs,
+        unused_other_nmea, unused_proprietary, unused_other_messages, nothing_to_use,
+        checksum_errors, without_checksum, malformed, oversized, wrong_length, resyncs,
+        unframed_bytes, lines_crlf, lines_lf, epochs, epochs_without_fix, published,
+        publish_failures, ubx_late, nmea_epochs_superseded, silent_episodes,
+    }
+
     /// [`HealthReport`], on [`ipc_types::names::HEALTH`].
     pub static HEALTH_REPORT: HealthReport = "HealthReport" {
-        version, count, _pad as pad0, now_ns, uptime_ms, services, link, redundancy, nav,
+        version, count, _pad as pad0, now_ns, uptime_ms, services, link, redundancy, nav, gnss,
     }
 
     /// [`FaultApplied`], on [`ipc_types::names::SIM_FAULT_APPLIED`].

@@ -4,7 +4,16 @@
 //! A reference that does not come from rins's own decoder: gpsd is a second, widely used decoder
 //! of these receivers, so an epoch rins does not publish, or publishes elsewhere, is a difference
 //! between two independent readings of one byte stream.
+//!
+//! **Time-only epochs are not reference epochs.** A u-blox timing receiver in its fixed-position
+//! mode reports fix type 5, "time only" (NAV-PVT fixType, NAV-SOL gpsFix): it solves for time
+//! alone and repeats a position it was given. gpsd reports these epochs as 3-D fixes; the
+//! product's decoder refuses them by design, as they measure no position. The epochs whose own
+//! UBX output (NAV-PVT or NAV-SOL of the same iTOW) says time-only are therefore left out of the
+//! reference and counted apart ([`Reference::time_only_epochs`]). The fix type byte is read from
+//! the frames as the product's framer finds them, not through the decoder under evaluation.
 
+use rins_gnss_protocol::decode::framer::{Framed, Framer};
 use serde::Serialize;
 use serde_json::Value;
 
@@ -66,11 +75,47 @@ pub struct Reference {
     pub fixes_without_time: usize,
     /// Lines that start like JSON (`{`) but do not parse.
     pub unreadable_lines: usize,
+    /// gpsd's epochs with a position that the receiver's own UBX output calls time-only: not
+    /// reference epochs.
+    pub time_only_epochs: usize,
+}
+
+/// UBX fix type "time only" (NAV-PVT fixType, NAV-SOL gpsFix).
+const TIME_ONLY: u8 = 5;
+
+/// The times of week (iTOW, ms) of the epochs whose NAV-PVT or NAV-SOL in `receiver_bytes` says
+/// time-only, sorted and without repeats.
+pub fn time_only_itows_ms(receiver_bytes: &[u8]) -> Vec<u64> {
+    let mut itows = Vec::new();
+    let mut framer = Box::<Framer>::default();
+    framer.push(receiver_bytes, |item| {
+        let Framed::Ubx { class, id, payload } = item else {
+            return;
+        };
+        // Offset of the fix type: NAV-PVT after iTOW and the date and time, NAV-SOL after iTOW,
+        // fTOW and the week.
+        let fix_type_at = match (class, id) {
+            (0x01, 0x07) => 20,
+            (0x01, 0x06) => 10,
+            _ => return,
+        };
+        if let (Some(&TIME_ONLY), Some(itow)) = (payload.get(fix_type_at), payload.get(..4)) {
+            itows.push(u64::from(u32::from_le_bytes([
+                itow[0], itow[1], itow[2], itow[3],
+            ])));
+        }
+    });
+    itows.sort_unstable();
+    itows.dedup();
+    itows
 }
 
 /// The reference epochs of a `.chk` file: TPV reports with `mode` ≥ 2 and both `lat` and `lon`,
-/// one per distinct `time` (gpsd reports some epochs twice as more sentences of it arrive).
-pub fn reference_epochs(chk: &str) -> Reference {
+/// one per distinct `time` (gpsd reports some epochs twice as more sentences of it arrive),
+/// except those that `receiver_bytes` (the capture gpsd decoded) report as time-only.
+pub fn reference_epochs(chk: &str, receiver_bytes: &[u8]) -> Reference {
+    let time_only = time_only_itows_ms(receiver_bytes);
+    let mut time_only_seen = Vec::new();
     let mut reference = Reference::default();
     for line in chk.lines() {
         let line = line.trim();
@@ -101,7 +146,12 @@ pub fn reference_epochs(chk: &str) -> Reference {
             reference.fixes_without_time += 1;
             continue;
         };
-        if reference.epochs.iter().any(|e| e.time == time) {
+        if reference.epochs.iter().any(|e| e.time == time) || time_only_seen.contains(&time) {
+            continue;
+        }
+        if time_only.binary_search(&time.gps_time_of_week_ms()).is_ok() {
+            time_only_seen.push(time);
+            reference.time_only_epochs += 1;
             continue;
         }
         let alt_msl_m = value
@@ -199,6 +249,7 @@ pub fn gps_minus_utc_s(day: i64) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rins_gnss_protocol::encode::write_ubx_frame;
 
     #[test]
     fn civil_days_match_known_dates() {
@@ -257,6 +308,52 @@ mod tests {
         assert_eq!(gps_minus_utc_s(days_from_civil(1980, 1, 6)), 0);
     }
 
+    /// A UBX frame of `payload` with its checksum.
+    fn ubx_frame(class: u8, id: u8, payload: &[u8]) -> Vec<u8> {
+        let mut frame = Vec::new();
+        write_ubx_frame(class, id, payload, &mut frame);
+        frame
+    }
+
+    /// NAV-PVT (92 bytes) or NAV-SOL (52 bytes) of `itow` with fix type `fix_type`.
+    fn solution(pvt: bool, itow: u32, fix_type: u8) -> Vec<u8> {
+        let (id, len, at) = if pvt { (0x07, 92, 20) } else { (0x06, 52, 10) };
+        let mut payload = vec![0u8; len];
+        payload[..4].copy_from_slice(&itow.to_le_bytes());
+        payload[at] = fix_type;
+        ubx_frame(0x01, id, &payload)
+    }
+
+    #[test]
+    fn epochs_the_receiver_calls_time_only_are_counted_apart() {
+        // Monday 2019-01-07, 18 leap seconds: 10:00:0s UTC is iTOW 122 400 000 + 19 000 + s.
+        let itow = |s: u32| 86_400_000 + 36_000_000 + 18_000 + 1_000 * s;
+        let mut bytes = b"$GPTXT,01,01,02,x*00\r\n".to_vec();
+        bytes.extend(solution(true, itow(0), 3));
+        bytes.extend(solution(true, itow(1), 5));
+        bytes.extend(solution(false, itow(1), 5));
+        bytes.extend(solution(false, itow(2), 5));
+        bytes.extend(ubx_frame(0x01, 0x02, &itow(3).to_le_bytes()));
+        assert_eq!(
+            time_only_itows_ms(&bytes),
+            [itow(1), itow(2)].map(u64::from)
+        );
+        let tpv = |s: u32| {
+            format!(
+                "{{\"class\":\"TPV\",\"mode\":3,\"time\":\"2019-01-07T10:00:0{s}.000Z\",\
+                 \"lat\":45.0,\"lon\":7.0}}\n"
+            )
+        };
+        // Epoch 1 reported twice by gpsd, epoch 3 of another message.
+        let chk: String = [0, 1, 1, 2, 3].map(tpv).concat();
+        let reference = reference_epochs(&chk, &bytes);
+        assert_eq!(reference.time_only_epochs, 2);
+        let kept: Vec<u32> = reference.epochs.iter().map(|e| e.time.ms_of_day).collect();
+        assert_eq!(kept, [36_000_000, 36_003_000]);
+        // Without the receiver's bytes every epoch is a reference epoch.
+        assert_eq!(reference_epochs(&chk, b"").epochs.len(), 4);
+    }
+
     #[test]
     fn first_tpv_of_each_time_with_a_position_is_an_epoch() {
         let chk = concat!(
@@ -274,7 +371,7 @@ mod tests {
             "{\"class\":\"TPV\",\"mode\":3,\"time\":\"2017-07-19T08:50:02.000Z\",\"lat\":-34.9}\n",
             "{\"class\":\"TPV\",\"mode\":3,\"time\":\"2017-07-19T08:50:02\n",
         );
-        let reference = reference_epochs(chk);
+        let reference = reference_epochs(chk, b"");
         assert_eq!(reference.fixes_without_time, 1);
         assert_eq!(reference.unreadable_lines, 1);
         assert_eq!(reference.epochs.len(), 2);

@@ -18,6 +18,9 @@ pub struct Totals {
     pub with_reference_yielding_fix: usize,
     /// Reference epochs.
     pub reference_epochs: usize,
+    /// gpsd's fixes that the receivers' own UBX output calls time-only: not reference epochs (a
+    /// time-only solution measures no position; see [`super::reference`]).
+    pub reference_time_only_epochs: usize,
     /// Published fixes with a position.
     pub published_with_position: usize,
     /// Published fixes matched to a reference epoch.
@@ -32,6 +35,15 @@ pub struct Totals {
     pub unmatched: usize,
     /// Captures whose bytes came in but of which nothing was used.
     pub silent: usize,
+    /// Published fixes with a position for which their capture has a position message (GGA,
+    /// GNS, RMC, GLL, NAV-PVT, NAV-POSLLH, NAV-SOL) of the same receiver time.
+    pub fixes_with_own_position: usize,
+    /// Of those, fixes within 1 cm of at least one such message.
+    pub fixes_within_1cm_of_own: usize,
+    /// Published fixes with a position without such a message, or not a number.
+    pub fixes_without_own_position: usize,
+    /// Largest distance of a fix from its nearest own position message, m.
+    pub worst_own_horizontal_m: Option<f64>,
 }
 
 /// The totals of the captures of one protocol group.
@@ -76,11 +88,21 @@ pub fn totals<'a>(captures: impl IntoIterator<Item = &'a CaptureResult>) -> Tota
             }
         }
         t.reference_epochs += s.reference_epochs;
+        t.reference_time_only_epochs += c.reference_time_only_epochs;
         t.published_with_position += s.published_with_position;
         t.matched += s.matched;
         t.within_1cm += s.within_1cm;
         t.unmatched += s.unmatched;
         t.silent += usize::from(c.decoder.silent());
+        t.fixes_with_own_position += c.own.fixes_with_own_position;
+        t.fixes_within_1cm_of_own += c.own.fixes_within_1cm_of_own;
+        t.fixes_without_own_position += c.own.fixes_without_own_position;
+        if let Some(w) = c.own.worst_own {
+            t.worst_own_horizontal_m = Some(
+                t.worst_own_horizontal_m
+                    .map_or(w.horizontal_m, |m| m.max(w.horizontal_m)),
+            );
+        }
     }
     t.matched_pct = pct(t.matched, t.reference_epochs);
     t.within_1cm_pct = pct(t.within_1cm, t.reference_epochs);
@@ -145,22 +167,39 @@ pub fn to_table(r: &CapturesReport) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<34} {:<9} {:>5} {:>5} {:>5} {:>5} {:>9} {:>9} | decoder: bytes sent ubx cksum unpars unsup malf epochs",
-        "capture", "protocol", "ref", "pub", "match", "<=1cm", "worst h m", "worst v m"
+        "{:<34} {:<9} {:>5} {:>5} {:>5} {:>5} {:>5} {:>9} {:>9} | {:>5} {:>8} {:>6} {:>11} | decoder: bytes sent ubx cksum unpars unsup malf epochs",
+        "capture",
+        "protocol",
+        "ref",
+        "tonly",
+        "pub",
+        "match",
+        "<=1cm",
+        "worst h m",
+        "worst v m",
+        "own",
+        "own<=1cm",
+        "no own",
+        "worst own m"
     );
     for c in &r.captures {
         let (sc, d) = (&c.score, &c.decoder);
         let _ = writeln!(
             s,
-            "{:<34} {:<9} {:>5} {:>5} {:>5} {:>5} {:>9} {:>9} | {} {} {} {} {} {} {} {}{}",
+            "{:<34} {:<9} {:>5} {:>5} {:>5} {:>5} {:>5} {:>9} {:>9} | {:>5} {:>8} {:>6} {:>11} | {} {} {} {} {} {} {} {}{}",
             c.name,
             group_name(c.protocols),
             sc.reference_epochs,
+            c.reference_time_only_epochs,
             sc.published_with_position,
             sc.matched,
             sc.within_1cm,
             metres(sc.worst_horizontal_m),
             metres(sc.worst_vertical_m),
+            c.own.fixes_with_own_position,
+            c.own.fixes_within_1cm_of_own,
+            c.own.fixes_without_own_position,
+            metres(c.own.worst_own.map(|w| w.horizontal_m)),
             d.bytes,
             d.sentences,
             d.ubx_frames,
@@ -174,18 +213,23 @@ pub fn to_table(r: &CapturesReport) -> String {
     }
     let _ = writeln!(
         s,
-        "\n{:<10} {:>8} {:>8} {:>9} {:>9} {:>9} {:>8} {:>9} {:>8} {:>9} {:>6}",
+        "\n{:<10} {:>8} {:>8} {:>9} {:>9} {:>6} {:>9} {:>8} {:>9} {:>8} {:>9} {:>6} | {:>6} {:>8} {:>6} {:>11}",
         "protocol",
         "captures",
         "with ref",
         "yielding",
         "ref",
+        "tonly",
         "matched",
         "%",
         "<=1cm",
         "%",
         "unmatched",
-        "silent"
+        "silent",
+        "own",
+        "own<=1cm",
+        "no own",
+        "worst own m"
     );
     let rows = r
         .by_protocol
@@ -195,18 +239,23 @@ pub fn to_table(r: &CapturesReport) -> String {
     for (name, t) in rows {
         let _ = writeln!(
             s,
-            "{:<10} {:>8} {:>8} {:>9} {:>9} {:>9} {:>8.1} {:>9} {:>8.1} {:>9} {:>6}",
+            "{:<10} {:>8} {:>8} {:>9} {:>9} {:>6} {:>9} {:>8.1} {:>9} {:>8.1} {:>9} {:>6} | {:>6} {:>8} {:>6} {:>11}",
             name,
             t.captures,
             t.with_reference,
             t.with_reference_yielding_fix,
             t.reference_epochs,
+            t.reference_time_only_epochs,
             t.matched,
             t.matched_pct,
             t.within_1cm,
             t.within_1cm_pct,
             t.unmatched,
-            t.silent
+            t.silent,
+            t.fixes_with_own_position,
+            t.fixes_within_1cm_of_own,
+            t.fixes_without_own_position,
+            metres(t.worst_own_horizontal_m)
         );
     }
     // gpsd's latitude and longitude repeat the first epoch for some u-blox receivers while its
@@ -215,6 +264,19 @@ pub fn to_table(r: &CapturesReport) -> String {
         s,
         "\n<=1cm: horizontal distance from gpsd's latitude and longitude, or from its ECEF \
          position (WGS84) where its report carries one and that is nearer"
+    );
+    let _ = writeln!(
+        s,
+        "tonly: gpsd's fixes whose epoch the receiver's own NAV-PVT/NAV-SOL calls time-only \
+         (fix type 5): no position measured, not in ref"
+    );
+    let _ = writeln!(
+        s,
+        "own: published fixes for which the capture itself has a position message (GGA, GNS, RMC, \
+         GLL, NAV-PVT, NAV-POSLLH, NAV-SOL) of the same receiver time (UTC within 10 ms, iTOW \
+         equal, a repeated time matched epoch by epoch); own<=1cm: within 1 cm of the epoch's \
+         GGA, GNS, NAV-PVT or NAV-POSLLH, or without one of its RMC, GLL or NAV-SOL; no own: \
+         fixes without one"
     );
     if !r.silent_captures.is_empty() {
         let _ = writeln!(
@@ -233,7 +295,7 @@ pub fn to_table(r: &CapturesReport) -> String {
 mod tests {
     use super::*;
     use crate::gnss_captures::replay::ProtocolsSeen;
-    use crate::gnss_captures::score::Score;
+    use crate::gnss_captures::score::{OwnScore, Score};
     use rins_gnss_protocol::decode::GnssDecoderStats;
 
     fn capture(
@@ -248,6 +310,13 @@ mod tests {
             seen: ProtocolsSeen::default(),
             reference_fixes_without_time: 0,
             reference_unreadable_lines: 0,
+            reference_time_only_epochs: reference / 5,
+            own: OwnScore {
+                fixes_with_own_position: matched,
+                fixes_within_1cm_of_own: matched / 2,
+                fixes_without_own_position: 1,
+                ..OwnScore::default()
+            },
             score: Score {
                 reference_epochs: reference,
                 published: matched + 1,
@@ -285,12 +354,17 @@ mod tests {
         assert_eq!(t.with_reference, 3);
         assert_eq!(t.with_reference_yielding_fix, 2);
         assert_eq!(t.reference_epochs, 20);
+        // A fifth of each capture's reference: 2 + 0 + 1 + 0.
+        assert_eq!(t.reference_time_only_epochs, 3);
         assert_eq!(t.matched, 8);
         assert!((t.matched_pct - 40.0).abs() < 1e-12);
         assert_eq!(t.within_1cm, 4);
         assert!((t.within_1cm_pct - 20.0).abs() < 1e-12);
         assert_eq!(t.unmatched, 4);
         assert_eq!(t.silent, 2);
+        assert_eq!(t.fixes_with_own_position, 8);
+        assert_eq!(t.fixes_within_1cm_of_own, 4);
+        assert_eq!(t.fixes_without_own_position, 4);
         assert_eq!(report.silent_captures, ["b.log", "c.log"]);
         let groups: Vec<_> = report.by_protocol.iter().map(|g| g.protocols).collect();
         assert_eq!(

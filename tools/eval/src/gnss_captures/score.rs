@@ -4,6 +4,9 @@
 use ipc_types::{GnssFix, GnssFixType, GnssProtocol};
 use serde::Serialize;
 
+use super::own_positions::{
+    MS_PER_WEEK, OwnMessage, OwnPlace, OwnPosition, OwnPositions, OwnTime, US_PER_DAY,
+};
 use super::reference::{MS_PER_DAY, ReferenceEpoch};
 
 /// Mean Earth radius, m (IUGG). Over the centimetres compared here the sphere's distance differs
@@ -173,6 +176,188 @@ pub fn haversine_m(lat1: f64, lon1: f64, lat2: f64, lon2: f64) -> f64 {
     2.0 * EARTH_RADIUS_M * a.sqrt().clamp(0.0, 1.0).asin()
 }
 
+/// An NMEA fix and a sentence are of the same epoch when their UTC times of day differ by at most
+/// this, µs: sentences carry hundredths or thousandths of a second, so a difference below 10 ms is
+/// only a difference of rounding.
+pub const OWN_SAME_TIME_US: u64 = 10_000;
+
+/// How one capture's published fixes compare with the capture's own position messages of the same
+/// receiver time ([`super::own_positions`]): a check of the product's readers against the bytes
+/// themselves, beside gpsd's decode.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct OwnScore {
+    /// Position messages in the capture (good checksum, a fix, readable fields).
+    pub own_positions: usize,
+    /// Position sentences set aside for a missing or wrong checksum.
+    pub own_bad_checksum: usize,
+    /// Position messages whose status, quality or fix type says "no fix".
+    pub own_no_fix: usize,
+    /// Position messages with an empty or unreadable field.
+    pub own_unreadable: usize,
+    /// Published fixes with a position for which the capture has a position message of the same
+    /// receiver time.
+    pub fixes_with_own_position: usize,
+    /// Of those, fixes within [`AGREE_M`] horizontally of the epoch's full solution message, or
+    /// without one of another position message of it (see [`score_own`]).
+    pub fixes_within_1cm_of_own: usize,
+    /// Published fixes with a position for which the capture has no position message of that
+    /// time, or whose latitude or longitude is not a number.
+    pub fixes_without_own_position: usize,
+    /// The fix farthest from its nearest own position message of the same time.
+    pub worst_own: Option<OwnWorst>,
+}
+
+/// A fix's distance from the nearest of the capture's own position messages of its time.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct OwnWorst {
+    /// Horizontal distance, m.
+    pub horizontal_m: f64,
+    /// The nearest message.
+    pub message: OwnMessage,
+    /// The fix's receiver time, µs (UTC time of day for NMEA, GPS time of week for UBX).
+    pub receiver_time_us: u64,
+}
+
+/// Compares every published fix with a position with the capture's `own` position messages of
+/// the same receiver time (NMEA: UTC time of day within [`OWN_SAME_TIME_US`]; UBX: iTOW equal in
+/// ms; a time the receiver repeats later is matched epoch by epoch, in order): the fix agrees
+/// when it lies within [`AGREE_M`] of the epoch's full solution (GGA, GNS, NAV-PVT, NAV-POSLLH)
+/// where the receiver sent one, else of one of its other position messages (RMC, GLL, NAV-SOL).
+pub fn score_own(own: &OwnPositions, fixes: &[GnssFix]) -> OwnScore {
+    let mut result = OwnScore {
+        own_positions: own.positions.len(),
+        own_bad_checksum: own.bad_checksum,
+        own_no_fix: own.no_fix,
+        own_unreadable: own.unreadable,
+        ..OwnScore::default()
+    };
+    let occurrence = occurrences(&own.positions);
+    // Fixes scored so far per receiver time: the k-th fix of a time is the k-th epoch of it.
+    let mut fixes_of_time: Vec<(OwnTime, usize)> = Vec::new();
+    for fix in fixes.iter().filter(|f| has_position(f)) {
+        let nearest = if fix.latitude_rad.is_finite() && fix.longitude_rad.is_finite() {
+            let same_time_at = |i: &usize| same_time(fix, own.positions[*i].time);
+            let epoch = (0..own.positions.len()).find(same_time_at).map(|first| {
+                let time = own.positions[first].time;
+                let k = match fixes_of_time.iter_mut().find(|(t, _)| *t == time) {
+                    Some((_, n)) => {
+                        *n += 1;
+                        *n - 1
+                    }
+                    None => {
+                        fixes_of_time.push((time, 1));
+                        0
+                    }
+                };
+                let last = (0..own.positions.len())
+                    .filter(same_time_at)
+                    .map(|i| occurrence[i])
+                    .max()
+                    .unwrap_or(0);
+                k.min(last)
+            });
+            // The receiver's full solution (GGA, GNS, NAV-PVT, NAV-POSLLH) where it sent one
+            // for the epoch: a fix that took a coarser sentence's position instead (RMC and GLL
+            // often carry fewer decimals) does not agree.
+            let of_epoch = || {
+                own.positions
+                    .iter()
+                    .zip(&occurrence)
+                    .filter(|(p, o)| same_time(fix, p.time) && Some(**o) == epoch)
+                    .map(|(p, _)| p)
+            };
+            let primary = of_epoch().any(|p| p.message.is_full_solution());
+            of_epoch()
+                .filter(|p| !primary || p.message.is_full_solution())
+                .map(|p| (own_distance_m(fix, p), p.message))
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+        } else {
+            None
+        };
+        let Some((horizontal_m, message)) = nearest else {
+            result.fixes_without_own_position += 1;
+            continue;
+        };
+        result.fixes_with_own_position += 1;
+        if horizontal_m <= AGREE_M {
+            result.fixes_within_1cm_of_own += 1;
+        }
+        if result
+            .worst_own
+            .is_none_or(|w| horizontal_m.total_cmp(&w.horizontal_m).is_gt())
+        {
+            result.worst_own = Some(OwnWorst {
+                horizontal_m,
+                message,
+                receiver_time_us: fix.receiver_time_us,
+            });
+        }
+    }
+    result
+}
+
+/// Which epoch of its receiver time each position message belongs to, counted from 0: a time
+/// met again after messages of other times is a later epoch (a receiver whose clock stepped
+/// back repeats its times with other positions).
+fn occurrences(positions: &[OwnPosition]) -> Vec<usize> {
+    let mut seen: Vec<(OwnTime, usize)> = Vec::new();
+    let mut previous: Option<OwnTime> = None;
+    positions
+        .iter()
+        .map(|p| {
+            let occurrence = match seen.iter_mut().find(|(t, _)| *t == p.time) {
+                Some((_, n)) if previous != Some(p.time) => {
+                    *n += 1;
+                    *n
+                }
+                Some((_, n)) => *n,
+                None => {
+                    seen.push((p.time, 0));
+                    0
+                }
+            };
+            previous = Some(p.time);
+            occurrence
+        })
+        .collect()
+}
+
+/// Whether `fix` and a position message of receiver time `time` are of one epoch.
+fn same_time(fix: &GnssFix, time: OwnTime) -> bool {
+    let ubx = fix.protocol == GnssProtocol::Ubx as u8;
+    match time {
+        OwnTime::TimeOfWeekMs(itow) if ubx => {
+            (fix.receiver_time_us + 500) / 1_000 % MS_PER_WEEK == itow % MS_PER_WEEK
+        }
+        OwnTime::UtcOfDayUs(us) if !ubx => {
+            // A time of day wraps at midnight: the nearer way round counts.
+            let d = (fix.receiver_time_us % US_PER_DAY).abs_diff(us % US_PER_DAY);
+            d.min(US_PER_DAY - d) <= OWN_SAME_TIME_US
+        }
+        _ => false,
+    }
+}
+
+/// Horizontal distance of `fix` from a position message, m: on the WGS84 ellipsoid's local radii
+/// of curvature for latitude and longitude (a flat earth is exact to far below a centimetre over
+/// the distances that decide agreement), or from an ECEF position as [`horizontal_from_ecef_m`].
+fn own_distance_m(fix: &GnssFix, own: &OwnPosition) -> f64 {
+    match own.place {
+        OwnPlace::Geodetic { lat_deg, lon_deg } => {
+            let dlat = fix.latitude_rad - lat_deg.to_radians();
+            // The shorter way round at the antimeridian.
+            let dlon = (fix.longitude_rad - lon_deg.to_radians() + std::f64::consts::PI)
+                .rem_euclid(std::f64::consts::TAU)
+                - std::f64::consts::PI;
+            let north = dlat * rins_earth::meridian_radius(fix.latitude_rad);
+            let east =
+                dlon * rins_earth::prime_vertical_radius(fix.latitude_rad) * fix.latitude_rad.cos();
+            north.hypot(east)
+        }
+        OwnPlace::Ecef(ecef) => horizontal_from_ecef_m(fix.latitude_rad, fix.longitude_rad, ecef),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -300,5 +485,128 @@ mod tests {
         let s = score(&[reference], &fixes);
         assert_eq!((s.matched, s.within_1cm), (1, 1));
         assert!(s.worst_horizontal_m.unwrap() < 1e-6);
+    }
+
+    fn own(message: OwnMessage, time: OwnTime, lat_deg: f64, lon_deg: f64) -> OwnPosition {
+        OwnPosition {
+            message,
+            time,
+            place: OwnPlace::Geodetic { lat_deg, lon_deg },
+        }
+    }
+
+    #[test]
+    fn fixes_are_compared_with_their_captures_own_messages_of_the_same_time() {
+        let day_us = 36_000_000_000_u64;
+        // 1 cm of latitude on the meridian at 45°, in degrees.
+        let cm_deg = (0.01 / rins_earth::meridian_radius(45.0_f64.to_radians())).to_degrees();
+        let (lat, lon) = (45.0_f64, 7.0_f64);
+        let ecef = ecef_from_geodetic(lat.to_radians(), (lon + 1e-6).to_radians(), 250.0);
+        let own_positions = OwnPositions {
+            positions: vec![
+                // An RMC with 4 decimals 5 mm off, and the GGA of the same second exact.
+                own(
+                    OwnMessage::Rmc,
+                    OwnTime::UtcOfDayUs(day_us + 4_000),
+                    lat + 0.5 * cm_deg,
+                    lon,
+                ),
+                own(OwnMessage::Gga, OwnTime::UtcOfDayUs(day_us), lat, lon),
+                // A second later: 2 cm off.
+                own(
+                    OwnMessage::Gga,
+                    OwnTime::UtcOfDayUs(day_us + 1_000_000),
+                    lat + 2.0 * cm_deg,
+                    lon,
+                ),
+                own(OwnMessage::NavPvt, OwnTime::TimeOfWeekMs(5_000), lat, lon),
+                OwnPosition {
+                    message: OwnMessage::NavSol,
+                    time: OwnTime::TimeOfWeekMs(6_000),
+                    place: OwnPlace::Ecef(ecef),
+                },
+            ],
+            bad_checksum: 1,
+            ..OwnPositions::default()
+        };
+        let fixes = [
+            fix(GnssProtocol::Nmea, day_us + 5_000, lat, lon),
+            fix(GnssProtocol::Nmea, day_us + 1_000_000, lat, lon),
+            // 20 ms from any sentence, a NaN, and a UBX time that only an NMEA sentence has.
+            fix(GnssProtocol::Nmea, day_us + 20_000, lat, lon),
+            fix(GnssProtocol::Nmea, day_us, f64::NAN, lon),
+            fix(GnssProtocol::Ubx, day_us, lat, lon),
+            // iTOW equal after rounding to ms; NAV-SOL's ECEF 1e-6° of longitude east.
+            fix(GnssProtocol::Ubx, 5_000_400, lat, lon),
+            fix(GnssProtocol::Ubx, 6_000_000, lat, lon),
+            GnssFix {
+                fix_type: GnssFixType::NoFix as u8,
+                ..fix(GnssProtocol::Ubx, 5_000_000, lat, lon)
+            },
+        ];
+        let s = score_own(&own_positions, &fixes);
+        assert_eq!((s.own_positions, s.own_bad_checksum), (5, 1));
+        assert_eq!(s.fixes_with_own_position, 4);
+        assert_eq!(s.fixes_within_1cm_of_own, 2);
+        assert_eq!(s.fixes_without_own_position, 3);
+        // The worst: NAV-SOL, 1e-6° of longitude at 45° (about 7.9 cm), beyond the GGA's 2 cm.
+        let worst = s.worst_own.unwrap();
+        let expected = 1e-6_f64.to_radians()
+            * rins_earth::prime_vertical_radius(45.0_f64.to_radians())
+            * 45.0_f64.to_radians().cos();
+        assert_eq!(worst.message, OwnMessage::NavSol);
+        assert_eq!(worst.receiver_time_us, 6_000_000);
+        assert!((worst.horizontal_m - expected).abs() < 1e-5, "{worst:?}");
+    }
+
+    #[test]
+    fn a_fix_must_agree_with_its_epochs_full_solution_and_a_repeated_time_is_a_later_epoch() {
+        let t_us = 36_000_000_000_u64;
+        let t = OwnTime::UtcOfDayUs(t_us);
+        let cm_deg = (0.01 / rins_earth::meridian_radius(45.0_f64.to_radians())).to_degrees();
+        let (lat, lon) = (45.0_f64, 7.0_f64);
+        let own_positions = OwnPositions {
+            positions: vec![
+                // The first epoch of time t: a coarse RMC 3 m off, and its GGA.
+                own(OwnMessage::Rmc, t, lat + 300.0 * cm_deg, lon),
+                own(OwnMessage::Gga, t, lat, lon),
+                own(
+                    OwnMessage::Gga,
+                    OwnTime::UtcOfDayUs(36_001_000_000),
+                    lat,
+                    lon,
+                ),
+                // The clock stepped back: time t again, 40 m further on, an RMC only.
+                own(OwnMessage::Rmc, t, lat + 4000.0 * cm_deg, lon),
+            ],
+            ..OwnPositions::default()
+        };
+        // A fix that took the RMC's position where the GGA was sent does not agree; the second
+        // epoch of t is scored against its own RMC, not the first epoch's GGA.
+        let coarse = [
+            fix(GnssProtocol::Nmea, t_us, lat + 300.0 * cm_deg, lon),
+            fix(GnssProtocol::Nmea, t_us, lat + 4000.0 * cm_deg, lon),
+        ];
+        let s = score_own(&own_positions, &coarse);
+        assert_eq!(
+            (s.fixes_with_own_position, s.fixes_within_1cm_of_own),
+            (2, 1)
+        );
+        let worst = s.worst_own.expect("a worst fix");
+        assert_eq!(worst.message, OwnMessage::Gga);
+        assert!((worst.horizontal_m - 3.0).abs() < 1e-3, "{worst:?}");
+        let exact = [
+            fix(GnssProtocol::Nmea, t_us, lat, lon),
+            fix(GnssProtocol::Nmea, t_us, lat + 4000.0 * cm_deg, lon),
+        ];
+        assert_eq!(score_own(&own_positions, &exact).fixes_within_1cm_of_own, 2);
+    }
+
+    #[test]
+    fn a_time_of_day_matches_across_midnight() {
+        let just_before = OwnTime::UtcOfDayUs(US_PER_DAY - 5_000);
+        let at_midnight = fix(GnssProtocol::Nmea, US_PER_DAY + 2_000, 0.0, 0.0);
+        assert!(same_time(&at_midnight, just_before));
+        assert!(!same_time(&at_midnight, OwnTime::UtcOfDayUs(20_000)));
     }
 }
