@@ -227,6 +227,44 @@ fn eval_quadrotor_ahrs_scores_every_flight_beside_each_units_own_filter() {
         );
         assert_eq!(f["file_offsets_s"].as_array().unwrap().len(), 4, "{f}");
     }
+    check_references(&r, fused);
+}
+
+/// The reference filters and the average of the units' own filters, scored the same way: each
+/// grid's choice made on every flight, the default settings named, every figure finite and above
+/// rins's fused one (Madgwick 2.9°, Mahony 1.35° cross-validated on these flights; the averaged
+/// own filters 0.8°), and the start windows' means over the flights that reach them.
+fn check_references(r: &Value, fused: f64) {
+    for (filter, settings, default) in [
+        ("madgwick", 4, "Madgwick beta 0.1"),
+        ("mahony", 12, "Mahony kp 0.5 ki 0"),
+    ] {
+        let grid = r[filter]["grid"].as_array().unwrap();
+        assert_eq!(grid.len(), settings, "{filter}");
+        let chosen: u64 = grid.iter().map(|c| c["chosen"].as_u64().unwrap()).sum();
+        assert_eq!(chosen, 12, "{filter}");
+        assert_eq!(r[filter]["default"]["setting"], default);
+        for setting in ["default", "cross_validated"] {
+            let s = &r[filter][setting];
+            let figure = number(&s["fused_roll_pitch_rmse_deg"]);
+            assert!(figure > fused && figure < 5.0, "{filter} {setting}: {s}");
+            for unit in s["single_roll_pitch_rmse_deg"].as_array().unwrap() {
+                assert!(number(unit) > 0.2 && number(unit) < 8.0, "{filter}: {s}");
+            }
+            assert_eq!(s["samples_without_force"], 0, "{s}");
+        }
+    }
+    let average = number(&r["peer_average_roll_pitch_rmse_deg"]);
+    assert!(average > fused && average < 1.5, "{average}");
+    assert_eq!(r["window_starts_s"], serde_json::json!([5.0, 10.0, 30.0]));
+    // The straight-line flights end before 30 s.
+    assert_eq!(r["flights_per_window"], serde_json::json!([12, 12, 6]));
+    assert_eq!(r["long_flight_windows"]["flights"], 6);
+    for key in ["fused_window_rmse_deg", "peer_average_window_rmse_deg"] {
+        for w in r[key].as_array().unwrap() {
+            assert!(number(w) > 0.1 && number(w) < 2.0, "{key}: {r}");
+        }
+    }
 }
 
 /// Failed units, a counter wrap, an unreadable unit file and an empty reference file: the flights
@@ -292,11 +330,17 @@ fn eval_quadrotor_ahrs_goes_on_past_failed_units_and_broken_files() {
         "{one_unit}"
     );
     assert!(one_unit["peer_roll_pitch_rmse_deg"][1].is_null());
+    // One unit's own filter averaged is that filter, turned by the mounting of the other
+    // flights' four-unit averages (no other flight has unit 1 alone), as the fused solution is.
+    assert!(number(&one_unit["peer_average"]["roll_pitch_rmse_deg"]).is_finite());
+    assert!(one_unit["mahony"]["cross_validated"]["single_roll_pitch_rmse_deg"][1].is_null());
     let three_units = flights
         .iter()
         .find(|f| f["name"] == "Horizontal/path_7")
         .unwrap();
     assert_eq!(three_units["imus"], serde_json::json!([1, 2, 4]));
+    assert!(three_units["madgwick"]["default"]["single_roll_pitch_rmse_deg"][2].is_null());
+    assert!(number(&three_units["peer_average"]["roll_pitch_rmse_deg"]).is_finite());
 }
 
 #[test]

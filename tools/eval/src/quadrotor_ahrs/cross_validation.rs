@@ -8,6 +8,7 @@ use super::candidates::Candidate;
 use super::live::ScoredRun;
 use super::mounting::{Paired, fit_mounting, mounting_rotation, roll_pitch_rmse_deg};
 use super::run::{AttitudeTrace, GyroPrior, navigate_ahrs};
+use super::windows;
 use super::{CandidateFigure, Flight, FlightResult, SETTLE_S, pair, with_candidate};
 use crate::datasets::quadrotor::MAX_IMUS;
 use crate::quadrotor_nav::frames::Motion;
@@ -24,7 +25,7 @@ pub struct Outcome {
 }
 
 /// Mean score of `runs` after [`SETTLE_S`] with the mounting fitted on all of them.
-fn training_score(runs: &[&Paired]) -> f64 {
+pub(super) fn training_score(runs: &[&Paired]) -> f64 {
     let tilt = fit_mounting(runs, SETTLE_S);
     mean(
         &runs
@@ -35,7 +36,7 @@ fn training_score(runs: &[&Paired]) -> f64 {
 }
 
 /// `runs` without flight `f`.
-fn without<T>(runs: &[T], f: usize) -> Vec<&T> {
+pub(super) fn without<T>(runs: &[T], f: usize) -> Vec<&T> {
     runs.iter()
         .enumerate()
         .filter(|&(g, _)| g != f)
@@ -46,7 +47,7 @@ fn without<T>(runs: &[T], f: usize) -> Vec<&T> {
 /// The runs of the flights other than `f` and `also_left_out` that carry the same units as `f` (the
 /// fused solution of four units and of one are different instruments, with different biases and
 /// mountings); all those flights when none does.
-fn same_units<'a, T>(
+pub(super) fn same_units<'a, T>(
     flights: &[Flight],
     runs: &'a [T],
     f: usize,
@@ -65,7 +66,7 @@ fn same_units<'a, T>(
 }
 
 /// Where unit `imu` sits in each flight other than `f` that has it: `(flight, position)`.
-fn others_with_unit(flights: &[Flight], f: usize, imu: usize) -> Vec<(usize, usize)> {
+pub(super) fn others_with_unit(flights: &[Flight], f: usize, imu: usize) -> Vec<(usize, usize)> {
     flights
         .iter()
         .enumerate()
@@ -249,6 +250,7 @@ pub(crate) fn run(
             let fused = scored.paired(&scored.trace);
             let mut single = [None; MAX_IMUS];
             let mut peer = [None; MAX_IMUS];
+            let mut peer_windows = [None; MAX_IMUS];
             for (k, &imu) in flight.imus.iter().enumerate() {
                 let others = others_with_unit(flights, f, imu);
                 if others.is_empty() {
@@ -274,6 +276,7 @@ pub(crate) fn run(
                     SETTLE_S,
                 );
                 peer[imu - 1] = Some(roll_pitch_rmse_deg(&flight.peers[k], tilt, 0.0));
+                peer_windows[imu - 1] = Some(windows::of(&flight.peers[k], tilt));
             }
             progress(MAX_IMUS + 1);
             let result = FlightResult {
@@ -288,6 +291,11 @@ pub(crate) fn run(
                 file_offsets_s: flight.file_offsets_s.clone(),
                 repairs: flight.repairs,
                 notes: flight.notes.clone(),
+                fused_window_rmse_deg: windows::of(&fused, tilt),
+                peer_window_rmse_deg: peer_windows,
+                peer_average: Default::default(),
+                madgwick: Default::default(),
+                mahony: Default::default(),
                 live: None,
             };
             (result, scored)

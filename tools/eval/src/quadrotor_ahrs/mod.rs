@@ -21,13 +21,23 @@
 //!
 //! Nothing learnt from F is used to score F. A flight that cannot be loaded or prepared is
 //! reported with its reason and left out; the evaluation goes on.
+//!
+//! Beside rins, scored the same way: Madgwick's and Mahony's filters on the same motion
+//! ([`reference_cv`]), the average of the units' own filters ([`peer_average`]), and every
+//! series over windows of time since the start ([`windows`]).
 
 pub mod candidates;
 pub mod cross_validation;
 pub mod live;
 pub mod mounting;
+pub mod peer_average;
+pub mod reference_algorithms;
+pub mod reference_cv;
+pub mod reference_filter;
+pub mod reference_report;
 pub mod report;
 pub mod run;
+pub mod windows;
 
 use std::path::{Path, PathBuf};
 
@@ -47,7 +57,10 @@ use crate::quadrotor_nav::{require_data_dir, vehicle_from_reference};
 use candidates::Candidate;
 use live::ScoredRun;
 use mounting::Paired;
+use reference_cv::{PeerAverageScore, ReferenceFlight};
+use reference_report::ReferenceSummary;
 use run::AttitudeTrace;
+use windows::WindowRmse;
 
 /// Initial velocity σ of every run, m/s (see the module docs).
 pub const INITIAL_VELOCITY_SIGMA_MPS: f64 = 5.0;
@@ -70,6 +83,8 @@ pub(crate) struct Flight {
     rows: Vec<(f64, f64, f64)>,
     /// Each unit's on-board attitude paired with the reference rows.
     peers: Vec<Paired>,
+    /// The average of the units' on-board attitudes paired with the reference rows.
+    peer_average: Paired,
     truth_offset_s: f64,
     file_offsets_s: Vec<f64>,
     repairs: Repairs,
@@ -102,6 +117,17 @@ pub struct FlightResult {
     pub repairs: Repairs,
     /// What the loader repaired or noticed.
     pub notes: Vec<String>,
+    /// The fused RMSE over the windows of time since the start
+    /// ([`windows::WINDOW_STARTS_S`]), degrees.
+    pub fused_window_rmse_deg: WindowRmse,
+    /// Each unit's own filter over the same windows, by unit number (null when absent).
+    pub peer_window_rmse_deg: [Option<WindowRmse>; MAX_IMUS],
+    /// The normalised average of the units' own filters, scored the same way.
+    pub peer_average: PeerAverageScore,
+    /// Madgwick's filter on the same motion.
+    pub madgwick: ReferenceFlight,
+    /// Mahony's filter on the same motion.
+    pub mahony: ReferenceFlight,
     /// The same run through the running processes (`--live`).
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     pub live: Option<live::LiveFlight>,
@@ -148,6 +174,10 @@ pub struct AhrsReport {
     pub roll_pitch_target_met: bool,
     /// Every candidate's in-sample figure and how often it was chosen.
     pub candidates: Vec<CandidateFigure>,
+    /// The reference filters and the average of the units' own filters, scored the same way,
+    /// and the windows of time since the start.
+    #[serde(flatten)]
+    pub references: ReferenceSummary,
     /// Per flight.
     pub flights: Vec<FlightResult>,
     /// The fused runs through the running processes (`--live`).
@@ -187,21 +217,23 @@ fn prepare(trial: Trial) -> Result<Flight> {
         .filter(|r| r.t_s <= fused.end_s())
         .map(|r| (r.t_s, r.roll_rad, r.pitch_rad))
         .collect();
-    let peers = trial
+    let traces: Vec<AttitudeTrace> = trial
         .imus
         .iter()
-        .map(|series| {
-            let trace = AttitudeTrace {
-                t_s: series.samples.iter().map(|s| s.t_s).collect(),
-                attitude: series
-                    .samples
-                    .iter()
-                    .map(|s| quaternion_from_euler(s.euler_rad[0], s.euler_rad[1], s.euler_rad[2]))
-                    .collect::<Vec<UnitQuaternion<f64>>>(),
-            };
-            pair(&trace, start.t_s, &rows)
+        .map(|series| AttitudeTrace {
+            t_s: series.samples.iter().map(|s| s.t_s).collect(),
+            attitude: series
+                .samples
+                .iter()
+                .map(|s| quaternion_from_euler(s.euler_rad[0], s.euler_rad[1], s.euler_rad[2]))
+                .collect::<Vec<UnitQuaternion<f64>>>(),
         })
         .collect();
+    let peers = traces
+        .iter()
+        .map(|trace| pair(trace, start.t_s, &rows))
+        .collect();
+    let peer_average = peer_average::pair_average(&traces, start.t_s, &rows);
     Ok(Flight {
         name: trial.name.clone(),
         imus: trial.imus.iter().map(|s| s.imu).collect(),
@@ -214,6 +246,7 @@ fn prepare(trial: Trial) -> Result<Flight> {
         start,
         rows,
         peers,
+        peer_average,
     })
 }
 
@@ -286,14 +319,16 @@ pub fn evaluate_with_runs(
         done += runs;
         progress(done.min(total), total);
     });
+    let references = reference_cv::score_all(&flights, outcome.flights);
     progress(total, total);
-    let report = report::summarise(
+    let mut report = report::summarise(
         dir,
         flights_total,
         repairs,
         failures,
-        outcome.flights,
+        references.flights,
         outcome.candidates,
     );
+    report.references = reference_report::summarise(&report.flights, references.grids);
     Ok((report, outcome.runs))
 }

@@ -69,9 +69,15 @@ fn errors(p: &Paired, k: usize, m: &UnitQuaternion<f64>) -> [f64; 2] {
 /// degrees, with mounting tilt `tilt_rad`, over the rows at least `from_s` after the run's start;
 /// NaN without such rows.
 pub fn roll_pitch_rmse_deg(p: &Paired, tilt_rad: [f64; 2], from_s: f64) -> f64 {
+    roll_pitch_rmse_between_deg(p, tilt_rad, from_s, f64::INFINITY)
+}
+
+/// [`roll_pitch_rmse_deg`] over the rows from `from_s` (included) to `to_s` (excluded) after the
+/// run's start; NaN without such rows.
+pub fn roll_pitch_rmse_between_deg(p: &Paired, tilt_rad: [f64; 2], from_s: f64, to_s: f64) -> f64 {
     let m = mounting_rotation(tilt_rad);
     let (sum, n) = (0..p.len())
-        .filter(|&k| p.since_start_s[k] >= from_s)
+        .filter(|&k| p.since_start_s[k] >= from_s && p.since_start_s[k] < to_s)
         .map(|k| {
             let [r, q] = errors(p, k, &m);
             (r * r + q * q) / 2.0

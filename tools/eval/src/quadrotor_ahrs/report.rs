@@ -53,6 +53,7 @@ pub fn summarise(
         roll_pitch_target_deg: ROLL_PITCH_TARGET_DEG,
         roll_pitch_target_met: fused <= ROLL_PITCH_TARGET_DEG,
         candidates,
+        references: super::reference_report::ReferenceSummary::default(),
         flights,
         live: None,
     }
@@ -130,6 +131,7 @@ pub fn to_table(r: &AhrsReport) -> String {
             c.name, c.in_sample_roll_pitch_rmse_deg, c.chosen
         );
     }
+    super::reference_report::lines(&mut s, r);
     let p = &r.repairs;
     let _ = writeln!(
         s,
