@@ -28,10 +28,13 @@ use serde::Serialize;
 
 use crate::datasets::quadrotor::projection::estimate_installation;
 use crate::datasets::quadrotor::{SkippedTrial, Trial, list_trials, load_trial, nothing_evaluated};
+use crate::quadrotor_ahrs::SETTLE_S;
+use crate::quadrotor_ahrs::mounting::{Paired, fit_mounting, roll_pitch_rmse_deg};
 use crate::quadrotor_nav::frames::{self, Motion};
 use crate::quadrotor_nav::metrics::{angle_error, mean, median, rms};
 use crate::quadrotor_nav::run::{Start, start_from_truth};
 use crate::quadrotor_nav::{require_data_dir, vehicle_from_reference};
+use rins_navigator::attitude::quaternion_from_euler;
 use run::{GnssTrace, navigate_with_gnss};
 
 /// Length of the outage at the end of each flight, s.
@@ -73,6 +76,9 @@ pub struct RunScores {
     pub fixes_outliers: usize,
     /// Times the monitor rejected the receiver.
     pub rejections: u64,
+    /// The solution's attitude at each scored reference row, for the mounting fit.
+    #[serde(skip)]
+    pub paired: Paired,
 }
 
 /// One flight's figures.
@@ -90,6 +96,12 @@ pub struct FlightResult {
     pub median_single_end_error_m: f64,
     /// The drift test's setting, chosen on the other flights.
     pub drift_setting: cross_validation::Choice,
+    /// The fused roll/pitch RMSE with the units' mounting tilt fitted on the other flights, as
+    /// `--mode ahrs` scores, degrees (the mounting is the airframe's, not the flight's).
+    pub fused_roll_pitch_rmse_mounted_deg: f64,
+    /// The same with the mounting fitted on every flight, this one included: in sample, shown
+    /// beside the held-out figure so that overfitting shows.
+    pub fused_roll_pitch_rmse_mounted_in_sample_deg: f64,
 }
 
 /// The whole data set's figures.
@@ -103,6 +115,11 @@ pub struct GnssReport {
     pub trials: Vec<FlightResult>,
     /// Mean over flights of the fused roll/pitch RMSE, degrees.
     pub roll_pitch_rmse_deg: f64,
+    /// Mean over flights of the fused roll/pitch RMSE with the mounting fitted on the other
+    /// flights ([`FlightResult::fused_roll_pitch_rmse_mounted_deg`]), degrees.
+    pub roll_pitch_rmse_mounted_deg: f64,
+    /// The same with the mounting fitted on every flight (in sample), degrees.
+    pub roll_pitch_rmse_mounted_in_sample_deg: f64,
     /// The fused roll/pitch RMSE is within [`ROLL_PITCH_TARGET_DEG`] (`gnss` mode).
     pub roll_pitch_target_met: bool,
     /// Mean over flights of the fused heading RMSE, degrees.
@@ -131,6 +148,7 @@ pub struct GnssReport {
 /// Scores `trace` against the reference rows from `start` on.
 fn score(imu: Option<usize>, trace: &GnssTrace, trial: &Trial, start: &Start) -> RunScores {
     let (mut rp, mut yaw, mut horiz) = (Vec::new(), Vec::new(), Vec::new());
+    let mut paired = Paired::default();
     let mut end = f64::NAN;
     for row in trial.truth.iter().skip(start.row) {
         let i = trace.samples.partition_point(|s| s.t_s < row.t_s);
@@ -142,6 +160,12 @@ fn score(imu: Option<usize>, trace: &GnssTrace, trial: &Trial, start: &Start) ->
             continue;
         };
         let [r, p, y] = s.euler_rad;
+        paired.push(
+            row.t_s - start.t_s,
+            quaternion_from_euler(r, p, y),
+            row.roll_rad,
+            row.pitch_rad,
+        );
         rp.push(angle_error(r, row.roll_rad).to_degrees());
         rp.push(angle_error(p, row.pitch_rad).to_degrees());
         yaw.push(angle_error(y, row.heading_rad).to_degrees());
@@ -158,6 +182,7 @@ fn score(imu: Option<usize>, trace: &GnssTrace, trial: &Trial, start: &Start) ->
         fixes_applied: trace.applied,
         fixes_outliers: trace.outliers,
         rejections: trace.rejections,
+        paired,
     }
 }
 
@@ -225,7 +250,33 @@ pub fn evaluate_trial(
         fused,
         median_single_end_error_m,
         drift_setting,
+        // Filled in once every flight has run: the mounting is fitted on the others.
+        fused_roll_pitch_rmse_mounted_deg: f64::NAN,
+        fused_roll_pitch_rmse_mounted_in_sample_deg: f64::NAN,
     })
+}
+
+/// Scores each flight's fused attitude with the units' mounting tilt fitted on the other
+/// flights (the rows after [`SETTLE_S`]), and on all of them for the in-sample figure.
+fn score_mounted(trials: &mut [FlightResult]) {
+    let all: Vec<&Paired> = trials.iter().map(|t| &t.fused.paired).collect();
+    let in_sample = fit_mounting(&all, SETTLE_S);
+    let held_out: Vec<[f64; 2]> = (0..trials.len())
+        .map(|f| {
+            let others: Vec<&Paired> = all
+                .iter()
+                .enumerate()
+                .filter(|&(g, _)| g != f)
+                .map(|(_, p)| *p)
+                .collect();
+            fit_mounting(&others, SETTLE_S)
+        })
+        .collect();
+    for (t, tilt) in trials.iter_mut().zip(held_out) {
+        t.fused_roll_pitch_rmse_mounted_deg = roll_pitch_rmse_deg(&t.fused.paired, tilt, 0.0);
+        t.fused_roll_pitch_rmse_mounted_in_sample_deg =
+            roll_pitch_rmse_deg(&t.fused.paired, in_sample, 0.0);
+    }
 }
 
 /// Every flight under `dir`; `progress(done, total)` after each navigator run.
@@ -321,6 +372,7 @@ pub fn evaluate(
     if trials.is_empty() {
         return Err(anyhow!("eval quadrotor: {}", nothing_evaluated(&skipped)));
     }
+    score_mounted(&mut trials);
     Ok(summarise(dir, mode, trials, skipped))
 }
 
@@ -350,6 +402,10 @@ fn summarise(
         dir: dir.to_path_buf(),
         mode,
         roll_pitch_rmse_deg: roll_pitch,
+        roll_pitch_rmse_mounted_deg: of(&|t| t.fused_roll_pitch_rmse_mounted_deg),
+        roll_pitch_rmse_mounted_in_sample_deg: of(&|t| {
+            t.fused_roll_pitch_rmse_mounted_in_sample_deg
+        }),
         roll_pitch_target_met: roll_pitch <= ROLL_PITCH_TARGET_DEG,
         heading_rmse_deg: of(&|t| t.fused.heading_rmse_deg),
         horizontal_rmse_m: of(&|t| t.fused.horizontal_rmse_m),
@@ -366,5 +422,80 @@ fn summarise(
         outage_target_met: mode == GnssMode::Outage && ratio <= OUTAGE_RATIO_TARGET,
         trials,
         skipped,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::quadrotor_ahrs::mounting::mounting_rotation;
+
+    /// A flight whose solution is the reference turned by the mounting `tilt`, at 1 Hz.
+    fn flight(tilt: [f64; 2], roll_deg: f64) -> FlightResult {
+        let mut paired = Paired::default();
+        let m_inv = mounting_rotation(tilt).inverse();
+        for k in 0..60 {
+            let (roll, pitch, yaw) = (roll_deg.to_radians(), (k as f64 * 0.01).sin(), 0.3);
+            let vehicle = quaternion_from_euler(roll, pitch, yaw);
+            paired.push(k as f64, vehicle * m_inv, roll, pitch);
+        }
+        let run = RunScores {
+            imu: None,
+            roll_pitch_rmse_deg: f64::NAN,
+            heading_rmse_deg: f64::NAN,
+            horizontal_rmse_m: f64::NAN,
+            end_horizontal_error_m: f64::NAN,
+            fixes_applied: 0,
+            fixes_outliers: 0,
+            rejections: 0,
+            paired,
+        };
+        FlightResult {
+            name: String::new(),
+            duration_s: 60.0,
+            single: Vec::new(),
+            fused: run,
+            median_single_end_error_m: f64::NAN,
+            drift_setting: cross_validation::Choice {
+                candidate: 0,
+                drift_slack: 0.0,
+                drift_threshold: 0.0,
+            },
+            fused_roll_pitch_rmse_mounted_deg: f64::NAN,
+            fused_roll_pitch_rmse_mounted_in_sample_deg: f64::NAN,
+        }
+    }
+
+    #[test]
+    fn each_flight_is_scored_with_the_mounting_of_the_others() {
+        let tilt = [0.7_f64.to_radians(), -0.5_f64.to_radians()];
+        let mut same = vec![flight(tilt, 2.0), flight(tilt, -3.0), flight(tilt, 5.0)];
+        score_mounted(&mut same);
+        for t in &same {
+            // The airframe's mounting, learnt from the other flights, removes the whole error.
+            assert!(
+                t.fused_roll_pitch_rmse_mounted_deg < 1e-6,
+                "{}",
+                t.fused_roll_pitch_rmse_mounted_deg
+            );
+            assert!(t.fused_roll_pitch_rmse_mounted_in_sample_deg < 1e-6);
+        }
+        // A flight mounted otherwise than the two others keeps the difference held out, and shares
+        // it in sample.
+        let mut odd = vec![
+            flight(tilt, 2.0),
+            flight(tilt, -3.0),
+            flight([0.0, 0.0], 5.0),
+        ];
+        score_mounted(&mut odd);
+        let held_out = odd[2].fused_roll_pitch_rmse_mounted_deg;
+        let rms_tilt_deg = ((tilt[0].powi(2) + tilt[1].powi(2)) / 2.0)
+            .sqrt()
+            .to_degrees();
+        assert!(
+            (held_out - rms_tilt_deg).abs() < 0.02,
+            "{held_out} vs {rms_tilt_deg}"
+        );
+        assert!(odd[2].fused_roll_pitch_rmse_mounted_in_sample_deg < held_out);
     }
 }

@@ -42,6 +42,11 @@ pub fn to_table(r: &GnssReport) -> String {
         r.gnss_rejections,
         r.gnss_rejections_fused
     );
+    let _ = writeln!(
+        s,
+        "fused roll/pitch with the units' mounting tilt fitted as --mode ahrs fits it: {:.3}° (fitted on the other flights), {:.3}° (in sample, fitted on every flight)",
+        r.roll_pitch_rmse_mounted_deg, r.roll_pitch_rmse_mounted_in_sample_deg
+    );
     if r.mode == GnssMode::Outage {
         let singles: Vec<String> = r
             .single_outage_error_m
