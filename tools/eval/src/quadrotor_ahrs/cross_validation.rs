@@ -105,21 +105,29 @@ const PRIOR_SIGMA_SCALES: [f64; 4] = [0.1, 0.25, 0.5, 1.0];
 /// spread (at least [`MIN_PRIOR_SIGMA_RPS`]). A unit's bias changes little between flights of one
 /// session; the live navigator has the same knowledge from its static alignment before take-off.
 fn prior_from(others: &[&Scored], scale: f64) -> Option<GyroPrior> {
-    if others.is_empty() {
+    let biases: Vec<[f64; 3]> = others.iter().map(|s| s.final_gyro_bias_rps).collect();
+    gyro_prior(&biases, scale)
+}
+
+/// A gyro bias prior from the biases `final_biases_rps` (rad/s) the same series ended other
+/// flights with: their mean, σ `scale` times their largest per-axis spread (at least
+/// [`MIN_PRIOR_SIGMA_RPS`]); `None` without any.
+pub fn gyro_prior(final_biases_rps: &[[f64; 3]], scale: f64) -> Option<GyroPrior> {
+    if final_biases_rps.is_empty() {
         return None;
     }
-    let n = others.len() as f64;
+    let n = final_biases_rps.len() as f64;
     let mut bias = [0.0; 3];
-    for s in others {
-        for (b, x) in bias.iter_mut().zip(s.final_gyro_bias_rps) {
-            *b += x / n;
+    for b in final_biases_rps {
+        for (m, x) in bias.iter_mut().zip(b) {
+            *m += x / n;
         }
     }
     let spread = (0..3)
         .map(|axis| {
-            let var = others
+            let var = final_biases_rps
                 .iter()
-                .map(|s| (s.final_gyro_bias_rps[axis] - bias[axis]).powi(2))
+                .map(|b| (b[axis] - bias[axis]).powi(2))
                 .sum::<f64>()
                 / n;
             var.sqrt()

@@ -11,11 +11,23 @@
 //! - `outage`: the receiver cut for the last [`OUTAGE_S`] of each flight; the horizontal error
 //!   at the end of the outage, the fused four beside each unit alone.
 //!
-//! One setting is chosen from these flights, the drift test's (`[navigator.gnss] drift_slack`
-//! and `drift_threshold`), leave-one-flight-out ([`cross_validation`]): each flight is scored
-//! with the setting the other flights chose. Everything else is the UAV profile's.
+//! Chosen from these flights, leave-one-flight-out (each flight is scored with what the other
+//! flights chose):
+//! - the drift test's setting (`[navigator.gnss] drift_slack` and `drift_threshold`,
+//!   [`cross_validation`]), on runs with the nominal antenna;
+//! - the antenna's lever arm (`[navigator.gnss] lever_arm_m`) and the lead of the reference's
+//!   position over the units' clock, from which the receiver's times are made ([`antenna`]).
+//!
+//! - each series' mounting and gyro bias at t0, as `--mode ahrs` learns them
+//!   ([`held_out_start`]): a first pass starts every run from the airframe's attitude with no
+//!   bias known; the second, scored, pass starts each flight's runs with what the first pass of
+//!   the other flights learnt, and scores the attitude with that mounting.
+//!
+//! Everything else is the UAV profile's.
 
+pub mod antenna;
 pub mod cross_validation;
+pub mod held_out_start;
 pub mod receiver;
 pub mod report;
 pub mod run;
@@ -30,10 +42,12 @@ use crate::datasets::quadrotor::projection::estimate_installation;
 use crate::datasets::quadrotor::{SkippedTrial, Trial, list_trials, load_trial, nothing_evaluated};
 use crate::quadrotor_ahrs::SETTLE_S;
 use crate::quadrotor_ahrs::mounting::{Paired, fit_mounting, roll_pitch_rmse_deg};
+use crate::quadrotor_ahrs::windows::{self, WindowRmse};
 use crate::quadrotor_nav::frames::{self, Motion};
 use crate::quadrotor_nav::metrics::{angle_error, mean, median, rms};
 use crate::quadrotor_nav::run::{Start, start_from_truth};
 use crate::quadrotor_nav::{require_data_dir, vehicle_from_reference};
+use held_out_start::FlightStarts;
 use rins_navigator::attitude::quaternion_from_euler;
 use run::{GnssTrace, navigate_with_gnss};
 
@@ -79,6 +93,9 @@ pub struct RunScores {
     /// The solution's attitude at each scored reference row, for the mounting fit.
     #[serde(skip)]
     pub paired: Paired,
+    /// The filter's gyro bias at the end, body FRD, rad/s, for the next flights' prior.
+    #[serde(skip)]
+    pub final_gyro_bias_rps: [f64; 3],
 }
 
 /// One flight's figures.
@@ -96,12 +113,16 @@ pub struct FlightResult {
     pub median_single_end_error_m: f64,
     /// The drift test's setting, chosen on the other flights.
     pub drift_setting: cross_validation::Choice,
+    /// The antenna's lever arm and the position's lead, fitted on the other flights.
+    pub antenna: antenna::Antenna,
     /// The fused roll/pitch RMSE with the units' mounting tilt fitted on the other flights, as
     /// `--mode ahrs` scores, degrees (the mounting is the airframe's, not the flight's).
     pub fused_roll_pitch_rmse_mounted_deg: f64,
     /// The same with the mounting fitted on every flight, this one included: in sample, shown
     /// beside the held-out figure so that overfitting shows.
     pub fused_roll_pitch_rmse_mounted_in_sample_deg: f64,
+    /// The held-out mounted figure over windows of time since the start (as `--mode ahrs`).
+    pub fused_window_rmse_deg: WindowRmse,
 }
 
 /// The whole data set's figures.
@@ -115,11 +136,18 @@ pub struct GnssReport {
     pub trials: Vec<FlightResult>,
     /// Mean over flights of the fused roll/pitch RMSE, degrees.
     pub roll_pitch_rmse_deg: f64,
+    /// The antenna fitted on every flight (in sample), beside the held-out ones in `trials`;
+    /// absent when the flights do not tell it.
+    pub antenna_in_sample: Option<antenna::Antenna>,
     /// Mean over flights of the fused roll/pitch RMSE with the mounting fitted on the other
     /// flights ([`FlightResult::fused_roll_pitch_rmse_mounted_deg`]), degrees.
     pub roll_pitch_rmse_mounted_deg: f64,
     /// The same with the mounting fitted on every flight (in sample), degrees.
     pub roll_pitch_rmse_mounted_in_sample_deg: f64,
+    /// Window starts since the start of each run, s.
+    pub window_starts_s: [f64; 3],
+    /// Per window, the mean over the flights with rows in it of the held-out mounted figure.
+    pub fused_window_rmse_deg: WindowRmse,
     /// The fused roll/pitch RMSE is within [`ROLL_PITCH_TARGET_DEG`] (`gnss` mode).
     pub roll_pitch_target_met: bool,
     /// Mean over flights of the fused heading RMSE, degrees.
@@ -183,6 +211,7 @@ fn score(imu: Option<usize>, trace: &GnssTrace, trial: &Trial, start: &Start) ->
         fixes_outliers: trace.outliers,
         rejections: trace.rejections,
         paired,
+        final_gyro_bias_rps: trace.final_gyro_bias_rps,
     }
 }
 
@@ -192,11 +221,14 @@ pub fn evaluate_trial(
     config: &AidedConfig,
     mode: GnssMode,
     drift_setting: cross_validation::Choice,
+    antenna: antenna::Antenna,
+    starts: &FlightStarts,
     progress: &mut dyn FnMut(),
 ) -> Result<FlightResult> {
     let mut config = *config;
     config.gnss.drift_slack = drift_setting.drift_slack;
     config.gnss.drift_threshold = drift_setting.drift_threshold;
+    config.gnss.lever_arm_m = antenna.lever_arm_m;
     let config = &config;
     let installation = estimate_installation(trial)?;
     let vehicle = vehicle_from_reference();
@@ -220,6 +252,7 @@ pub fn evaluate_trial(
         &trial.truth,
         start.t_s,
         end_s,
+        antenna.position_lead_s,
         receiver::seed_of(&trial.name),
     );
     let gnss_until_s = match mode {
@@ -227,7 +260,8 @@ pub fn evaluate_trial(
         GnssMode::Outage => end_s - OUTAGE_S,
     };
     let mut run = |imu: Option<usize>, motion: &Motion| {
-        let trace = navigate_with_gnss(motion, &start, config, &fixes, gnss_until_s);
+        let known = starts.of(imu).known;
+        let trace = navigate_with_gnss(motion, &start, &known, config, &fixes, gnss_until_s);
         progress();
         score(imu, &trace, trial, &start)
     };
@@ -237,6 +271,9 @@ pub fn evaluate_trial(
         single.push(run(Some(series.imu), &motion));
     }
     let fused = run(None, &fused);
+    let fused_roll_pitch_rmse_mounted_deg =
+        roll_pitch_rmse_deg(&fused.paired, starts.fused.tilt_rad, 0.0);
+    let fused_window_rmse_deg = windows::of(&fused.paired, starts.fused.tilt_rad);
     let median_single_end_error_m = median(
         &single
             .iter()
@@ -250,30 +287,20 @@ pub fn evaluate_trial(
         fused,
         median_single_end_error_m,
         drift_setting,
-        // Filled in once every flight has run: the mounting is fitted on the others.
-        fused_roll_pitch_rmse_mounted_deg: f64::NAN,
+        antenna,
+        fused_roll_pitch_rmse_mounted_deg,
+        fused_window_rmse_deg,
+        // Filled in once every flight has run: the mounting is fitted on all.
         fused_roll_pitch_rmse_mounted_in_sample_deg: f64::NAN,
     })
 }
 
-/// Scores each flight's fused attitude with the units' mounting tilt fitted on the other
-/// flights (the rows after [`SETTLE_S`]), and on all of them for the in-sample figure.
-fn score_mounted(trials: &mut [FlightResult]) {
+/// Scores each flight's fused attitude with the units' mounting tilt fitted on every flight, this
+/// one included (in sample).
+fn score_mounted_in_sample(trials: &mut [FlightResult]) {
     let all: Vec<&Paired> = trials.iter().map(|t| &t.fused.paired).collect();
     let in_sample = fit_mounting(&all, SETTLE_S);
-    let held_out: Vec<[f64; 2]> = (0..trials.len())
-        .map(|f| {
-            let others: Vec<&Paired> = all
-                .iter()
-                .enumerate()
-                .filter(|&(g, _)| g != f)
-                .map(|(_, p)| *p)
-                .collect();
-            fit_mounting(&others, SETTLE_S)
-        })
-        .collect();
-    for (t, tilt) in trials.iter_mut().zip(held_out) {
-        t.fused_roll_pitch_rmse_mounted_deg = roll_pitch_rmse_deg(&t.fused.paired, tilt, 0.0);
+    for t in trials.iter_mut() {
         t.fused_roll_pitch_rmse_mounted_in_sample_deg =
             roll_pitch_rmse_deg(&t.fused.paired, in_sample, 0.0);
     }
@@ -290,7 +317,7 @@ pub fn evaluate(
     let entries = list_trials(dir)
         .with_context(|| format!("eval quadrotor: cannot list trials in {}", dir.display()))?;
     let n = cross_validation::CANDIDATES.len();
-    let total: usize = entries.iter().map(|e| (e.imus.len() + 1) * (n + 1)).sum();
+    let total: usize = entries.iter().map(|e| (e.imus.len() + 1) * (n + 2)).sum();
     let mut done = 0;
     let mut loaded = Vec::new();
     let mut skipped = Vec::new();
@@ -325,10 +352,20 @@ pub fn evaluate(
                 drift_slack,
                 drift_threshold,
             };
-            match evaluate_trial(trial, config, mode, choice, &mut || {
-                done += 1;
-                progress(done, total);
-            }) {
+            // The nominal antenna: the drift setting is chosen without the antenna fit.
+            let (nominal_antenna, nominal_start) = Default::default();
+            match evaluate_trial(
+                trial,
+                config,
+                mode,
+                choice,
+                nominal_antenna,
+                &nominal_start,
+                &mut || {
+                    done += 1;
+                    progress(done, total);
+                },
+            ) {
                 Ok(r) => per.push(
                     r.single
                         .iter()
@@ -354,9 +391,42 @@ pub fn evaluate(
         }
     }
     let chosen = cross_validation::choose(&rejections);
-    let mut trials = Vec::with_capacity(usable.len());
-    for (trial, choice) in usable.into_iter().zip(chosen) {
-        let result = evaluate_trial(trial, config, mode, choice, &mut || {
+    let equations: Vec<antenna::NormalEquations> =
+        usable.iter().map(|t| antenna_equations(t)).collect();
+    let antennas = antenna::held_out(&equations);
+    let antenna_in_sample = antenna::in_sample(&equations);
+    // First pass: every run from the airframe's attitude, no bias known.
+    let mut first = Vec::with_capacity(usable.len());
+    let mut scored = Vec::with_capacity(usable.len());
+    for ((trial, choice), antenna) in usable.into_iter().zip(chosen).zip(antennas) {
+        let result = evaluate_trial(
+            trial,
+            config,
+            mode,
+            choice,
+            antenna,
+            &FlightStarts::default(),
+            &mut || {
+                done += 1;
+                progress(done, total);
+            },
+        );
+        match result {
+            Ok(r) => {
+                first.push(r);
+                scored.push((trial, choice, antenna));
+            }
+            Err(e) => skipped.push(SkippedTrial {
+                trial: trial.name.clone(),
+                reason: format!("{e:#}"),
+            }),
+        }
+    }
+    // Second pass, scored: each flight started with what the others' first pass learnt.
+    let starts = held_out_start::held_out_starts(&first);
+    let mut trials = Vec::with_capacity(scored.len());
+    for ((trial, choice, antenna), starts) in scored.into_iter().zip(&starts) {
+        let result = evaluate_trial(trial, config, mode, choice, antenna, starts, &mut || {
             done += 1;
             progress(done, total);
         });
@@ -372,8 +442,22 @@ pub fn evaluate(
     if trials.is_empty() {
         return Err(anyhow!("eval quadrotor: {}", nothing_evaluated(&skipped)));
     }
-    score_mounted(&mut trials);
-    Ok(summarise(dir, mode, trials, skipped))
+    score_mounted_in_sample(&mut trials);
+    let mut report = summarise(dir, mode, trials, skipped);
+    report.antenna_in_sample = antenna_in_sample;
+    Ok(report)
+}
+
+/// One flight's share of the antenna fit: its reference against its fused units' motion (none
+/// when the units cannot be fused, which the flight's own run reports).
+fn antenna_equations(trial: &Trial) -> antenna::NormalEquations {
+    estimate_installation(trial)
+        .ok()
+        .and_then(|installation| {
+            frames::fused(trial, &installation, &vehicle_from_reference()).ok()
+        })
+        .map(|motion| antenna::normal_equations(&trial.truth, &motion))
+        .unwrap_or_default()
 }
 
 fn summarise(
@@ -402,11 +486,14 @@ fn summarise(
         dir: dir.to_path_buf(),
         mode,
         roll_pitch_rmse_deg: roll_pitch,
+        antenna_in_sample: None,
         roll_pitch_rmse_mounted_deg: of(&|t| t.fused_roll_pitch_rmse_mounted_deg),
         roll_pitch_rmse_mounted_in_sample_deg: of(&|t| {
             t.fused_roll_pitch_rmse_mounted_in_sample_deg
         }),
         roll_pitch_target_met: roll_pitch <= ROLL_PITCH_TARGET_DEG,
+        window_starts_s: windows::WINDOW_STARTS_S,
+        fused_window_rmse_deg: windows::mean(trials.iter().map(|t| &t.fused_window_rmse_deg)),
         heading_rmse_deg: of(&|t| t.fused.heading_rmse_deg),
         horizontal_rmse_m: of(&|t| t.fused.horizontal_rmse_m),
         gnss_rejections: trials
@@ -422,80 +509,5 @@ fn summarise(
         outage_target_met: mode == GnssMode::Outage && ratio <= OUTAGE_RATIO_TARGET,
         trials,
         skipped,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::quadrotor_ahrs::mounting::mounting_rotation;
-
-    /// A flight whose solution is the reference turned by the mounting `tilt`, at 1 Hz.
-    fn flight(tilt: [f64; 2], roll_deg: f64) -> FlightResult {
-        let mut paired = Paired::default();
-        let m_inv = mounting_rotation(tilt).inverse();
-        for k in 0..60 {
-            let (roll, pitch, yaw) = (roll_deg.to_radians(), (k as f64 * 0.01).sin(), 0.3);
-            let vehicle = quaternion_from_euler(roll, pitch, yaw);
-            paired.push(k as f64, vehicle * m_inv, roll, pitch);
-        }
-        let run = RunScores {
-            imu: None,
-            roll_pitch_rmse_deg: f64::NAN,
-            heading_rmse_deg: f64::NAN,
-            horizontal_rmse_m: f64::NAN,
-            end_horizontal_error_m: f64::NAN,
-            fixes_applied: 0,
-            fixes_outliers: 0,
-            rejections: 0,
-            paired,
-        };
-        FlightResult {
-            name: String::new(),
-            duration_s: 60.0,
-            single: Vec::new(),
-            fused: run,
-            median_single_end_error_m: f64::NAN,
-            drift_setting: cross_validation::Choice {
-                candidate: 0,
-                drift_slack: 0.0,
-                drift_threshold: 0.0,
-            },
-            fused_roll_pitch_rmse_mounted_deg: f64::NAN,
-            fused_roll_pitch_rmse_mounted_in_sample_deg: f64::NAN,
-        }
-    }
-
-    #[test]
-    fn each_flight_is_scored_with_the_mounting_of_the_others() {
-        let tilt = [0.7_f64.to_radians(), -0.5_f64.to_radians()];
-        let mut same = vec![flight(tilt, 2.0), flight(tilt, -3.0), flight(tilt, 5.0)];
-        score_mounted(&mut same);
-        for t in &same {
-            // The airframe's mounting, learnt from the other flights, removes the whole error.
-            assert!(
-                t.fused_roll_pitch_rmse_mounted_deg < 1e-6,
-                "{}",
-                t.fused_roll_pitch_rmse_mounted_deg
-            );
-            assert!(t.fused_roll_pitch_rmse_mounted_in_sample_deg < 1e-6);
-        }
-        // A flight mounted otherwise than the two others keeps the difference held out, and shares
-        // it in sample.
-        let mut odd = vec![
-            flight(tilt, 2.0),
-            flight(tilt, -3.0),
-            flight([0.0, 0.0], 5.0),
-        ];
-        score_mounted(&mut odd);
-        let held_out = odd[2].fused_roll_pitch_rmse_mounted_deg;
-        let rms_tilt_deg = ((tilt[0].powi(2) + tilt[1].powi(2)) / 2.0)
-            .sqrt()
-            .to_degrees();
-        assert!(
-            (held_out - rms_tilt_deg).abs() < 0.02,
-            "{held_out} vs {rms_tilt_deg}"
-        );
-        assert!(odd[2].fused_roll_pitch_rmse_mounted_in_sample_deg < held_out);
     }
 }

@@ -1,6 +1,7 @@
 //! A standard GNSS receiver made from the reference trajectory: positions decimated to 5 Hz
 //! (interpolated at 0.2 s steps), with seeded white noise of σ 1.5 m horizontal, 3 m vertical and
-//! 0.1 m/s velocity per axis, measured at the reference's own time (no latency).
+//! 0.1 m/s velocity per axis, measured at the reference's own time (no latency), which leads the
+//! units' clock by the lead the evaluation fits ([`super::antenna`]).
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -53,8 +54,10 @@ pub fn truth_ned_at(truth: &[TruthRow], t_s: f64) -> Option<[f64; 3]> {
 }
 
 /// The receiver's epochs from `from_s` to `to_s` (inclusive), every 1/[`RATE_HZ`] s, the noise
-/// drawn from `seed`. The velocity is the central difference of the reference over ±0.1 s.
-pub fn epochs(truth: &[TruthRow], from_s: f64, to_s: f64, seed: u64) -> Vec<LocalFix> {
+/// drawn from `seed`. The velocity is the central difference of the reference over ±0.1 s. Each
+/// epoch made from the reference at t is stamped `t + lead_s`: the reference position stamped t
+/// is the antenna's at t + `lead_s` on the units' clock.
+pub fn epochs(truth: &[TruthRow], from_s: f64, to_s: f64, lead_s: f64, seed: u64) -> Vec<LocalFix> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut normal = move || -> f64 { StandardNormal.sample(&mut rng) };
     let step = 1.0 / RATE_HZ;
@@ -75,7 +78,7 @@ pub fn epochs(truth: &[TruthRow], from_s: f64, to_s: f64, seed: u64) -> Vec<Loca
         };
         let v = [0, 1, 2].map(|i| (after[i] - before[i]) / 0.2);
         out.push(LocalFix {
-            t_s: t,
+            t_s: t + lead_s,
             ned_m: [
                 p[0] + SIGMA_H_M * normal(),
                 p[1] + SIGMA_H_M * normal(),
@@ -123,7 +126,7 @@ mod tests {
     #[test]
     fn five_epochs_a_second_with_the_configured_noise() {
         let truth = line(20_001);
-        let fixes = epochs(&truth, 0.1, 1999.0, 3);
+        let fixes = epochs(&truth, 0.1, 1999.0, 0.0, 3);
         // 0.1 … 1998.9 s every 0.2 s, the last needing a row 0.1 s later.
         assert_eq!(fixes.len(), 9995);
         assert!((fixes[1].t_s - fixes[0].t_s - 0.2).abs() < 1e-9);
@@ -134,7 +137,10 @@ mod tests {
         assert!((rms(&|x| x.ned_m[0] - 3.0 * x.t_s) - SIGMA_H_M).abs() < 0.05);
         assert!((rms(&|x| x.ned_m[2]) - SIGMA_V_M).abs() < 0.1);
         assert!((rms(&|x| x.velocity_ned_mps[1] - 4.0) - SIGMA_VEL_MPS).abs() < 0.004);
-        assert_eq!(epochs(&truth, 0.1, 10.0, 3), epochs(&truth, 0.1, 10.0, 3));
+        assert_eq!(
+            epochs(&truth, 0.1, 10.0, 0.0, 3),
+            epochs(&truth, 0.1, 10.0, 0.0, 3)
+        );
         assert_ne!(seed_of("Horizontal/path_1"), seed_of("Horizontal/path_2"));
     }
 }

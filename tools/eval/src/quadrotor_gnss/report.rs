@@ -47,6 +47,28 @@ pub fn to_table(r: &GnssReport) -> String {
         "fused roll/pitch with the units' mounting tilt fitted as --mode ahrs fits it: {:.3}° (fitted on the other flights), {:.3}° (in sample, fitted on every flight)",
         r.roll_pitch_rmse_mounted_deg, r.roll_pitch_rmse_mounted_in_sample_deg
     );
+    let windows: Vec<String> = r
+        .window_starts_s
+        .iter()
+        .zip(&r.fused_window_rmse_deg)
+        .map(|(from, v)| match v {
+            Some(v) => format!("from {from} s {v:.3}°"),
+            None => format!("from {from} s -"),
+        })
+        .collect();
+    let _ = writeln!(
+        s,
+        "the same by time since the start: {}",
+        windows.join(", ")
+    );
+    if let Some(a) = &r.antenna_in_sample {
+        let [x, y, z] = a.lever_arm_m;
+        let _ = writeln!(
+            s,
+            "antenna fitted on every flight (each flight runs with the fit of the others): lever arm [{x:.3}, {y:.3}, {z:.3}] m, position lead {:.1} ms",
+            a.position_lead_s * 1e3
+        );
+    }
     if r.mode == GnssMode::Outage {
         let singles: Vec<String> = r
             .single_outage_error_m

@@ -1,8 +1,9 @@
 //! One motion series through the aided navigator with the simulated receiver's fixes: started
-//! from the reference at t0 (as the free-inertial mode), the fixes applied at their own time,
-//! the receiver cut from `gnss_until_s` on.
+//! from the reference at t0 as `--mode ahrs` starts (the airframe's attitude turned by the
+//! series' mounting, the gyro bias from a prior when one is given), the fixes applied at their
+//! own time, the receiver cut from `gnss_until_s` on.
 
-use nalgebra::Vector3;
+use nalgebra::{UnitQuaternion, Vector3};
 use rins_earth::LocalOrigin;
 use rins_navigator::aiding::gnss::measurement::{GnssMeasurement, GnssOutcome};
 use rins_navigator::inertial_core::AidedConfig;
@@ -11,6 +12,7 @@ use rins_navigator::mechanisation::quaternion_from_euler;
 use rins_navigator::{ImuBias, NominalState};
 
 use super::receiver::{LocalFix, SIGMA_H_M, SIGMA_V_M, SIGMA_VEL_MPS};
+use crate::quadrotor_ahrs::run::GyroPrior;
 use crate::quadrotor_nav::frames::Motion;
 use crate::quadrotor_nav::run::Start;
 
@@ -38,6 +40,26 @@ pub struct GnssTrace {
     pub rejected: usize,
     /// Times the monitor rejected the receiver.
     pub rejections: u64,
+    /// The filter's gyro bias estimate at the end, body FRD, rad/s.
+    pub final_gyro_bias_rps: [f64; 3],
+}
+
+/// How a run starts besides the reference's state at t0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StartKnowledge {
+    /// The series' mounting on the airframe (`C_nav←vehicle = C_nav←unit · mounting`).
+    pub mounting: UnitQuaternion<f64>,
+    /// The gyro bias at t0; zero with the configured σ when absent.
+    pub prior: Option<GyroPrior>,
+}
+
+impl Default for StartKnowledge {
+    fn default() -> Self {
+        Self {
+            mounting: UnitQuaternion::identity(),
+            prior: None,
+        }
+    }
 }
 
 /// Runs `motion` from `start` with `fixes` (those at or after `gnss_until_s` withheld) through an
@@ -45,6 +67,7 @@ pub struct GnssTrace {
 pub fn navigate_with_gnss(
     motion: &Motion,
     start: &Start,
+    known: &StartKnowledge,
     config: &AidedConfig,
     fixes: &[LocalFix],
     gnss_until_s: f64,
@@ -52,6 +75,11 @@ pub fn navigate_with_gnss(
     let mut config = *config;
     config.gnss.enabled = true;
     config.gnss.delay_s = 0.0;
+    let mut bias = ImuBias::default();
+    if let Some(p) = &known.prior {
+        config.noise.initial_gyro_bias_sigma = p.sigma_rps;
+        bias.gyro_rps = Vector3::from(p.bias_rps);
+    }
     let [lat0, lon0, alt0] = config.origin;
     let origin = LocalOrigin::new(lat0, lon0, alt0);
     let to_geo = |ned: [f64; 3]| origin.geodetic(ned);
@@ -66,12 +94,12 @@ pub fn navigate_with_gnss(
     let [roll, pitch, heading] = start.euler_rad;
     let [lat, lon, alt] = to_geo(start.ned_m);
     let mut state = NominalState::at_rest(lat, lon, alt);
-    state.attitude = quaternion_from_euler(roll, pitch, heading);
+    state.attitude = quaternion_from_euler(roll, pitch, heading) * known.mounting.inverse();
     state.velocity_ned = Vector3::from(start.velocity_ned);
     nav.take_over(
         us(start.t_s),
         state,
-        ImuBias::default(),
+        bias,
         &config.noise.initial_variances(),
     );
 
@@ -115,5 +143,6 @@ pub fn navigate_with_gnss(
         }
     }
     trace.rejections = nav.gnss_monitor().rejections();
+    trace.final_gyro_bias_rps = nav.ekf().map_or([0.0; 3], |ekf| ekf.bias().gyro_rps.into());
     trace
 }
