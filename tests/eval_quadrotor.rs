@@ -174,21 +174,28 @@ fn eval_quadrotor_names_a_bad_profile() {
     );
 }
 
-fn ahrs_report(dir: &std::path::Path) -> Value {
-    let out = rins(&[
+/// `rins eval quadrotor DIR --mode MODE --json` and any `extra` arguments, which must succeed.
+fn report(dir: &std::path::Path, mode: &str, extra: &[&str]) -> Value {
+    let mut args = vec![
         "eval",
         "quadrotor",
         dir.to_str().unwrap(),
         "--mode",
-        "ahrs",
+        mode,
         "--json",
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    let out = rins(&args);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
     serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn ahrs_report(dir: &std::path::Path) -> Value {
+    report(dir, "ahrs", &[])
 }
 
 fn per_unit(report: &Value, key: &str) -> Vec<f64> {
@@ -349,20 +356,7 @@ fn eval_quadrotor_gnss_and_outage_modes_report_their_figures() {
         return;
     };
     for mode in ["gnss", "outage"] {
-        let out = rins(&[
-            "eval",
-            "quadrotor",
-            dir.to_str().unwrap(),
-            "--mode",
-            mode,
-            "--json",
-        ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+        let report = report(&dir, mode, &[]);
         assert_eq!(report["mode"], mode);
         let trials = report["trials"].as_array().unwrap();
         assert!(!trials.is_empty(), "{report}");
@@ -391,5 +385,31 @@ fn eval_quadrotor_gnss_and_outage_modes_report_their_figures() {
             let single = report["single_outage_error_m"].as_array().unwrap();
             assert_eq!(single.len(), 4, "{report}");
         }
+    }
+}
+
+#[test]
+fn eval_quadrotor_gnss_live_repeats_every_flight_through_the_running_processes() {
+    let Some(dir) = common::quadrotor_data_dir() else {
+        return;
+    };
+    let report = report(&dir, "gnss", &["--live"]);
+    let live = &report["live"];
+    // The processes are the library code: the same frames and messages give the same attitude.
+    assert!(
+        number(&live["live_vs_same_input_max_diff_deg"]) < 1e-9,
+        "{live}"
+    );
+    assert_eq!(live["live_rows_missing"].as_u64(), Some(0), "{live}");
+    // Against the in-process run only the counts and fusion's fault detection differ: the mean
+    // figure agrees to far below its own precision.
+    let in_process = number(&report["roll_pitch_rmse_mounted_deg"]);
+    let from_service = number(&live["live_roll_pitch_rmse_deg"]);
+    assert!(
+        (in_process - from_service).abs() < 0.01,
+        "{in_process} vs {from_service}"
+    );
+    for t in report["trials"].as_array().unwrap() {
+        assert!(t["live"].is_object(), "{t}");
     }
 }

@@ -2,9 +2,10 @@
 //! accelerating vehicle, fed to a private deployment (fusion, altimeter, two navigator lanes)
 //! whose navigator starts from `[navigator.start]` in the air, give the attitude the same library
 //! code gives in process, sample for sample; both lanes take the configured start (neither waits
-//! for the other), and nothing is left in /dev/shm.
+//! for the other), and nothing is left in /dev/shm. Receiver messages published on the receiver's
+//! topic move the running navigators as they move the same code in process.
 
-use ipc_types::{Header, NavMode, NavState, PAYLOAD_VERSION, RawImu};
+use ipc_types::{GnssFix, GnssFixType, Header, NavMode, NavState, PAYLOAD_VERSION, RawImu};
 use rins::config::RinsConfig;
 use rins::replay::input::{RawSample, ReplayInput};
 use rins::replay::live::{self, LiveOptions};
@@ -125,37 +126,60 @@ fn angle_deg(a: [f64; 4], b: [f64; 4]) -> f64 {
     2.0 * dot.abs().min(1.0).acos().to_degrees()
 }
 
-#[test]
-fn an_in_flight_start_runs_live_as_in_process() {
-    let cfg = RinsConfig::parse(CONFIG, "test").expect("the configuration is valid");
-    let raw = frames();
-    let input = ReplayInput {
-        raw: raw.clone(),
-        ..ReplayInput::default()
-    };
-    let built = cfg.build_services().expect("services");
-    let offline =
-        OfflinePipeline::new(built.fuser, built.altimeter, built.navigator, 2).run(&input, |_| {});
-
-    let dir = std::env::temp_dir().join(format!("rins-live-start-{}", std::process::id()));
+/// `raw` through a private deployment running `config` (two lanes); the output and the
+/// deployment's /dev/shm prefix.
+fn run_live(config: &str, raw: &[RawSample], tag: &str) -> (live::LiveOutput, String) {
+    let dir = std::env::temp_dir().join(format!("rins-live-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("scratch directory");
-    let config = dir.join("live.toml");
-    std::fs::write(&config, CONFIG).expect("configuration written");
-    let private = live::private_settings("ls").expect("private root");
+    let config_file = dir.join("live.toml");
+    std::fs::write(&config_file, config).expect("configuration written");
+    let private = live::private_settings(tag).expect("private root");
     let prefix = private.prefix.clone();
     let options = LiveOptions {
         exe: Some(env!("CARGO_BIN_EXE_rins").into()),
-        config: Some(config),
+        config: Some(config_file),
         lanes: 2,
         speed: None,
         private: Some(private),
         log: Some(dir.join("live.log")),
     };
     let shutdown = Shutdown::install().expect("signal handlers");
-    let out = live::run(&raw, &options, &shutdown, &mut |_, _| {});
+    let out = live::run(raw, &options, &shutdown, &mut |_, _| {});
     let log = std::fs::read_to_string(dir.join("live.log")).unwrap_or_default();
     let _ = std::fs::remove_dir_all(&dir);
-    let out = out.unwrap_or_else(|e| panic!("live run: {e:#}\n{log}"));
+    (
+        out.unwrap_or_else(|e| panic!("live run: {e:#}\n{log}")),
+        prefix,
+    )
+}
+
+fn assert_nothing_left(prefix: &str) {
+    let leftovers: Vec<String> = std::fs::read_dir("/dev/shm")
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|n| n.starts_with(prefix))
+                .collect()
+        })
+        .unwrap_or_default();
+    assert!(leftovers.is_empty(), "left in /dev/shm: {leftovers:?}");
+}
+
+fn offline(config: &str, raw: &[RawSample]) -> [Vec<NavState>; 2] {
+    let cfg = RinsConfig::parse(config, "test").expect("the configuration is valid");
+    let input = ReplayInput {
+        raw: raw.to_vec(),
+        ..ReplayInput::default()
+    };
+    let built = cfg.build_services().expect("services");
+    OfflinePipeline::new(built.fuser, built.altimeter, built.navigator, 2).run(&input, |_| {})
+}
+
+#[test]
+fn an_in_flight_start_runs_live_as_in_process() {
+    let raw = frames();
+    let offline = offline(CONFIG, &raw);
+    let (out, prefix) = run_live(CONFIG, &raw, "ls");
 
     // The state is taken at the start's own instant, published for that sample and every one
     // after it.
@@ -195,13 +219,77 @@ fn an_in_flight_start_runs_live_as_in_process() {
         "{:?}",
         out.excluded_channels
     );
-    let leftovers: Vec<String> = std::fs::read_dir("/dev/shm")
-        .map(|d| {
-            d.filter_map(|e| e.ok())
-                .map(|e| e.file_name().to_string_lossy().into_owned())
-                .filter(|n| n.starts_with(&prefix))
-                .collect()
+    assert_nothing_left(&prefix);
+}
+
+/// Receiver messages every 0.2 s from the start on: the position the solution without them had
+/// at that time (`reference`, lane 0), moved `offset_north_m` north, and its velocity.
+fn fixes(reference: &[NavState], offset_north_m: f64) -> Vec<RawSample> {
+    let metres_per_rad = 6_371_000.0;
+    navigating(reference)
+        .into_iter()
+        .filter(|n| (n.header.origin_device_time_us - T0_US).is_multiple_of(200_000))
+        .enumerate()
+        .map(|(k, n)| {
+            let t_us = n.header.origin_device_time_us;
+            RawSample::Gnss(GnssFix {
+                fix_type: GnssFixType::Fix3d as u8,
+                velocity_valid: 1,
+                accuracy_reported: 1,
+                header: Header {
+                    origin_seq: k as u64 + 1,
+                    origin_device_time_us: t_us,
+                    origin_rx_ns: t_us * 1000,
+                    ..Header::default()
+                },
+                receiver_time_us: t_us,
+                latitude_rad: n.latitude_rad + offset_north_m / metres_per_rad,
+                longitude_rad: n.longitude_rad,
+                altitude_m: n.altitude_m,
+                velocity_ned_mps: n.velocity_ned_mps,
+                horizontal_accuracy_m: 1.0,
+                vertical_accuracy_m: 2.0,
+                speed_accuracy_mps: 0.2,
+                ..GnssFix::default()
+            })
         })
-        .unwrap_or_default();
-    assert!(leftovers.is_empty(), "left in /dev/shm: {leftovers:?}");
+        .collect()
+}
+
+fn north_of_m(a: &NavState, b: &NavState) -> f64 {
+    (a.latitude_rad - b.latitude_rad) * 6_371_000.0
+}
+
+#[test]
+fn receiver_messages_reach_the_running_navigators_as_in_process() {
+    let config = format!("{CONFIG}\n[navigator.gnss]\nenabled = true\n");
+    let imu = frames();
+    let without = offline(&config, &imu);
+    // Fixes 3 m north of where the solution without them goes, with its velocity: each lane
+    // moves north (the jump against the velocity also turns into tilt and bias, so by more
+    // than the 3 m in time; what matters here is that the messages reach the filter).
+    let mut raw = imu.clone();
+    raw.extend(fixes(&without[0], 3.0));
+    raw.sort_by_key(|s| s.rx_ns());
+    let with = offline(&config, &raw);
+    for (lane, (w, wo)) in with.iter().zip(&without).enumerate() {
+        let (w, wo) = (navigating(w), navigating(wo));
+        let moved = north_of_m(w.last().expect("samples"), wo.last().expect("samples"));
+        assert!(moved > 1.5, "lane {lane}: {moved} m");
+    }
+    let (out, prefix) = run_live(&config, &raw, "lg");
+    for (lane, (live, off)) in out.nav.iter().zip(&with).enumerate() {
+        let (live, off) = (navigating(live), navigating(off));
+        assert_eq!(live.len(), off.len(), "lane {lane}");
+        let worst = live
+            .iter()
+            .zip(&off)
+            .map(|(l, o)| {
+                assert_eq!(l.header.origin_seq, o.header.origin_seq);
+                north_of_m(l, o).abs()
+            })
+            .fold(0.0, f64::max);
+        assert!(worst <= 1e-6, "lane {lane}: {worst} m apart");
+    }
+    assert_nothing_left(&prefix);
 }

@@ -71,9 +71,10 @@ pub struct EvalQuadrotorArgs {
     /// What to run.
     #[arg(long, value_enum, default_value = "free")]
     pub mode: QuadrotorMode,
-    /// With `--mode ahrs`: run each flight's scored fused solution again through the running
-    /// processes (fusion and the navigator lanes, a private deployment per flight) and report
-    /// their figures beside the in-process ones.
+    /// With `--mode ahrs` or `--mode gnss`: run each flight's scored fused solution again through
+    /// the running processes (fusion and the navigator lanes, a private deployment per flight; in
+    /// gnss mode the receiver's messages on the receiver's topic) and report their figures beside
+    /// the in-process ones.
     #[arg(long)]
     pub live: bool,
     /// Output format and navigator profile.

@@ -126,8 +126,23 @@ pub fn run_quadrotor(args: &EvalQuadrotorArgs) -> Result<()> {
         .navigator
         .aided_config();
     let mut bar = super::progress::Progress::new("eval quadrotor");
-    if args.live && args.mode != QuadrotorMode::Ahrs {
-        anyhow::bail!("eval quadrotor: --live runs --mode ahrs only");
+    if args.live && !matches!(args.mode, QuadrotorMode::Ahrs | QuadrotorMode::Gnss) {
+        anyhow::bail!("eval quadrotor: --live runs --mode ahrs and --mode gnss only");
+    }
+    if args.live && args.mode == QuadrotorMode::Gnss {
+        let (mut report, runs) = rins_eval::quadrotor_gnss::evaluate_with_runs(
+            &args.dir,
+            &aided,
+            rins_eval::quadrotor_gnss::GnssMode::Gnss,
+            &mut |d, t| bar.set(d, t),
+        )?;
+        bar.finish();
+        super::eval_live::quadrotor_gnss(&args.dir, &runs, &mut report)?;
+        return print(
+            args.common.json,
+            &report,
+            rins_eval::quadrotor_gnss::report::to_table,
+        );
     }
     if args.live {
         let (mut report, runs) =

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use ipc_types::{
-    Health, NavState, RawAirspeed, RawAux, RawBaro, RawImu, RawMag, ServiceKind, names,
+    GnssFix, Health, NavState, RawAirspeed, RawAux, RawBaro, RawImu, RawMag, ServiceKind, names,
 };
 use rins_navigator::aiding::readings::{HeldPayload, Reading};
 use rins_recording::{RecordedMessage, Recording, read_file};
@@ -13,7 +13,8 @@ use rins_recording::{RecordedMessage, Recording, read_file};
 /// The raw topics a replay feeds, one line per topic: `Variant(Payload) = TOPIC,` makes the
 /// [`RawSample`] variant `Variant` of the `ipc_types::names` topic `TOPIC`. The lines under `held`
 /// are payloads the navigator holds as they come (see `rins_navigator::aiding::readings`); those
-/// under `stages` feed a stage (fusion, the altimeter) or none.
+/// under `stages` feed a stage (fusion, the altimeter), the navigator's own receiver hold (GNSS),
+/// or none.
 macro_rules! raw_samples {
     (
         stages { $($(#[$sdoc:meta])* $stage:ident($stage_payload:ty) = $stage_topic:ident,)+ }
@@ -73,6 +74,8 @@ raw_samples! {
         Baro(RawBaro) = RAW_BARO,
         /// An auxiliary sample (temperatures, foot pressure).
         Aux(RawAux) = RAW_AUX,
+        /// A receiver fix (the navigator lanes place it by its receive time).
+        Gnss(GnssFix) = GNSS,
     }
     held {
         /// A magnetometer sample.

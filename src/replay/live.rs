@@ -11,8 +11,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail};
 use ipc_types::{
-    Altitude, ChannelState, FusedImu, Health, NavState, RawAirspeed, RawAux, RawBaro, RawImu,
-    RawMag, ServiceKind, names,
+    Altitude, ChannelState, FusedImu, GnssFix, Health, NavState, RawAirspeed, RawAux, RawBaro,
+    RawImu, RawMag, ServiceKind, names,
 };
 use rins_navigator::aiding::hold::HOLD_US;
 use rins_runtime::ipc::{
@@ -296,6 +296,7 @@ fn feed(
     let mag = TopicPublisher::<RawMag>::new(node, names::RAW_MAG)?;
     let aux = TopicPublisher::<RawAux>::new(node, names::RAW_AUX)?;
     let airspeed = TopicPublisher::<RawAirspeed>::new(node, names::RAW_AIRSPEED)?;
+    let gnss = TopicPublisher::<GnssFix>::new(node, names::GNSS)?;
     let mut tap = NavTap {
         lanes: [
             TopicSubscriber::new(node, names::NAV_LANES[0])?,
@@ -356,6 +357,7 @@ fn feed(
             RawSample::Mag(s) => mag.publish(*s)?,
             RawSample::Aux(s) => aux.publish(*s)?,
             RawSample::Airspeed(s) => airspeed.publish(*s)?,
+            RawSample::Gnss(s) => gnss.publish(*s)?,
         }
         tap.drain()?;
         if i % 1000 == 0 {
@@ -378,7 +380,7 @@ fn feed(
         }
     }
     drop(tap);
-    drop((imu, baro, mag, aux, airspeed));
+    drop((imu, baro, mag, aux, airspeed, gnss));
     drop(tool);
     Ok(out)
 }

@@ -1,16 +1,17 @@
 //! The pipeline in one process, without IPC: the raw samples of a recording through the same
 //! library code the services run — fusion's fuser and message, the altimeter's estimator, each
-//! navigator lane's aiding hold (every held reading it subscribes to) and step — in the order the
-//! sensor block sent them. What the live pipeline publishes for a sample does not depend on when
+//! navigator lane's aiding hold (every held reading it subscribes to), receiver hold and step — in
+//! the order the sensor block sent them. What the live pipeline publishes for a sample does not depend on when
 //! it arrived (the navigator holds aiding readings until the IMU stream passes their time), so
 //! this gives the same output.
 
-use ipc_types::{FusedImu, NavState, PAYLOAD_VERSION, RawImu};
+use ipc_types::{FusedImu, GnssFix, NavState, PAYLOAD_VERSION, RawImu};
 use rins_altimeter::AltitudeEstimator;
 use rins_altimeter::service::altitude_message;
 use rins_fusion::ImuFuser;
 use rins_fusion::service::{fused_message, rejected_message};
 use rins_navigator::Navigator;
+use rins_navigator::aiding::gnss::hold::GnssHold;
 use rins_navigator::aiding::readings::{AidingQueue, HeldPayload, Reading};
 use rins_navigator::service::step;
 
@@ -20,15 +21,18 @@ use super::input::{RawSample, ReplayInput};
 struct Lane {
     nav: Navigator,
     aiding: AidingQueue,
+    gnss: GnssHold,
     last: NavState,
     out: Vec<NavState>,
 }
 
 impl Lane {
     fn new(nav: Navigator, lane: u8) -> Self {
+        let gnss = GnssHold::new(nav.config().gnss.delay_s);
         Self {
             nav,
             aiding: AidingQueue::default(),
+            gnss,
             last: NavState {
                 lane,
                 ..NavState::default()
@@ -45,6 +49,13 @@ impl Lane {
         }
     }
 
+    /// What the navigator service does with a receiver fix: holds it, when GNSS aiding is on.
+    fn on_fix(&mut self, fix: &GnssFix) {
+        if self.nav.config().gnss.enabled {
+            self.gnss.push(*fix);
+        }
+    }
+
     /// What the navigator service does with a fused sample (without a peer to take over from).
     fn on_fused(&mut self, imu: &FusedImu) {
         if self.last.header.origin_seq != 0 && imu.header.origin_seq <= self.last.header.origin_seq
@@ -53,6 +64,14 @@ impl Lane {
         }
         self.aiding
             .release_to(imu.header.origin_device_time_us, &mut self.nav);
+        let nav = &mut self.nav;
+        self.gnss.release(
+            imu.header.origin_device_time_us,
+            imu.header.origin_rx_ns,
+            |fix, t_us| {
+                let _ = nav.on_gnss(fix, t_us);
+            },
+        );
         let mut state = step(&mut self.nav, imu, &self.last);
         state.version = PAYLOAD_VERSION;
         self.last = state;
@@ -118,6 +137,11 @@ impl OfflinePipeline {
                     let alt = altitude_message(raw, &out);
                     for lane in &mut self.lanes {
                         lane.on_reading(alt.reading());
+                    }
+                }
+                RawSample::Gnss(fix) => {
+                    for lane in &mut self.lanes {
+                        lane.on_fix(fix);
                     }
                 }
                 other => {

@@ -24,7 +24,7 @@ use super::progress::Progress;
 
 pub use gnss_captures::{GnssLiveOptions, gnss_captures};
 pub use pyshoe::pyshoe;
-pub use quadrotor::quadrotor_ahrs;
+pub use quadrotor::{quadrotor_ahrs, quadrotor_gnss};
 
 /// Where a live evaluation's configurations and deployment logs go: kept when the evaluation
 /// fails, removed by [`Scratch::remove`] when it succeeds.
@@ -73,14 +73,16 @@ fn reparsed(cfg: &RinsConfig, what: &str) -> Result<RinsConfig> {
     RinsConfig::parse(&text, what)
 }
 
-/// The sample index of each frame's device time.
+/// The sample index of each IMU frame's device time: its place among the IMU frames (other
+/// samples between them not counted).
 fn device_index(raw: &[RawSample]) -> HashMap<u64, usize> {
     raw.iter()
-        .enumerate()
-        .filter_map(|(j, s)| match s {
-            RawSample::Imu(f) => Some((f.header.origin_device_time_us, j)),
+        .filter_map(|s| match s {
+            RawSample::Imu(f) => Some(f.header.origin_device_time_us),
             _ => None,
         })
+        .enumerate()
+        .map(|(j, t)| (t, j))
         .collect()
 }
 

@@ -2,6 +2,7 @@
 //! the navigator lanes as separate processes) can repeat it and be scored the same way
 //! (`rins eval quadrotor --mode ahrs --live`).
 
+use ipc_types::{GnssFix, NavState};
 use nalgebra::{Quaternion, UnitQuaternion};
 use rins_navigator::attitude::euler_from_quaternion;
 use rins_navigator::inertial_core::AidedConfig;
@@ -14,6 +15,98 @@ use super::run::{AttitudeTrace, GyroPrior, in_flight_start, navigate_ahrs};
 use crate::quadrotor_nav::frames::Motion;
 use crate::quadrotor_nav::metrics::{angle_error, mean};
 use crate::quadrotor_nav::run::Start;
+
+/// A flight's scored fused run that the running service repeats: what the live evaluation needs
+/// of it, whatever aids it.
+pub trait RepeatableRun {
+    /// The solution over the flight.
+    type Trace;
+    /// `<group>/path_<N>`.
+    fn flight(&self) -> &str;
+    /// The fused motion, vehicle frame.
+    fn motion(&self) -> &Motion;
+    /// The navigator's `[navigator.start]` and settings of the run.
+    fn in_flight_start(&self) -> (InFlightStart, AidedConfig);
+    /// Receiver messages the run is fed besides the IMU (none by default).
+    fn receiver_messages(&self) -> Vec<GnssFix> {
+        Vec::new()
+    }
+    /// The in-process run.
+    fn in_process(&self) -> &Self::Trace;
+    /// The same run in process on other samples of the motion.
+    fn rerun(&self, motion: &Motion) -> Self::Trace;
+    /// What a running navigator published, `(sample index, state)` of every navigating sample in
+    /// order, as a trace on the flight's time base.
+    fn trace_from<'a>(
+        &self,
+        published: impl IntoIterator<Item = (usize, &'a NavState)>,
+    ) -> Self::Trace;
+    /// Roll/pitch RMSE of a trace, scored as the in-process run is, degrees.
+    fn score_deg(&self, trace: &Self::Trace) -> f64;
+    /// The largest attitude difference between two traces at the scored rows, degrees, and the
+    /// rows where only one has a solution.
+    fn max_difference_deg(&self, a: &Self::Trace, b: &Self::Trace) -> (f64, usize);
+    /// The largest roll or pitch difference between two traces at the scored rows, degrees.
+    fn max_tilt_difference_deg(&self, a: &Self::Trace, b: &Self::Trace) -> f64;
+}
+
+/// One flight's live figures: `live` (the running processes), `same_frames` (the same pipeline's
+/// library code in process on the same frames), `same_input` (the run in process on what fusion
+/// made of the frames), against the run's in-process solution; and what fusion flagged live.
+pub fn live_flight<R: RepeatableRun>(
+    run: &R,
+    live: &R::Trace,
+    same_frames: &R::Trace,
+    same_input: &R::Trace,
+    live_fdi_events: u64,
+    live_excluded_channels: Vec<String>,
+) -> LiveFlight {
+    let (live_vs_offline, missing) = run.max_difference_deg(live, run.in_process());
+    LiveFlight {
+        live_roll_pitch_rmse_deg: run.score_deg(live),
+        live_vs_offline_max_diff_deg: live_vs_offline,
+        live_vs_same_input_max_diff_deg: run.max_difference_deg(live, same_frames).0,
+        quantisation_max_diff_deg: run.max_difference_deg(same_input, run.in_process()).0,
+        quantisation_max_tilt_diff_deg: run.max_tilt_difference_deg(same_input, run.in_process()),
+        live_rows_missing: missing,
+        live_fdi_events,
+        live_excluded_channels,
+    }
+}
+
+impl RepeatableRun for ScoredRun {
+    type Trace = AttitudeTrace;
+    fn flight(&self) -> &str {
+        &self.flight
+    }
+    fn motion(&self) -> &Motion {
+        &self.motion
+    }
+    fn in_flight_start(&self) -> (InFlightStart, AidedConfig) {
+        ScoredRun::in_flight_start(self)
+    }
+    fn in_process(&self) -> &AttitudeTrace {
+        &self.trace
+    }
+    fn rerun(&self, motion: &Motion) -> AttitudeTrace {
+        ScoredRun::rerun(self, motion)
+    }
+    fn trace_from<'a>(
+        &self,
+        published: impl IntoIterator<Item = (usize, &'a NavState)>,
+    ) -> AttitudeTrace {
+        ScoredRun::trace_from(self, published.into_iter().map(|(j, n)| (j, n.quaternion)))
+    }
+    fn score_deg(&self, trace: &AttitudeTrace) -> f64 {
+        ScoredRun::score_deg(self, trace)
+    }
+    fn max_difference_deg(&self, a: &AttitudeTrace, b: &AttitudeTrace) -> (f64, usize) {
+        ScoredRun::max_difference_deg(self, a, b)
+    }
+    fn max_tilt_difference_deg(&self, a: &AttitudeTrace, b: &AttitudeTrace) -> f64 {
+        ScoredRun::max_tilt_difference_deg(self, a, b)
+    }
+}
 
 /// One flight's scored fused run: what it was given and the attitude it produced in process.
 #[derive(Debug, Clone)]

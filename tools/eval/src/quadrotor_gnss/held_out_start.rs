@@ -138,6 +138,8 @@ mod tests {
             fused_roll_pitch_rmse_mounted_deg: f64::NAN,
             fused_roll_pitch_rmse_mounted_in_sample_deg: f64::NAN,
             fused_window_rmse_deg: [None; 3],
+            scored: None,
+            live: None,
         }
     }
 

@@ -28,21 +28,26 @@
 pub mod antenna;
 pub mod cross_validation;
 pub mod held_out_start;
+pub mod live;
 pub mod receiver;
 pub mod report;
+pub mod results;
 pub mod run;
 
-use std::path::{Path, PathBuf};
+pub use results::{FlightResult, GnssMode, GnssReport, RunScores};
+
+use std::path::Path;
 
 use anyhow::{Context, Result, anyhow};
 use rins_navigator::inertial_core::AidedConfig;
-use serde::Serialize;
 
 use crate::datasets::quadrotor::projection::estimate_installation;
-use crate::datasets::quadrotor::{SkippedTrial, Trial, list_trials, load_trial, nothing_evaluated};
+use crate::datasets::quadrotor::{
+    SkippedTrial, Trial, TruthRow, list_trials, load_trial, nothing_evaluated,
+};
 use crate::quadrotor_ahrs::SETTLE_S;
 use crate::quadrotor_ahrs::mounting::{Paired, fit_mounting, roll_pitch_rmse_deg};
-use crate::quadrotor_ahrs::windows::{self, WindowRmse};
+use crate::quadrotor_ahrs::windows;
 use crate::quadrotor_nav::frames::{self, Motion};
 use crate::quadrotor_nav::metrics::{angle_error, mean, median, rms};
 use crate::quadrotor_nav::run::{Start, start_from_truth};
@@ -60,125 +65,17 @@ pub const ROLL_PITCH_TARGET_DEG: f64 = 0.5;
 /// The fused outage error is held to this share of the median single unit's.
 pub const OUTAGE_RATIO_TARGET: f64 = 0.7;
 
-/// What the receiver does.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum GnssMode {
-    /// Fixes throughout.
-    Gnss,
-    /// Fixes cut for the last [`OUTAGE_S`].
-    Outage,
-}
-
-/// One run's figures.
-#[derive(Debug, Clone, Serialize)]
-pub struct RunScores {
-    /// IMU file number; absent for the fused units.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub imu: Option<usize>,
-    /// RMS of roll and pitch errors together, degrees.
-    pub roll_pitch_rmse_deg: f64,
-    /// RMS of the heading error, degrees.
-    pub heading_rmse_deg: f64,
-    /// RMS of the horizontal position error, m.
-    pub horizontal_rmse_m: f64,
-    /// Horizontal error at the last reference row of the run (the end of the outage), m.
-    pub end_horizontal_error_m: f64,
-    /// Fixes applied, outliers, skipped while rejected; times the receiver was rejected.
-    pub fixes_applied: usize,
-    /// Fixes outside the gate.
-    pub fixes_outliers: usize,
-    /// Times the monitor rejected the receiver.
-    pub rejections: u64,
-    /// The solution's attitude at each scored reference row, for the mounting fit.
-    #[serde(skip)]
-    pub paired: Paired,
-    /// The filter's gyro bias at the end, body FRD, rad/s, for the next flights' prior.
-    #[serde(skip)]
-    pub final_gyro_bias_rps: [f64; 3],
-}
-
-/// One flight's figures.
-#[derive(Debug, Clone, Serialize)]
-pub struct FlightResult {
-    /// `<group>/path_<N>`.
-    pub name: String,
-    /// From t0 to the last reference row scored, s.
-    pub duration_s: f64,
-    /// Each unit alone, in file order.
-    pub single: Vec<RunScores>,
-    /// The units fused.
-    pub fused: RunScores,
-    /// Median over the single units of the end horizontal error, m.
-    pub median_single_end_error_m: f64,
-    /// The drift test's setting, chosen on the other flights.
-    pub drift_setting: cross_validation::Choice,
-    /// The antenna's lever arm and the position's lead, fitted on the other flights.
-    pub antenna: antenna::Antenna,
-    /// The fused roll/pitch RMSE with the units' mounting tilt fitted on the other flights, as
-    /// `--mode ahrs` scores, degrees (the mounting is the airframe's, not the flight's).
-    pub fused_roll_pitch_rmse_mounted_deg: f64,
-    /// The same with the mounting fitted on every flight, this one included: in sample, shown
-    /// beside the held-out figure so that overfitting shows.
-    pub fused_roll_pitch_rmse_mounted_in_sample_deg: f64,
-    /// The held-out mounted figure over windows of time since the start (as `--mode ahrs`).
-    pub fused_window_rmse_deg: WindowRmse,
-}
-
-/// The whole data set's figures.
-#[derive(Debug, Clone, Serialize)]
-pub struct GnssReport {
-    /// The data set directory.
-    pub dir: PathBuf,
-    /// `gnss` or `outage`.
-    pub mode: GnssMode,
-    /// Every flight's figures.
-    pub trials: Vec<FlightResult>,
-    /// Mean over flights of the fused roll/pitch RMSE, degrees.
-    pub roll_pitch_rmse_deg: f64,
-    /// The antenna fitted on every flight (in sample), beside the held-out ones in `trials`;
-    /// absent when the flights do not tell it.
-    pub antenna_in_sample: Option<antenna::Antenna>,
-    /// Mean over flights of the fused roll/pitch RMSE with the mounting fitted on the other
-    /// flights ([`FlightResult::fused_roll_pitch_rmse_mounted_deg`]), degrees.
-    pub roll_pitch_rmse_mounted_deg: f64,
-    /// The same with the mounting fitted on every flight (in sample), degrees.
-    pub roll_pitch_rmse_mounted_in_sample_deg: f64,
-    /// Window starts since the start of each run, s.
-    pub window_starts_s: [f64; 3],
-    /// Per window, the mean over the flights with rows in it of the held-out mounted figure.
-    pub fused_window_rmse_deg: WindowRmse,
-    /// The fused roll/pitch RMSE is within [`ROLL_PITCH_TARGET_DEG`] (`gnss` mode).
-    pub roll_pitch_target_met: bool,
-    /// Mean over flights of the fused heading RMSE, degrees.
-    pub heading_rmse_deg: f64,
-    /// Mean over flights of the fused horizontal RMSE, m.
-    pub horizontal_rmse_m: f64,
-    /// Receiver rejections over every run (fused and single), each flight with the drift
-    /// setting chosen on the others: false alarms on these clean fixes.
-    pub gnss_rejections: u64,
-    /// The same over the fused runs only.
-    pub gnss_rejections_fused: u64,
-    /// Outage mode: mean over flights of the fused end-of-outage horizontal error, m.
-    pub outage_error_m: f64,
-    /// Outage mode: mean over flights of each unit's (by file number) end-of-outage error, m.
-    pub single_outage_error_m: Vec<f64>,
-    /// Outage mode: mean over flights of the median single unit's error, m.
-    pub median_single_outage_error_m: f64,
-    /// `outage_error_m / median_single_outage_error_m`.
-    pub outage_ratio: f64,
-    /// The ratio is within [`OUTAGE_RATIO_TARGET`] (`outage` mode).
-    pub outage_target_met: bool,
-    /// Flights listed but not evaluated, with the reason.
-    pub skipped: Vec<SkippedTrial>,
-}
-
-/// Scores `trace` against the reference rows from `start` on.
-fn score(imu: Option<usize>, trace: &GnssTrace, trial: &Trial, start: &Start) -> RunScores {
+/// Scores `trace` against the reference rows `truth` from `start` on.
+pub fn score(
+    imu: Option<usize>,
+    trace: &GnssTrace,
+    truth: &[TruthRow],
+    start: &Start,
+) -> RunScores {
     let (mut rp, mut yaw, mut horiz) = (Vec::new(), Vec::new(), Vec::new());
     let mut paired = Paired::default();
     let mut end = f64::NAN;
-    for row in trial.truth.iter().skip(start.row) {
+    for row in truth.iter().skip(start.row) {
         let i = trace.samples.partition_point(|s| s.t_s < row.t_s);
         let Some(s) = trace
             .samples
@@ -232,14 +129,14 @@ pub fn evaluate_trial(
     let config = &config;
     let installation = estimate_installation(trial)?;
     let vehicle = vehicle_from_reference();
-    let fused = frames::fused(trial, &installation, &vehicle)?;
-    let start = start_from_truth(&trial.truth, fused.t0_s, fused.end_s())
+    let fused_motion = frames::fused(trial, &installation, &vehicle)?;
+    let start = start_from_truth(&trial.truth, fused_motion.t0_s, fused_motion.end_s())
         .ok_or_else(|| anyhow!("{}: no reference row inside the IMU recording", trial.name))?;
     let end_s = trial
         .truth
         .iter()
         .map(|r| r.t_s)
-        .rfind(|&t| t <= fused.end_s())
+        .rfind(|&t| t <= fused_motion.end_s())
         .unwrap_or(start.t_s);
     let duration_s = end_s - start.t_s;
     if mode == GnssMode::Outage && duration_s < MIN_OUTAGE_FLIGHT_S {
@@ -263,14 +160,26 @@ pub fn evaluate_trial(
         let known = starts.of(imu).known;
         let trace = navigate_with_gnss(motion, &start, &known, config, &fixes, gnss_until_s);
         progress();
-        score(imu, &trace, trial, &start)
+        (score(imu, &trace, &trial.truth, &start), trace)
     };
     let mut single = Vec::with_capacity(trial.imus.len());
     for (index, series) in trial.imus.iter().enumerate() {
         let motion = frames::single(trial, &installation, &vehicle, index)?;
-        single.push(run(Some(series.imu), &motion));
+        single.push(run(Some(series.imu), &motion).0);
     }
-    let fused = run(None, &fused);
+    let (fused, trace) = run(None, &fused_motion);
+    let scored = live::ScoredGnssRun {
+        flight: trial.name.clone(),
+        motion: fused_motion,
+        start,
+        known: starts.fused.known,
+        config: *config,
+        fixes,
+        gnss_until_s,
+        tilt_rad: starts.fused.tilt_rad,
+        truth: trial.truth.clone(),
+        trace,
+    };
     let fused_roll_pitch_rmse_mounted_deg =
         roll_pitch_rmse_deg(&fused.paired, starts.fused.tilt_rad, 0.0);
     let fused_window_rmse_deg = windows::of(&fused.paired, starts.fused.tilt_rad);
@@ -290,6 +199,8 @@ pub fn evaluate_trial(
         antenna,
         fused_roll_pitch_rmse_mounted_deg,
         fused_window_rmse_deg,
+        scored: Some(Box::new(scored)),
+        live: None,
         // Filled in once every flight has run: the mounting is fitted on all.
         fused_roll_pitch_rmse_mounted_in_sample_deg: f64::NAN,
     })
@@ -304,6 +215,23 @@ fn score_mounted_in_sample(trials: &mut [FlightResult]) {
         t.fused_roll_pitch_rmse_mounted_in_sample_deg =
             roll_pitch_rmse_deg(&t.fused.paired, in_sample, 0.0);
     }
+}
+
+/// [`evaluate`], and each flight's scored fused run (in the report's flight order), for the
+/// running service to repeat.
+pub fn evaluate_with_runs(
+    dir: &Path,
+    config: &AidedConfig,
+    mode: GnssMode,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<(GnssReport, Vec<live::ScoredGnssRun>)> {
+    let mut report = evaluate(dir, config, mode, progress)?;
+    let runs = report
+        .trials
+        .iter_mut()
+        .filter_map(|t| t.scored.take().map(|r| *r))
+        .collect();
+    Ok((report, runs))
 }
 
 /// Every flight under `dir`; `progress(done, total)` after each navigator run.
@@ -509,5 +437,6 @@ fn summarise(
         outage_target_met: mode == GnssMode::Outage && ratio <= OUTAGE_RATIO_TARGET,
         trials,
         skipped,
+        live: None,
     }
 }

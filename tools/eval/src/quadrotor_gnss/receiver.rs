@@ -7,7 +7,12 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
+use ipc_types::{GnssFix, GnssFixType, GnssProtocol, Header};
+use rins_earth::LocalOrigin;
+
 use crate::datasets::quadrotor::TruthRow;
+use crate::import::rx_ns;
+use crate::quadrotor_ahrs::run::device_us;
 
 /// Epochs per second.
 pub const RATE_HZ: f64 = 5.0;
@@ -88,6 +93,36 @@ pub fn epochs(truth: &[TruthRow], from_s: f64, to_s: f64, lead_s: f64, seed: u64
         });
     }
     out
+}
+
+/// The receiver message of `fix`: a 3-D fix at the geodetic position of its local `ned_m` about
+/// `origin`, its velocity and the receiver's σs, received at its device time (the trial's time
+/// plus a second, as the import writes it), `seq` its sequence number.
+pub fn gnss_fix(fix: &LocalFix, origin: &LocalOrigin, seq: u64) -> GnssFix {
+    let [lat, lon, alt] = origin.geodetic(fix.ned_m);
+    let t_us = device_us(fix.t_s);
+    GnssFix {
+        fix_type: GnssFixType::Fix3d as u8,
+        satellites: 12,
+        protocol: GnssProtocol::Ubx as u8,
+        velocity_valid: 1,
+        accuracy_reported: 1,
+        header: Header {
+            origin_seq: seq,
+            origin_device_time_us: t_us,
+            origin_rx_ns: rx_ns(t_us),
+            ..Header::default()
+        },
+        receiver_time_us: t_us,
+        latitude_rad: lat,
+        longitude_rad: lon,
+        altitude_m: alt,
+        velocity_ned_mps: fix.velocity_ned_mps,
+        horizontal_accuracy_m: SIGMA_H_M,
+        vertical_accuracy_m: SIGMA_V_M,
+        speed_accuracy_mps: SIGMA_VEL_MPS,
+        ..GnssFix::default()
+    }
 }
 
 /// A seed from a trial's name, so that each flight has its own noise and every run the same.

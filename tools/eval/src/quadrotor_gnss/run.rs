@@ -1,18 +1,21 @@
 //! One motion series through the aided navigator with the simulated receiver's fixes: started
 //! from the reference at t0 as `--mode ahrs` starts (the airframe's attitude turned by the
-//! series' mounting, the gyro bias from a prior when one is given), the fixes applied at their
-//! own time, the receiver cut from `gnss_until_s` on.
+//! series' mounting, the gyro bias from a prior when one is given), the fixes placed by the
+//! navigator service's receiver hold, the receiver cut from `gnss_until_s` on. Device time is the
+//! trial's time plus a second, as the import writes it.
 
-use nalgebra::{UnitQuaternion, Vector3};
+use ipc_types::GnssFix;
+use nalgebra::UnitQuaternion;
 use rins_earth::LocalOrigin;
+use rins_navigator::NominalState;
+use rins_navigator::aiding::gnss::hold::GnssHold;
 use rins_navigator::aiding::gnss::measurement::{GnssMeasurement, GnssOutcome};
-use rins_navigator::inertial_core::AidedConfig;
-use rins_navigator::inertial_core::AidedNavigator;
-use rins_navigator::mechanisation::quaternion_from_euler;
-use rins_navigator::{ImuBias, NominalState};
+use rins_navigator::inertial_core::{AidedConfig, AidedNavigator};
+use rins_navigator::start::InFlightStart;
 
-use super::receiver::{LocalFix, SIGMA_H_M, SIGMA_V_M, SIGMA_VEL_MPS};
-use crate::quadrotor_ahrs::run::GyroPrior;
+use super::receiver::{LocalFix, gnss_fix};
+use crate::import::rx_ns;
+use crate::quadrotor_ahrs::run::{GyroPrior, device_us, first_sample_after, in_flight_start};
 use crate::quadrotor_nav::frames::Motion;
 use crate::quadrotor_nav::run::Start;
 
@@ -62,8 +65,52 @@ impl Default for StartKnowledge {
     }
 }
 
+/// The navigator settings and `[navigator.start]` of a run: `config` with GNSS aiding on and no
+/// receiver delay, its origin moved to the reference's horizontal position at t0 (the start table
+/// states a height, not a place), and the start as `--mode ahrs` makes it from `known`, at the
+/// reference position's altitude (the receiver's datum: the reference's height above take-off is
+/// another one, metres apart).
+pub fn gnss_start(
+    start: &Start,
+    known: &StartKnowledge,
+    config: &AidedConfig,
+) -> (InFlightStart, AidedConfig) {
+    let mut config = *config;
+    config.gnss.enabled = true;
+    config.gnss.delay_s = 0.0;
+    let [lat0, lon0, alt0] = config.origin;
+    let [lat, lon, _] =
+        LocalOrigin::new(lat0, lon0, alt0).geodetic([start.ned_m[0], start.ned_m[1], 0.0]);
+    // As a configuration states it (degrees), so that the running navigator has the same origin.
+    let stated = |rad: f64| rad.to_degrees().to_radians();
+    config.origin = [stated(lat), stated(lon), alt0];
+    let (mut table, config) =
+        in_flight_start(start, &config, &known.mounting, known.prior.as_ref());
+    table.altitude_m = alt0 - start.ned_m[2];
+    (table, config)
+}
+
+/// The receiver's messages of the epochs of `fixes` after `from_s` and before `until_s`, about
+/// `origin`, numbered from 1 in the epochs' order.
+pub fn receiver_messages(
+    fixes: &[LocalFix],
+    origin: &LocalOrigin,
+    from_s: f64,
+    until_s: f64,
+) -> Vec<GnssFix> {
+    fixes
+        .iter()
+        .enumerate()
+        .filter(|(_, f)| f.t_s > from_s && f.t_s < until_s)
+        .map(|(k, f)| gnss_fix(f, origin, k as u64 + 1))
+        .collect()
+}
+
 /// Runs `motion` from `start` with `fixes` (those at or after `gnss_until_s` withheld) through an
-/// [`AidedNavigator`] with `config` (GNSS aiding turned on). Device time counts from t0.
+/// [`AidedNavigator`] with `config` as the navigator service runs it: started from the table
+/// [`gnss_start`] makes, each fix made a receiver message ([`super::receiver::gnss_fix`]) received
+/// at its device time, held and placed by the service's own receiver hold. Fixes and scores stay
+/// in the reference's local frame (`config.origin`).
 pub fn navigate_with_gnss(
     motion: &Motion,
     start: &Start,
@@ -72,67 +119,47 @@ pub fn navigate_with_gnss(
     fixes: &[LocalFix],
     gnss_until_s: f64,
 ) -> GnssTrace {
-    let mut config = *config;
-    config.gnss.enabled = true;
-    config.gnss.delay_s = 0.0;
-    let mut bias = ImuBias::default();
-    if let Some(p) = &known.prior {
-        config.noise.initial_gyro_bias_sigma = p.sigma_rps;
-        bias.gyro_rps = Vector3::from(p.bias_rps);
-    }
     let [lat0, lon0, alt0] = config.origin;
     let origin = LocalOrigin::new(lat0, lon0, alt0);
-    let to_geo = |ned: [f64; 3]| origin.geodetic(ned);
     let to_local = |s: &NominalState| {
         let [n, e, _] = origin.ned(s.lat, s.lon, s.alt);
         [n, e]
     };
-    // Device time: µs since one second before t0, so that every time is positive.
-    let us = |t_s: f64| ((t_s - start.t_s + 1.0) * 1e6).round().max(0.0) as u64;
-
+    let (table, config) = gnss_start(start, known, config);
+    let s = table.state(&config);
     let mut nav = AidedNavigator::new(config);
-    let [roll, pitch, heading] = start.euler_rad;
-    let [lat, lon, alt] = to_geo(start.ned_m);
-    let mut state = NominalState::at_rest(lat, lon, alt);
-    state.attitude = quaternion_from_euler(roll, pitch, heading) * known.mounting.inverse();
-    state.velocity_ned = Vector3::from(start.velocity_ned);
-    nav.take_over(
-        us(start.t_s),
-        state,
-        bias,
-        &config.noise.initial_variances(),
-    );
-
+    nav.take_over(s.device_time_us, s.state, s.bias, &s.variances);
+    let messages = receiver_messages(fixes, &origin, start.t_s, gnss_until_s);
+    let mut hold = GnssHold::new(config.gnss.delay_s);
+    let mut next_fix = 0;
     let mut trace = GnssTrace::default();
-    let mut next_fix = fixes.partition_point(|f| f.t_s <= start.t_s);
-    let first = ((start.t_s - motion.t0_s) / motion.dt_s).floor().max(-1.0) + 1.0;
-    for (j, sample) in motion.samples.iter().enumerate().skip(first as usize) {
+    for (j, sample) in motion
+        .samples
+        .iter()
+        .enumerate()
+        .skip(first_sample_after(motion, start.t_s))
+    {
         let t_s = motion.time(j);
-        let step = nav.on_imu(us(t_s), sample.gyro_rps, sample.accel_mps2, None);
-        if !step.propagated.is_some_and(|p| p.is_applied()) {
-            continue;
-        }
-        while let Some(fix) = fixes.get(next_fix).filter(|f| f.t_s <= t_s) {
+        let (imu_us, imu_rx) = (device_us(t_s), rx_ns(device_us(t_s)));
+        // What the service has received by this frame, then what this frame releases.
+        while let Some(fix) = messages
+            .get(next_fix)
+            .filter(|f| f.header.origin_rx_ns <= imu_rx)
+        {
+            hold.push(*fix);
             next_fix += 1;
-            if fix.t_s >= gnss_until_s {
-                continue;
-            }
-            let m = GnssMeasurement {
-                t_us: us(fix.t_s),
-                receiver_time_us: us(fix.t_s),
-                fix_3d: true,
-                position: to_geo(fix.ned_m),
-                velocity_ned: Some(fix.velocity_ned_mps),
-                sigma_h_m: SIGMA_H_M,
-                sigma_v_m: SIGMA_V_M,
-                sigma_vel_mps: SIGMA_VEL_MPS,
-            };
-            match nav.on_gnss(&m) {
+        }
+        hold.release(imu_us, imu_rx, |fix, t_us| {
+            match nav.on_gnss(&GnssMeasurement::from_fix(fix, t_us)) {
                 GnssOutcome::Applied { .. } | GnssOutcome::Readmitted => trace.applied += 1,
                 GnssOutcome::Outlier => trace.outliers += 1,
                 GnssOutcome::Rejected => trace.rejected += 1,
                 _ => {}
             }
+        });
+        let step = nav.on_imu(imu_us, sample.gyro_rps, sample.accel_mps2, None);
+        if !step.propagated.is_some_and(|p| p.is_applied()) {
+            continue;
         }
         if let Some(ekf) = nav.ekf() {
             trace.samples.push(Sample {
