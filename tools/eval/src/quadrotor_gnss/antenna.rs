@@ -31,7 +31,7 @@ use crate::quadrotor_nav::frames::Motion;
 /// Unknowns: lever arm (3), lead (1), mounting tilt about x and y (2), accelerometer bias (3).
 pub const UNKNOWNS: usize = 9;
 /// Standard gravity, m/s²: its departure from the local value is absorbed by the bias terms.
-const GRAVITY_MPS2: f64 = 9.806_65;
+pub(super) const GRAVITY_MPS2: f64 = 9.806_65;
 /// Reference row spacing the second difference is taken over, s, and how far it may stray.
 const ROW_STEP_S: f64 = 0.1;
 const ROW_STEP_TOLERANCE_S: f64 = 0.02;
@@ -81,9 +81,9 @@ pub struct Antenna {
 
 /// Per IMU row, what the kernel averages: acceleration NED (3), then the mounting regressors
 /// `C (e_x × f)` (3) and `C (e_y × f)` (3), then the columns of `C` (9).
-type Row = [f64; 18];
+pub(super) type Row = [f64; 18];
 
-fn unwrapped_headings(truth: &[TruthRow]) -> Vec<f64> {
+pub(super) fn unwrapped_headings(truth: &[TruthRow]) -> Vec<f64> {
     let mut out: Vec<f64> = Vec::with_capacity(truth.len());
     for r in truth {
         let h = match out.last() {
@@ -100,14 +100,14 @@ fn unwrapped_headings(truth: &[TruthRow]) -> Vec<f64> {
     out
 }
 
-fn attitude(roll: f64, pitch: f64, heading: f64) -> Matrix3<f64> {
+pub(super) fn attitude(roll: f64, pitch: f64, heading: f64) -> Matrix3<f64> {
     quaternion_from_euler(roll, pitch, heading)
         .to_rotation_matrix()
         .into_inner()
 }
 
 /// The reference attitude at `t_s`, interpolated linearly in roll, pitch and unwrapped heading.
-fn attitude_at(truth: &[TruthRow], headings: &[f64], t_s: f64) -> Option<Matrix3<f64>> {
+pub(super) fn attitude_at(truth: &[TruthRow], headings: &[f64], t_s: f64) -> Option<Matrix3<f64>> {
     let i = truth.partition_point(|r| r.t_s <= t_s);
     if i == 0 || i >= truth.len() {
         return None;
@@ -126,13 +126,20 @@ fn attitude_at(truth: &[TruthRow], headings: &[f64], t_s: f64) -> Option<Matrix3
     ))
 }
 
-fn imu_rows(truth: &[TruthRow], headings: &[f64], motion: &Motion) -> Vec<Option<Row>> {
+/// Per IMU row, the kernel's inputs, with the units' axes `unit_from_vehicle` turned from the
+/// reference's (`C_unit = C_reference · unit_from_vehicle`).
+pub(super) fn imu_rows(
+    truth: &[TruthRow],
+    headings: &[f64],
+    motion: &Motion,
+    unit_from_vehicle: &Matrix3<f64>,
+) -> Vec<Option<Row>> {
     motion
         .samples
         .iter()
         .enumerate()
         .map(|(j, s)| {
-            let c = attitude_at(truth, headings, motion.time(j))?;
+            let c = attitude_at(truth, headings, motion.time(j))? * unit_from_vehicle;
             let f = Vector3::from(s.accel_mps2);
             let a = c * f + Vector3::new(0.0, 0.0, GRAVITY_MPS2);
             let tx = c * Vector3::x().cross(&f);
@@ -150,7 +157,7 @@ fn imu_rows(truth: &[TruthRow], headings: &[f64], motion: &Motion) -> Vec<Option
 }
 
 /// Triangular-kernel average of the rows within `half` of `t_s`; `None` when any is missing.
-fn kernel(rows: &[Option<Row>], motion: &Motion, t_s: f64, half: f64) -> Option<Row> {
+pub(super) fn kernel(rows: &[Option<Row>], motion: &Motion, t_s: f64, half: f64) -> Option<Row> {
     let index = |t: f64| ((t - motion.t0_s) / motion.dt_s).max(0.0);
     let from = index(t_s - half).ceil() as usize;
     let to = (index(t_s + half).floor() as usize).min(rows.len().checked_sub(1)?);
@@ -172,7 +179,7 @@ fn kernel(rows: &[Option<Row>], motion: &Motion, t_s: f64, half: f64) -> Option<
 /// One flight's normal equations from its reference and its units' motion (body FRD).
 pub fn normal_equations(truth: &[TruthRow], motion: &Motion) -> NormalEquations {
     let headings = unwrapped_headings(truth);
-    let rows = imu_rows(truth, &headings, motion);
+    let rows = imu_rows(truth, &headings, motion, &Matrix3::identity());
     let mut eq = NormalEquations::default();
     for k in 1..truth.len().saturating_sub(1) {
         let (a, b, c) = (&truth[k - 1], &truth[k], &truth[k + 1]);
@@ -264,77 +271,14 @@ pub fn in_sample(flights: &[NormalEquations]) -> Option<Antenna> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::quadrotor_nav::frames::BodySample;
+    use crate::quadrotor_gnss::synthetic;
+
+    fn flight(arm: [f64; 3], lead_s: f64) -> (Vec<TruthRow>, Motion) {
+        synthetic::flight(arm, lead_s, |_| 0.0)
+    }
 
     const ARM: [f64; 3] = [-0.06, 0.02, -0.16];
     const LEAD_S: f64 = 0.027;
-
-    fn euler(t: f64) -> [f64; 3] {
-        [0.2 * (1.3 * t).sin(), 0.15 * (0.9 * t + 1.0).sin(), 0.6 * t]
-    }
-
-    fn position(t: f64) -> Vector3<f64> {
-        Vector3::new(
-            3.0 * (0.5 * t).sin(),
-            2.0 * (0.7 * t).cos(),
-            0.5 * (1.1 * t).sin(),
-        )
-    }
-
-    fn acceleration(t: f64) -> Vector3<f64> {
-        Vector3::new(
-            -0.75 * (0.5 * t).sin(),
-            -0.98 * (0.7 * t).cos(),
-            -0.605 * (1.1 * t).sin(),
-        )
-    }
-
-    fn rotation(t: f64) -> Matrix3<f64> {
-        let [r, p, y] = euler(t);
-        attitude(r, p, y)
-    }
-
-    /// A minute of a turning, swaying flight: the units at 120 Hz, the reference at 10 Hz with
-    /// its position at the antenna (`arm`) and stamped `lead_s` early.
-    fn flight(arm: [f64; 3], lead_s: f64) -> (Vec<TruthRow>, Motion) {
-        let dt = 1.0 / 120.0;
-        let samples = (0..(60.0 / dt) as usize)
-            .map(|j| {
-                let t = j as f64 * dt;
-                let f = rotation(t).transpose()
-                    * (acceleration(t) - Vector3::new(0.0, 0.0, GRAVITY_MPS2));
-                BodySample {
-                    gyro_rps: [0.0; 3],
-                    accel_mps2: f.into(),
-                }
-            })
-            .collect();
-        let truth = (0..600)
-            .map(|k| {
-                let t = k as f64 * 0.1;
-                let [roll, pitch, heading] = euler(t);
-                let p = position(t + lead_s) + rotation(t + lead_s) * Vector3::from(arm);
-                TruthRow {
-                    t_s: t,
-                    distance_m: 0.0,
-                    speed_mps: 0.0,
-                    heading_rad: heading.rem_euclid(std::f64::consts::TAU),
-                    pitch_rad: pitch,
-                    roll_rad: roll,
-                    height_m: -p[2],
-                    north_m: p[0],
-                    east_m: p[1],
-                    down_m: p[2],
-                }
-            })
-            .collect();
-        let motion = Motion {
-            t0_s: 0.0,
-            dt_s: dt,
-            samples,
-        };
-        (truth, motion)
-    }
 
     #[test]
     fn the_arm_and_lead_of_a_known_flight_are_found() {

@@ -140,6 +140,7 @@ mod tests {
             fused_window_rmse_deg: [None; 3],
             scored: None,
             live: None,
+            reference_check: Default::default(),
         }
     }
 

@@ -23,16 +23,21 @@
 //!   bias known; the second, scored, pass starts each flight's runs with what the first pass of
 //!   the other flights learnt, and scores the attitude with that mounting.
 //!
-//! Everything else is the UAV profile's.
+//! Everything else is the UAV profile's. Beside the figures, each flight's reference is checked
+//! against itself and the units ([`reference_check`]): how far any filter that follows the gyros
+//! or the positions must stay from its attitude.
 
 pub mod antenna;
 pub mod cross_validation;
 pub mod held_out_start;
 pub mod live;
 pub mod receiver;
+pub mod reference_check;
 pub mod report;
 pub mod results;
 pub mod run;
+#[cfg(test)]
+mod synthetic;
 
 pub use results::{FlightResult, GnssMode, GnssReport, RunScores};
 
@@ -201,6 +206,7 @@ pub fn evaluate_trial(
         fused_window_rmse_deg,
         scored: Some(Box::new(scored)),
         live: None,
+        reference_check: Default::default(),
         // Filled in once every flight has run: the mounting is fitted on all.
         fused_roll_pitch_rmse_mounted_in_sample_deg: f64::NAN,
     })
@@ -371,6 +377,12 @@ pub fn evaluate(
         return Err(anyhow!("eval quadrotor: {}", nothing_evaluated(&skipped)));
     }
     score_mounted_in_sample(&mut trials);
+    for t in &mut trials {
+        if let Some(run) = &t.scored {
+            t.reference_check =
+                reference_check::check(&run.truth, &run.motion, run.tilt_rad, &t.antenna);
+        }
+    }
     let mut report = summarise(dir, mode, trials, skipped);
     report.antenna_in_sample = antenna_in_sample;
     Ok(report)
@@ -386,6 +398,11 @@ fn antenna_equations(trial: &Trial) -> antenna::NormalEquations {
         })
         .map(|motion| antenna::normal_equations(&trial.truth, &motion))
         .unwrap_or_default()
+}
+
+/// The mean of the finite values of `v`; NaN without any.
+fn finite_mean(v: impl Iterator<Item = f64>) -> f64 {
+    mean(&v.filter(|x| x.is_finite()).collect::<Vec<_>>())
 }
 
 fn summarise(
@@ -420,6 +437,16 @@ fn summarise(
             t.fused_roll_pitch_rmse_mounted_in_sample_deg
         }),
         roll_pitch_target_met: roll_pitch <= ROLL_PITCH_TARGET_DEG,
+        reference_attitude_vs_gyro_deg: finite_mean(
+            trials
+                .iter()
+                .map(|t| t.reference_check.attitude_vs_gyro_deg),
+        ),
+        reference_position_vs_attitude_deg: finite_mean(
+            trials
+                .iter()
+                .map(|t| t.reference_check.position_vs_attitude_deg),
+        ),
         window_starts_s: windows::WINDOW_STARTS_S,
         fused_window_rmse_deg: windows::mean(trials.iter().map(|t| &t.fused_window_rmse_deg)),
         heading_rmse_deg: of(&|t| t.fused.heading_rmse_deg),

@@ -61,6 +61,11 @@ pub fn to_table(r: &GnssReport) -> String {
         "the same by time since the start: {}",
         windows.join(", ")
     );
+    let _ = writeln!(
+        s,
+        "the reference against itself and the units, tilt per axis over 1 s: its attitude change against the gyros {:.3}°, its positions against its attitude and the accelerometers {:.3}° (no filter following the gyros or the positions gets closer to it)",
+        r.reference_attitude_vs_gyro_deg, r.reference_position_vs_attitude_deg
+    );
     if let Some(a) = &r.antenna_in_sample {
         let [x, y, z] = a.lever_arm_m;
         let _ = writeln!(

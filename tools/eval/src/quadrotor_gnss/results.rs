@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
+use super::reference_check::ReferenceCheck;
 use super::{antenna, cross_validation, live};
 use crate::datasets::quadrotor::SkippedTrial;
 use crate::quadrotor_ahrs::live::{LiveFlight, LiveSummary};
@@ -79,6 +80,9 @@ pub struct FlightResult {
     /// The same flight through the running processes (`--live`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub live: Option<LiveFlight>,
+    /// The reference checked against itself and the fused units, with the held-out mounting and
+    /// antenna.
+    pub reference_check: ReferenceCheck,
 }
 
 /// The whole data set's figures.
@@ -106,6 +110,12 @@ pub struct GnssReport {
     pub fused_window_rmse_deg: WindowRmse,
     /// The fused roll/pitch RMSE is within [`super::ROLL_PITCH_TARGET_DEG`] (`gnss` mode).
     pub roll_pitch_target_met: bool,
+    /// Mean over flights of the reference's attitude change over a second against the integrated
+    /// gyros, tilt per axis, degrees ([`super::reference_check`]).
+    pub reference_attitude_vs_gyro_deg: f64,
+    /// Mean over flights of the reference's position acceleration against its attitude and the
+    /// accelerometers, tilt per axis, degrees.
+    pub reference_position_vs_attitude_deg: f64,
     /// Mean over flights of the fused heading RMSE, degrees.
     pub heading_rmse_deg: f64,
     /// Mean over flights of the fused horizontal RMSE, m.
