@@ -186,8 +186,17 @@ fn the_stream_reaches_the_wire_whole_and_answers_come_back_on_it() {
             ..COMMAND_LONG_DATA::default()
         })))
         .unwrap();
+    // Read until the answer and every queued frame are in: the last queued is the heartbeat after
+    // the 20th odometry, and the answer, written by the reader at once, may overtake it.
     let frames = read_frames(&mut port.master, |seen| {
-        has(seen, TIMESYNC) && seen.iter().filter(|m| m.message_id() == ODOMETRY).count() == 20
+        let queued_heartbeats = seen
+            .iter()
+            .skip_while(|m| m.message_id() != ODOMETRY)
+            .filter(|m| m.message_id() == HEARTBEAT)
+            .count();
+        has(seen, TIMESYNC)
+            && seen.iter().filter(|m| m.message_id() == ODOMETRY).count() == 20
+            && queued_heartbeats >= 20
     });
     let seen: Vec<MavMessage> = frames.iter().map(|(_, m)| m.clone()).collect();
     assert!(has(&seen, HEARTBEAT) && has(&seen, ODOMETRY), "{seen:?}");
