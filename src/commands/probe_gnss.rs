@@ -14,6 +14,7 @@ use rins_serial_reader::port;
 use serde_json::{Value, json};
 use serialport::{ClearBuffer, SerialPort};
 
+use super::probe::rates_json;
 use super::probe_gnss_report::{
     EpochTally, GnssLineReport, best_rate, counters, receiver_time_text, scan_verdict,
 };
@@ -59,14 +60,7 @@ pub fn scan(port: &str, seconds: f64, json_out: bool) -> Result<()> {
     let best = best_rate(results.iter().map(|(baud, r)| (*baud, r.used())));
     let verdict = scan_verdict(&results);
     if json_out {
-        let rates: Vec<Value> = results
-            .iter()
-            .map(|(baud, r)| {
-                let mut v = report_json(r);
-                v["baud"] = json!(baud);
-                v
-            })
-            .collect();
+        let rates = rates_json(&results, report_json);
         let v = json!({
             "port": port,
             "seconds_per_rate": seconds,
