@@ -168,18 +168,24 @@ fn the_watchdog_frees_the_shared_memory_of_a_killed_process_it_did_not_start() {
     let mut echo = ipc
         .command()
         .args(["echo", "nav", "--timeout", "60"])
-        .stdout(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::null())
         .spawn()
         .expect("cannot start rins echo");
-    let start = Instant::now();
-    while ipc.shm_entries().len() <= before {
-        assert!(
-            start.elapsed() < Duration::from_secs(10),
-            "echo created nothing"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    // Killed only once it has printed a sample: its node and ports are then complete. A process
+    // killed halfway through creating them leaves a node iceoryx2 cannot yet call dead.
+    let stdout = echo.stdout.take().expect("echo's stdout is piped");
+    let (first_line, got_line) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let mut line = String::new();
+        let _ = std::io::BufRead::read_line(&mut std::io::BufReader::new(stdout), &mut line);
+        let _ = first_line.send(line);
+    });
+    let line = got_line
+        .recv_timeout(Duration::from_secs(10))
+        .expect("echo printed no sample in 10 s");
+    assert!(!line.is_empty(), "echo exited before printing a sample");
+    assert!(ipc.shm_entries().len() > before, "echo created nothing");
     echo.kill().expect("SIGKILL echo");
     echo.wait().expect("reap echo");
     // The watchdog's dead-node sweep (every 250 ms) removes them; nothing else here creates a node.
