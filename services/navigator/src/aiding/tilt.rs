@@ -67,6 +67,10 @@ pub struct TiltAidingConfig {
     pub drag_per_s: f64,
     /// The same along body y, 1/s (an airframe is seldom as draggy sideways as forwards).
     pub lateral_drag_per_s: f64,
+    /// `drag` model: let the drag also correct the heading (the direction of the velocity through
+    /// the air). Off by default: the filter's velocity is over the ground, so wind biases that
+    /// heading (`ErrorStateEkf::rotor_drag`).
+    pub drag_heading: bool,
     /// Innovation gate: largest accepted Mahalanobis distance.
     pub gate: f64,
     /// `gravity` model: the vehicle's acceleration is taken as the centripetal `ω × v` of its
@@ -87,6 +91,7 @@ impl Default for TiltAidingConfig {
             max_force_error_mps2: 2.0,
             drag_per_s: 0.6,
             lateral_drag_per_s: 0.6,
+            drag_heading: false,
             gate: 5.0,
             centripetal_correction: false,
         }
@@ -237,6 +242,7 @@ impl TiltAiding {
                 mean.force.into(),
                 [config.drag_per_s, config.lateral_drag_per_s],
                 sigma,
+                config.drag_heading,
                 config.gate,
             ),
         })
@@ -251,7 +257,7 @@ impl TiltAiding {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ekf::{ATT, BG, EkfNoise};
+    use crate::ekf::{ATT, BG, EkfNoise, VEL};
     use crate::mechanisation::{ImuBias, NominalState, StrapdownConfig, quaternion_from_euler};
 
     const RATE_HZ: f64 = 100.0;
@@ -424,6 +430,39 @@ mod tests {
             pitch.to_degrees()
         );
         assert!((ekf.state().velocity_ned.x - speed).abs() < 0.05);
+    }
+
+    /// Flying north at 5 m/s over the ground with 1 m/s of wind from the east: the air comes from
+    /// 11° right of the nose, so the drag has a sideways part the ground velocity cannot explain.
+    /// With the drag's heading information a filter that knows its ground velocity turns most of
+    /// its 2° heading σ towards the air; without it the heading is untouched.
+    #[test]
+    fn without_drag_heading_a_crosswind_does_not_turn_the_heading() {
+        let (mu, speed, crosswind) = (0.4, 5.0, 1.0);
+        let heading_after = |drag_heading: bool| {
+            let mut ekf = filter(0.0, 1e-12);
+            let g = ekf.strapdown().gravity();
+            ekf.state_mut().velocity_ned = Vector3::new(speed, 0.0, 0.0);
+            let force = [0.0, -mu * crosswind, -g];
+            // The ground velocity known to 2 cm/s, as a receiver gives it.
+            for axis in 0..3 {
+                ekf.reset_component(VEL + axis, 0.02 * 0.02);
+            }
+            let outcome = ekf.rotor_drag(force, [mu, mu], 0.05, drag_heading, 1e6);
+            assert!(
+                matches!(outcome, UpdateOutcome::Accepted { .. }),
+                "{outcome:?}"
+            );
+            ekf.state().euler()[2]
+        };
+        let turned = heading_after(true);
+        let kept = heading_after(false);
+        assert!(
+            turned.abs() > 0.5_f64.to_radians(),
+            "{}",
+            turned.to_degrees()
+        );
+        assert!(kept.abs() < 1e-9, "{kept}");
     }
 
     #[test]

@@ -99,11 +99,19 @@ impl ErrorStateEkf {
     /// `v_b ≈ Ĉᵀ v̂ + Ĉᵀ δv + Ĉᵀ [v̂×] δθ`: a tilt error shows through the velocity it makes the
     /// filter integrate, which the drag measures, so tilt and the horizontal gyro biases become
     /// observable without any position aiding.
+    ///
+    /// The model also ties the heading to the direction of the velocity through the air. The
+    /// filter's velocity is over the ground, so a wind of w at airspeed v turns that heading by up
+    /// to w / v rad (11° for 1 m/s across a 5 m/s flight). With `heading` false the update's
+    /// heading column (the vertical component of δθ) is zeroed: the drag then says nothing about
+    /// heading, and a GNSS-aided filter no longer turns the wind into heading error and that into
+    /// tilt error.
     pub fn rotor_drag(
         &mut self,
         force_body: [f64; 3],
         drag_per_s: [f64; 2],
         sigma_mps2: f64,
+        heading: bool,
         gate: f64,
     ) -> UpdateOutcome {
         let c = self.state().attitude.to_rotation_matrix().into_inner();
@@ -118,6 +126,9 @@ impl ErrorStateEkf {
             for j in 0..3 {
                 h[(k, VEL + j)] = -mu * ct[(k, j)];
                 h[(k, ATT + j)] = -mu * ct_vx[(k, j)];
+            }
+            if !heading {
+                h[(k, ATT + 2)] = 0.0;
             }
             h[(k, BA + k)] = 1.0;
             innovation[k] = force_body[k] - (b[k] - mu * v_body[k]);

@@ -3,7 +3,8 @@
 //! Both models of `[navigator.tilt]` over a small grid: the gravity model with a fixed σ or with
 //! σ inflated by the departure of |f| from g and by the rotation rate, and the rotor-drag model
 //! over the plausible drag coefficients of a small multirotor (0.3–0.6 /s forwards, 0.4–0.6 /s
-//! sideways) and two σs. Every other setting is the profile's.
+//! sideways) and two σs, with and without the drag's heading information (`drag_heading`). Every
+//! other setting is the profile's.
 
 use rins_navigator::aiding::tilt::{TiltAidingConfig, TiltModel};
 use serde::Serialize;
@@ -42,23 +43,27 @@ pub fn grid(base: &TiltAidingConfig) -> Vec<Candidate> {
             });
         }
     }
-    for forward in [0.3, 0.4, 0.6] {
-        for lateral in [0.4, 0.6] {
-            for sigma in [1.0, 1.5] {
-                out.push(Candidate {
-                    name: format!("drag mu {forward}/{lateral} sigma {sigma}"),
-                    tilt: TiltAidingConfig {
-                        enabled: true,
-                        model: TiltModel::Drag,
-                        sigma_mps2: sigma,
-                        force_error_gain: 0.0,
-                        rate_gain_mps: 0.0,
-                        max_force_error_mps2: MAX_FORCE_ERROR_MPS2,
-                        drag_per_s: forward,
-                        lateral_drag_per_s: lateral,
-                        ..*base
-                    },
-                });
+    for drag_heading in [false, true] {
+        for forward in [0.3, 0.4, 0.6] {
+            for lateral in [0.4, 0.6] {
+                for sigma in [1.0, 1.5] {
+                    let heading = if drag_heading { " heading" } else { "" };
+                    out.push(Candidate {
+                        name: format!("drag mu {forward}/{lateral} sigma {sigma}{heading}"),
+                        tilt: TiltAidingConfig {
+                            enabled: true,
+                            model: TiltModel::Drag,
+                            sigma_mps2: sigma,
+                            force_error_gain: 0.0,
+                            rate_gain_mps: 0.0,
+                            max_force_error_mps2: MAX_FORCE_ERROR_MPS2,
+                            drag_per_s: forward,
+                            lateral_drag_per_s: lateral,
+                            drag_heading,
+                            ..*base
+                        },
+                    });
+                }
             }
         }
     }

@@ -192,17 +192,31 @@ pub(crate) fn run(
     let n = flights.len();
     let identity = UnitQuaternion::identity();
     let configs: Vec<AidedConfig> = grid.iter().map(|c| with_candidate(base, c)).collect();
-    // First pass: every candidate on every flight, started from the airframe's attitude.
+    // First pass: every candidate on every flight, started from the airframe's attitude; the
+    // runs are independent, so they share the machine's cores.
+    let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
+    let runs = crate::parallel::run_indexed(
+        configs.len() * n,
+        threads,
+        |k| {
+            let flight = &flights[k % n];
+            Ok::<_, std::convert::Infallible>(run_paired(
+                flight,
+                &flight.fused,
+                &configs[k / n],
+                &identity,
+                None,
+            ))
+        },
+        |_, _| progress(1),
+    );
+    let mut runs = match runs {
+        Ok(runs) => runs.into_iter(),
+        Err(never) => match never {},
+    };
     let first: Vec<Vec<Scored>> = configs
         .iter()
-        .map(|config| {
-            let runs = flights
-                .iter()
-                .map(|f| run_paired(f, &f.fused, config, &identity, None))
-                .collect();
-            progress(n);
-            runs
-        })
+        .map(|_| runs.by_ref().take(n).collect())
         .collect();
     let chosen: Vec<usize> = (0..n)
         .map(|f| {
@@ -233,10 +247,13 @@ pub(crate) fn run(
             progress(n * MAX_IMUS);
         }
     }
-    let (results, runs): (Vec<FlightResult>, Vec<ScoredRun>) = flights
-        .iter()
-        .enumerate()
-        .map(|(f, flight)| {
+    // Each flight's scored runs, and the training runs that choose its prior: independent of
+    // the other flights' (the first pass is shared, read-only).
+    let scored = crate::parallel::run_indexed(
+        n,
+        threads,
+        |f| {
+            let flight = &flights[f];
             let c = chosen[f];
             let config = &configs[c];
             let scale = choose_prior_scale(flights, &first[c], config, f);
@@ -286,7 +303,6 @@ pub(crate) fn run(
                 peer[imu - 1] = Some(roll_pitch_rmse_deg(&flight.peers[k], tilt, 0.0));
                 peer_windows[imu - 1] = Some(windows::of(&flight.peers[k], tilt));
             }
-            progress(MAX_IMUS + 1);
             let result = FlightResult {
                 name: flight.name.clone(),
                 imus: flight.imus.clone(),
@@ -306,9 +322,14 @@ pub(crate) fn run(
                 mahony: Default::default(),
                 live: None,
             };
-            (result, scored)
-        })
-        .unzip();
+            Ok::<_, std::convert::Infallible>((result, scored))
+        },
+        |_, _| progress(MAX_IMUS + 1),
+    );
+    let (results, runs): (Vec<FlightResult>, Vec<ScoredRun>) = match scored {
+        Ok(scored) => scored.into_iter().unzip(),
+        Err(never) => match never {},
+    };
     let candidates = grid
         .iter()
         .enumerate()

@@ -97,8 +97,7 @@ pub fn held_out_starts(first_pass: &[FlightResult]) -> Vec<FlightStarts> {
 mod tests {
     use super::*;
     use crate::quadrotor_ahrs::mounting::roll_pitch_rmse_deg;
-    use crate::quadrotor_gnss::antenna::Antenna;
-    use crate::quadrotor_gnss::cross_validation::Choice;
+    use crate::quadrotor_gnss::synthetic::flight_result;
     use rins_navigator::attitude::quaternion_from_euler;
 
     /// A flight whose fused solution is the reference turned by the mounting `tilt`, at 1 Hz,
@@ -111,37 +110,7 @@ mod tests {
             let vehicle = quaternion_from_euler(roll, pitch, yaw);
             paired.push(k as f64, vehicle * m_inv, roll, pitch);
         }
-        let run = RunScores {
-            imu: None,
-            roll_pitch_rmse_deg: f64::NAN,
-            heading_rmse_deg: f64::NAN,
-            horizontal_rmse_m: f64::NAN,
-            end_horizontal_error_m: f64::NAN,
-            fixes_applied: 0,
-            fixes_outliers: 0,
-            rejections: 0,
-            paired,
-            final_gyro_bias_rps: bias,
-        };
-        FlightResult {
-            name: String::new(),
-            duration_s: 60.0,
-            single: Vec::new(),
-            fused: run,
-            median_single_end_error_m: f64::NAN,
-            drift_setting: Choice {
-                candidate: 0,
-                drift_slack: 0.0,
-                drift_threshold: 0.0,
-            },
-            antenna: Antenna::default(),
-            fused_roll_pitch_rmse_mounted_deg: f64::NAN,
-            fused_roll_pitch_rmse_mounted_in_sample_deg: f64::NAN,
-            fused_window_rmse_deg: [None; 3],
-            scored: None,
-            live: None,
-            reference_check: Default::default(),
-        }
+        flight_result(paired, bias, f64::NAN)
     }
 
     #[test]

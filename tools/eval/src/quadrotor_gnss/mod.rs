@@ -29,6 +29,7 @@
 
 pub mod antenna;
 pub mod cross_validation;
+pub mod drag_heading;
 pub mod held_out_start;
 pub mod live;
 pub mod receiver;
@@ -54,7 +55,7 @@ use crate::quadrotor_ahrs::SETTLE_S;
 use crate::quadrotor_ahrs::mounting::{Paired, fit_mounting, roll_pitch_rmse_deg};
 use crate::quadrotor_ahrs::windows;
 use crate::quadrotor_nav::frames::{self, Motion};
-use crate::quadrotor_nav::metrics::{angle_error, mean, median, rms};
+use crate::quadrotor_nav::metrics::{angle_error, median, rms};
 use crate::quadrotor_nav::run::{Start, start_from_truth};
 use crate::quadrotor_nav::{require_data_dir, vehicle_from_reference};
 use held_out_start::FlightStarts;
@@ -201,6 +202,7 @@ pub fn evaluate_trial(
         fused,
         median_single_end_error_m,
         drift_setting,
+        drag_heading: config.tilt.drag_heading,
         antenna,
         fused_roll_pitch_rmse_mounted_deg,
         fused_window_rmse_deg,
@@ -251,7 +253,8 @@ pub fn evaluate(
     let entries = list_trials(dir)
         .with_context(|| format!("eval quadrotor: cannot list trials in {}", dir.display()))?;
     let n = cross_validation::CANDIDATES.len();
-    let total: usize = entries.iter().map(|e| (e.imus.len() + 1) * (n + 2)).sum();
+    let passes = n + drag_heading::settings(&config.tilt).len() + 1;
+    let total: usize = entries.iter().map(|e| (e.imus.len() + 1) * passes).sum();
     let mut done = 0;
     let mut loaded = Vec::new();
     let mut skipped = Vec::new();
@@ -329,41 +332,70 @@ pub fn evaluate(
         usable.iter().map(|t| antenna_equations(t)).collect();
     let antennas = antenna::held_out(&equations);
     let antenna_in_sample = antenna::in_sample(&equations);
-    // First pass: every run from the airframe's attitude, no bias known.
-    let mut first = Vec::with_capacity(usable.len());
-    let mut scored = Vec::with_capacity(usable.len());
-    for ((trial, choice), antenna) in usable.into_iter().zip(chosen).zip(antennas) {
+    // First pass, under each drag-heading setting: every run from the airframe's attitude, no
+    // bias known.
+    let settings = drag_heading::settings(&config.tilt);
+    let with_heading = |drag_heading: bool| {
+        let mut c = *config;
+        c.tilt.drag_heading = drag_heading;
+        c
+    };
+    let mut first: Vec<Vec<FlightResult>> = vec![Vec::with_capacity(usable.len()); settings.len()];
+    let mut kept = Vec::with_capacity(usable.len());
+    'flights: for ((trial, choice), antenna) in usable.into_iter().zip(chosen).zip(antennas) {
+        let mut runs = Vec::with_capacity(settings.len());
+        for &setting in &settings {
+            let result = evaluate_trial(
+                trial,
+                &with_heading(setting),
+                mode,
+                choice,
+                antenna,
+                &FlightStarts::default(),
+                &mut || {
+                    done += 1;
+                    progress(done, total);
+                },
+            );
+            match result {
+                Ok(r) => runs.push(r),
+                Err(e) => {
+                    skipped.push(SkippedTrial {
+                        trial: trial.name.clone(),
+                        reason: format!("{e:#}"),
+                    });
+                    continue 'flights;
+                }
+            }
+        }
+        for (s, r) in runs.into_iter().enumerate() {
+            first[s].push(r);
+        }
+        kept.push((trial, choice, antenna));
+    }
+    // Second pass, scored: each flight with the drag-heading setting the others' first pass
+    // preferred, started with what the others' first pass under it learnt.
+    let heading_choice = drag_heading::choose(&first);
+    let starts: Vec<Vec<FlightStarts>> = first
+        .iter()
+        .map(|f| held_out_start::held_out_starts(f))
+        .collect();
+    let mut trials = Vec::with_capacity(kept.len());
+    for (f, (trial, choice, antenna)) in kept.into_iter().enumerate() {
+        let s = heading_choice[f];
+        let config = with_heading(settings[s]);
         let result = evaluate_trial(
             trial,
-            config,
+            &config,
             mode,
             choice,
             antenna,
-            &FlightStarts::default(),
+            &starts[s][f],
             &mut || {
                 done += 1;
                 progress(done, total);
             },
         );
-        match result {
-            Ok(r) => {
-                first.push(r);
-                scored.push((trial, choice, antenna));
-            }
-            Err(e) => skipped.push(SkippedTrial {
-                trial: trial.name.clone(),
-                reason: format!("{e:#}"),
-            }),
-        }
-    }
-    // Second pass, scored: each flight started with what the others' first pass learnt.
-    let starts = held_out_start::held_out_starts(&first);
-    let mut trials = Vec::with_capacity(scored.len());
-    for ((trial, choice, antenna), starts) in scored.into_iter().zip(&starts) {
-        let result = evaluate_trial(trial, config, mode, choice, antenna, starts, &mut || {
-            done += 1;
-            progress(done, total);
-        });
         match result {
             Ok(r) => trials.push(r),
             Err(e) => skipped.push(SkippedTrial {
@@ -383,7 +415,7 @@ pub fn evaluate(
                 reference_check::check(&run.truth, &run.motion, run.tilt_rad, &t.antenna);
         }
     }
-    let mut report = summarise(dir, mode, trials, skipped);
+    let mut report = results::summarise(dir, mode, trials, skipped);
     report.antenna_in_sample = antenna_in_sample;
     Ok(report)
 }
@@ -398,72 +430,4 @@ fn antenna_equations(trial: &Trial) -> antenna::NormalEquations {
         })
         .map(|motion| antenna::normal_equations(&trial.truth, &motion))
         .unwrap_or_default()
-}
-
-/// The mean of the finite values of `v`; NaN without any.
-fn finite_mean(v: impl Iterator<Item = f64>) -> f64 {
-    mean(&v.filter(|x| x.is_finite()).collect::<Vec<_>>())
-}
-
-fn summarise(
-    dir: &Path,
-    mode: GnssMode,
-    trials: Vec<FlightResult>,
-    skipped: Vec<SkippedTrial>,
-) -> GnssReport {
-    let of = |f: &dyn Fn(&FlightResult) -> f64| mean(&trials.iter().map(f).collect::<Vec<_>>());
-    let units = trials.iter().map(|t| t.single.len()).max().unwrap_or(0);
-    let single_outage_error_m = (0..units)
-        .map(|k| {
-            mean(
-                &trials
-                    .iter()
-                    .filter_map(|t| t.single.get(k).map(|s| s.end_horizontal_error_m))
-                    .collect::<Vec<_>>(),
-            )
-        })
-        .collect();
-    let roll_pitch = of(&|t| t.fused.roll_pitch_rmse_deg);
-    let outage = of(&|t| t.fused.end_horizontal_error_m);
-    let median_single = of(&|t| t.median_single_end_error_m);
-    let ratio = outage / median_single;
-    GnssReport {
-        dir: dir.to_path_buf(),
-        mode,
-        roll_pitch_rmse_deg: roll_pitch,
-        antenna_in_sample: None,
-        roll_pitch_rmse_mounted_deg: of(&|t| t.fused_roll_pitch_rmse_mounted_deg),
-        roll_pitch_rmse_mounted_in_sample_deg: of(&|t| {
-            t.fused_roll_pitch_rmse_mounted_in_sample_deg
-        }),
-        roll_pitch_target_met: roll_pitch <= ROLL_PITCH_TARGET_DEG,
-        reference_attitude_vs_gyro_deg: finite_mean(
-            trials
-                .iter()
-                .map(|t| t.reference_check.attitude_vs_gyro_deg),
-        ),
-        reference_position_vs_attitude_deg: finite_mean(
-            trials
-                .iter()
-                .map(|t| t.reference_check.position_vs_attitude_deg),
-        ),
-        window_starts_s: windows::WINDOW_STARTS_S,
-        fused_window_rmse_deg: windows::mean(trials.iter().map(|t| &t.fused_window_rmse_deg)),
-        heading_rmse_deg: of(&|t| t.fused.heading_rmse_deg),
-        horizontal_rmse_m: of(&|t| t.fused.horizontal_rmse_m),
-        gnss_rejections: trials
-            .iter()
-            .flat_map(|t| t.single.iter().chain(std::iter::once(&t.fused)))
-            .map(|r| r.rejections)
-            .sum(),
-        gnss_rejections_fused: trials.iter().map(|t| t.fused.rejections).sum(),
-        outage_error_m: outage,
-        single_outage_error_m,
-        median_single_outage_error_m: median_single,
-        outage_ratio: ratio,
-        outage_target_met: mode == GnssMode::Outage && ratio <= OUTAGE_RATIO_TARGET,
-        trials,
-        skipped,
-        live: None,
-    }
 }

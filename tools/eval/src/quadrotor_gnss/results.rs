@@ -1,15 +1,16 @@
 //! What the GNSS modes report: per run, per flight and over the data set.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
 use super::reference_check::ReferenceCheck;
-use super::{antenna, cross_validation, live};
+use super::{OUTAGE_RATIO_TARGET, ROLL_PITCH_TARGET_DEG, antenna, cross_validation, live};
 use crate::datasets::quadrotor::SkippedTrial;
 use crate::quadrotor_ahrs::live::{LiveFlight, LiveSummary};
 use crate::quadrotor_ahrs::mounting::Paired;
-use crate::quadrotor_ahrs::windows::WindowRmse;
+use crate::quadrotor_ahrs::windows::{self, WindowRmse};
+use crate::quadrotor_nav::metrics::mean;
 
 /// What the receiver does.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -64,6 +65,8 @@ pub struct FlightResult {
     pub median_single_end_error_m: f64,
     /// The drift test's setting, chosen on the other flights.
     pub drift_setting: cross_validation::Choice,
+    /// `[navigator.tilt] drag_heading`, chosen on the other flights ([`super::drag_heading`]).
+    pub drag_heading: bool,
     /// The antenna's lever arm and the position's lead, fitted on the other flights.
     pub antenna: antenna::Antenna,
     /// The fused roll/pitch RMSE with the units' mounting tilt fitted on the other flights, as
@@ -140,4 +143,72 @@ pub struct GnssReport {
     /// The same flights through the running processes (`--live`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub live: Option<LiveSummary>,
+}
+
+/// The mean of the finite values of `v`; NaN without any.
+fn finite_mean(v: impl Iterator<Item = f64>) -> f64 {
+    mean(&v.filter(|x| x.is_finite()).collect::<Vec<_>>())
+}
+
+pub(super) fn summarise(
+    dir: &Path,
+    mode: GnssMode,
+    trials: Vec<FlightResult>,
+    skipped: Vec<SkippedTrial>,
+) -> GnssReport {
+    let of = |f: &dyn Fn(&FlightResult) -> f64| mean(&trials.iter().map(f).collect::<Vec<_>>());
+    let units = trials.iter().map(|t| t.single.len()).max().unwrap_or(0);
+    let single_outage_error_m = (0..units)
+        .map(|k| {
+            mean(
+                &trials
+                    .iter()
+                    .filter_map(|t| t.single.get(k).map(|s| s.end_horizontal_error_m))
+                    .collect::<Vec<_>>(),
+            )
+        })
+        .collect();
+    let roll_pitch = of(&|t| t.fused.roll_pitch_rmse_deg);
+    let outage = of(&|t| t.fused.end_horizontal_error_m);
+    let median_single = of(&|t| t.median_single_end_error_m);
+    let ratio = outage / median_single;
+    GnssReport {
+        dir: dir.to_path_buf(),
+        mode,
+        roll_pitch_rmse_deg: roll_pitch,
+        antenna_in_sample: None,
+        roll_pitch_rmse_mounted_deg: of(&|t| t.fused_roll_pitch_rmse_mounted_deg),
+        roll_pitch_rmse_mounted_in_sample_deg: of(&|t| {
+            t.fused_roll_pitch_rmse_mounted_in_sample_deg
+        }),
+        roll_pitch_target_met: roll_pitch <= ROLL_PITCH_TARGET_DEG,
+        reference_attitude_vs_gyro_deg: finite_mean(
+            trials
+                .iter()
+                .map(|t| t.reference_check.attitude_vs_gyro_deg),
+        ),
+        reference_position_vs_attitude_deg: finite_mean(
+            trials
+                .iter()
+                .map(|t| t.reference_check.position_vs_attitude_deg),
+        ),
+        window_starts_s: windows::WINDOW_STARTS_S,
+        fused_window_rmse_deg: windows::mean(trials.iter().map(|t| &t.fused_window_rmse_deg)),
+        heading_rmse_deg: of(&|t| t.fused.heading_rmse_deg),
+        horizontal_rmse_m: of(&|t| t.fused.horizontal_rmse_m),
+        gnss_rejections: trials
+            .iter()
+            .flat_map(|t| t.single.iter().chain(std::iter::once(&t.fused)))
+            .map(|r| r.rejections)
+            .sum(),
+        gnss_rejections_fused: trials.iter().map(|t| t.fused.rejections).sum(),
+        outage_error_m: outage,
+        single_outage_error_m,
+        median_single_outage_error_m: median_single,
+        outage_ratio: ratio,
+        outage_target_met: mode == GnssMode::Outage && ratio <= OUTAGE_RATIO_TARGET,
+        trials,
+        skipped,
+        live: None,
+    }
 }

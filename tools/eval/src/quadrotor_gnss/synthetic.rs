@@ -3,9 +3,12 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::antenna::{GRAVITY_MPS2, attitude};
+use super::antenna::{Antenna, GRAVITY_MPS2, attitude};
+use super::cross_validation::Choice;
 use super::reference_check::rotation_vector;
+use super::{FlightResult, RunScores};
 use crate::datasets::quadrotor::TruthRow;
+use crate::quadrotor_ahrs::mounting::Paired;
 use crate::quadrotor_nav::frames::{BodySample, Motion};
 
 /// Roll, pitch and heading at `t`, rad.
@@ -83,4 +86,45 @@ pub fn flight(
             samples,
         },
     )
+}
+
+/// A flight's result with nothing in it but its fused run: the solution's `paired` rows, the gyro
+/// bias it ended with and its raw roll/pitch RMSE.
+pub fn flight_result(
+    paired: Paired,
+    final_gyro_bias_rps: [f64; 3],
+    roll_pitch_rmse_deg: f64,
+) -> FlightResult {
+    let run = RunScores {
+        imu: None,
+        roll_pitch_rmse_deg,
+        heading_rmse_deg: f64::NAN,
+        horizontal_rmse_m: f64::NAN,
+        end_horizontal_error_m: f64::NAN,
+        fixes_applied: 0,
+        fixes_outliers: 0,
+        rejections: 0,
+        paired,
+        final_gyro_bias_rps,
+    };
+    FlightResult {
+        name: String::new(),
+        duration_s: 60.0,
+        single: Vec::new(),
+        fused: run,
+        median_single_end_error_m: f64::NAN,
+        drift_setting: Choice {
+            candidate: 0,
+            drift_slack: 0.0,
+            drift_threshold: 0.0,
+        },
+        drag_heading: false,
+        antenna: Antenna::default(),
+        fused_roll_pitch_rmse_mounted_deg: f64::NAN,
+        fused_roll_pitch_rmse_mounted_in_sample_deg: f64::NAN,
+        fused_window_rmse_deg: [None; 3],
+        scored: None,
+        live: None,
+        reference_check: Default::default(),
+    }
 }
