@@ -5,7 +5,7 @@
 mod common;
 
 use common::{Fault, GYRO_SIGMA, Rig};
-use ipc_types::SensorType;
+use ipc_types::{ChannelState, SensorType};
 use rins_fusion::fdi::FdiConfig;
 
 /// The seed pyramid's gyros with exact (unquantised) values.
@@ -86,4 +86,82 @@ fn out_of_range_motion_settings_are_refused() {
             "{e}"
         );
     }
+}
+
+/// A rate of magnitude `rate` rad/s at step `k` whose direction sweeps the sphere.
+fn sweeping(rate: f64, k: usize) -> [f64; 3] {
+    let a = k as f64 * 0.003;
+    [
+        rate * 0.6 * a.cos(),
+        rate * 0.6 * a.sin(),
+        rate * 0.8 * (2.0 * a).cos(),
+    ]
+}
+
+/// Channel 0 reads 3 % high from the start. After the learning phase at rest, 20 s of gentle
+/// manoeuvring (0.4 rad/s: the error stays near the noise), then 2 s of a fast turn (5 rad/s).
+/// Returns the alarmed samples of the gentle part and of the turn.
+fn alarms_after_gentle_flight(config: &FdiConfig) -> (usize, usize) {
+    let mut rig = pyramid_gyros(config, 11);
+    rig.inject(0, Fault::Scale(0.03));
+    rig.learn([0.0; 3], false);
+    let mut alarms = |rig: &mut Rig, rate: f64, samples: usize| {
+        (0..samples)
+            .map(|k| rig.step(sweeping(rate, k), false).1)
+            .filter(|st| st.detected_not_isolated || st.test_statistic > st.threshold)
+            .count()
+    };
+    let gentle = alarms(&mut rig, 0.4, 20_000);
+    let turn = alarms(&mut rig, 5.0, 2_000);
+    (gentle, turn)
+}
+
+#[test]
+fn a_learnt_relative_scale_error_keeps_a_fast_turn_quiet() {
+    // 3 % of 5 rad/s on one channel is 0.15 rad/s, 27 σ; no motion noise is declared here.
+    let (gentle_plain, plain) = alarms_after_gentle_flight(&FdiConfig::default());
+    assert!(plain > 100, "{plain}");
+    let learnt = FdiConfig {
+        motion_offset: true,
+        ..FdiConfig::default()
+    };
+    // The gentle part exceeds while the slope is learnt (its first seconds), ten times less than
+    // without; the turn then raises nothing.
+    let (gentle, turn) = alarms_after_gentle_flight(&learnt);
+    assert!(
+        gentle * 10 < gentle_plain,
+        "{gentle} against {gentle_plain}"
+    );
+    assert_eq!(turn, 0);
+}
+
+#[test]
+fn the_motion_offset_still_detects_a_bias_at_once() {
+    let learnt = FdiConfig {
+        motion_offset: true,
+        ..FdiConfig::default()
+    };
+    let mut rig = pyramid_gyros(&learnt, 5);
+    // Learnt where the sweep starts: a step from rest to 1 rad/s would read as channel noise.
+    rig.learn(sweeping(1.0, 0), false);
+    for k in 0..5_000 {
+        let st = rig.step(sweeping(1.0, k), false).1;
+        assert!(!st.detected_not_isolated && !st.states.contains(&ChannelState::Excluded));
+    }
+    // Four channels detect a fault but cannot tell which (one parity dimension).
+    rig.inject(2, Fault::Bias(9.0 * GYRO_SIGMA));
+    let detected =
+        (5_000..5_010).any(|k| rig.step(sweeping(1.0, k), false).1.detected_not_isolated);
+    assert!(detected);
+}
+
+#[test]
+fn the_motion_offset_needs_the_parity_offset() {
+    let cfg = FdiConfig {
+        motion_offset: true,
+        parity_offset_window: 0,
+        ..FdiConfig::default()
+    };
+    let e = cfg.settings().expect_err("refused").to_string();
+    assert!(e.contains("motion_offset"), "{e}");
 }

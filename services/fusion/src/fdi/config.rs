@@ -55,6 +55,10 @@ pub struct FdiConfig {
     /// Averaging length of the parity offset estimate, samples (0: no offset estimate; see
     /// [`super::offset`]).
     pub parity_offset_window: u32,
+    /// Learn, with the parity offset, how the parity grows with the fused value — the channels'
+    /// relative scale factor and misalignment errors as the parity sees them — and take it out
+    /// before the test (see [`super::offset`]). Needs `parity_offset_window`.
+    pub motion_offset: bool,
     /// Averaging length of the mean-shift test, samples (0: off; see [`super::mean_shift`]):
     /// finds biases too small for the per-sample test, at the same false-alarm probability per
     /// window.
@@ -114,6 +118,7 @@ impl Default for FdiConfig {
             parity_noise: ParityNoise::Configured,
             adaptive_window: 10_000,
             parity_offset_window: 60_000,
+            motion_offset: false,
             mean_shift_window: 200,
             learning_samples: 1_000,
             saturation_samples: 5,
@@ -149,6 +154,8 @@ pub struct FdiSettings {
     pub adaptive_window: u32,
     /// 0: no offset estimate.
     pub parity_offset_window: u32,
+    /// See [`FdiConfig::motion_offset`].
+    pub motion_offset: bool,
     /// 0: no mean-shift test.
     pub mean_shift_window: u32,
     /// χ² threshold of the mean-shift test for each parity dimension (index m; entry 0 unused).
@@ -268,6 +275,12 @@ impl FdiConfig {
         at_least("adaptive_window", self.adaptive_window, 10)?;
         if self.parity_offset_window != 0 {
             at_least("parity_offset_window", self.parity_offset_window, 10)?;
+        } else if self.motion_offset {
+            return Err(ConfigError::new(
+                "motion_offset",
+                true,
+                "needs the parity offset (parity_offset_window > 0)",
+            ));
         }
         let learns = self.parity_offset_window != 0 || self.parity_noise == ParityNoise::Adaptive;
         at_least("saturation_samples", self.saturation_samples, 1)?;
@@ -347,6 +360,7 @@ impl FdiConfig {
             parity_noise: self.parity_noise,
             adaptive_window: self.adaptive_window,
             parity_offset_window: self.parity_offset_window,
+            motion_offset: self.motion_offset,
             mean_shift_window: self.mean_shift_window,
             mean_shift_thresholds,
             learning_samples: if learns { self.learning_samples } else { 0 },

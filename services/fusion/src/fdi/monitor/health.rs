@@ -87,7 +87,9 @@ impl SensorMonitor {
             .fold(0u32, |m, i| m | 1 << i);
         let candidates = self.active_mask() | (self.excluded_mask & input.valid & off_rail);
         let mut z = *input.z;
-        for (v, offset) in z.iter_mut().zip(&self.channel_offset).take(n) {
+        let none = [0.0; MAX_CHANNELS];
+        let channel_offset = self.offset.as_ref().map_or(&none, |o| o.channel_mean());
+        for (v, offset) in z.iter_mut().zip(channel_offset).take(n) {
             *v -= offset;
         }
         let retest = RetestInput {

@@ -148,9 +148,8 @@ pub struct SensorMonitor {
     last_x: [f64; 3],
     /// Channel variance the motion adds now (see [`FdiSettings::motion_noise_fraction`]).
     motion_variance: f64,
-    /// The learnt parity offset in channel terms, as of the last parity space that had one: it
-    /// outlives a loss of the parity space (fewer than four channels) and is carried into the next.
-    channel_offset: [f64; MAX_CHANNELS],
+    /// The solution before the test of this sample, where the offset is taken (with motion).
+    test_x: [f64; 3],
     /// Subtracted from the values before the solve (see [`solve_correction`]).
     correction: SolveCorrection,
     /// Re-test of the exclusions while the type has no solution.
@@ -176,8 +175,10 @@ impl SensorMonitor {
         status.states[..n].fill(ChannelState::Ok);
         let adaptive = (settings.parity_noise == ParityNoise::Adaptive)
             .then(|| AdaptiveParityNoise::new(settings.adaptive_window));
-        let offset = (settings.parity_offset_window > 0)
-            .then(|| ParityOffset::new(settings.parity_offset_window));
+        let offset = (settings.parity_offset_window > 0).then(|| match settings.motion_offset {
+            true => ParityOffset::with_motion(settings.parity_offset_window),
+            false => ParityOffset::new(settings.parity_offset_window),
+        });
         let health = ChannelHealth::new(geometry.axes(), &variances, settings.health);
         let mut monitor = Self {
             sensor,
@@ -209,7 +210,7 @@ impl SensorMonitor {
             status,
             last_x: [0.0; 3],
             motion_variance: 0.0,
-            channel_offset: [0.0; MAX_CHANNELS],
+            test_x: [0.0; 3],
             correction: SolveCorrection::new(settings.parity_offset_window),
             retest: ExclusionRetest::default(),
             probation: ProbationTest::new(
@@ -260,6 +261,7 @@ impl SensorMonitor {
             .map(|s| (s.mask(), s.solve(&corrected)));
         if let Some((_, (x, _))) = &before_test {
             self.motion_variance = motion_variance(&self.settings, x, &self.last_x);
+            self.test_x = *x;
         }
         let (t, candidates, learning) = self.parity_test(z, stationary);
 
@@ -401,15 +403,7 @@ impl SensorMonitor {
             p.set_noise_covariance(a.covariance());
         }
         if let Some(offset) = self.offset.as_mut() {
-            // Through channel terms, so that the offset also survives a spell without parity.
-            if let Some(old) = &old_parity {
-                self.channel_offset = old.to_channels(offset.mean());
-            }
-            let mut carried = [0.0; MAX_PARITY];
-            if let Some(new) = &self.parity {
-                new.parity(&self.channel_offset, &mut carried);
-            }
-            offset.set_mean(carried);
+            offset.carry_over(old_parity.as_ref(), self.parity.as_ref());
         }
         self.persistence.reset();
         self.window.clear();

@@ -42,7 +42,7 @@ impl SensorMonitor {
         space.parity(z, &mut p);
         let raw = p;
         if let Some(offset) = &self.offset {
-            for (v, m) in p.iter_mut().zip(offset.mean()).take(dim) {
+            for (v, m) in p.iter_mut().zip(offset.at(&self.test_x, dim)).take(dim) {
                 *v -= m;
             }
         }
@@ -74,7 +74,8 @@ impl SensorMonitor {
         // "offset" nor "noise".
         if learning || (self.persistence.count() == 0 && !shifted) {
             if let Some(offset) = self.offset.as_mut() {
-                offset.update(&raw, dim, offset_seen);
+                let noise = space.mean_noise_variance();
+                offset.update(&raw, &self.test_x, dim, offset_seen, noise);
             }
             self.correction.learn(space, z);
             let truncation = self.settings.truncation[dim];

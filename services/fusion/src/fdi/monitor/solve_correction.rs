@@ -66,7 +66,7 @@ impl SolveCorrection {
         let mut p = [0.0; MAX_PARITY];
         parity.parity(&corrected, &mut p);
         // The running-mean gain until the window is reached, then the window's.
-        mean.update(&p, parity.dimension(), Some(self.seen));
+        mean.update(&p, &[0.0; 3], parity.dimension(), Some(self.seen), 0.0);
         self.seen = self.seen.saturating_add(1);
     }
 
