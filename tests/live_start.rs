@@ -142,6 +142,7 @@ fn run_live(config: &str, raw: &[RawSample], tag: &str) -> (live::LiveOutput, St
         speed: None,
         private: Some(private),
         log: Some(dir.join("live.log")),
+        gnss: false,
     };
     let shutdown = Shutdown::install().expect("signal handlers");
     let out = live::run(raw, &options, &shutdown, &mut |_, _| {});

@@ -1,5 +1,5 @@
-//! Recording and deterministic replay end to end: a 20 s uav flight with a gyro killed at 8 s is
-//! recorded from the start (`rins up --record`); the raw topics of the file, fed through a fresh
+//! Recording and deterministic replay end to end: a 20 s uav flight with a receiver and a gyro
+//! killed at 8 s is recorded from the start (`rins up --gnss --record`); the raw topics of the file, fed through a fresh
 //! deployment as fast as it takes them, give the same navigation output bit for bit (both lanes,
 //! every sample, all but the stages' publish times), and so does the in-process replay; a recording
 //! whose navigator applied an aiding reading late (a burst after a stall) is said so, and its two
@@ -20,6 +20,7 @@ fn a_recorded_flight_replays_to_the_same_navigation_output() {
     let recording = Isolated::new("rec");
     let up = recording.run(&[
         "up",
+        "--gnss",
         "--duration",
         "20",
         "--json",
@@ -53,9 +54,16 @@ fn a_recorded_flight_replays_to_the_same_navigation_output() {
         names::ALTITUDE,
         names::TRUTH,
         names::HEALTH,
+        names::GNSS_LINK,
     ] {
         assert!(count(topic) > 0, "{topic}");
     }
+    // The receiver's fixes, 5 a second once it has one, which the replays publish again.
+    let fixes = count(names::GNSS);
+    assert!(
+        (60..=101).contains(&fixes),
+        "{fixes} receiver fixes in 20 s"
+    );
     let last_fused: FusedImu = rec
         .messages
         .iter()

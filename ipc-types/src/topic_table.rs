@@ -62,7 +62,7 @@ macro_rules! for_each_topic {
             }
             GnssFix (stamped) {
                 /// GNSS receiver epochs ([`crate::GnssFix`]), from the `gnss` service.
-                GNSS = "rins/gnss", echo "gnss";
+                GNSS = "rins/gnss", echo "gnss", record "gnss" at 17;
             }
             GnssLinkReport (unstamped) {
                 /// The `gnss` service's once-a-second line counters ([`crate::GnssLinkReport`]).

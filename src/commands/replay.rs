@@ -57,8 +57,14 @@ pub fn run(args: &ReplayArgs) -> Result<ExitCode> {
         (None, true) => None,
         (None, false) => Some(1.0),
     };
-    let cfg = config::load(args.config.as_deref())?;
+    let mut cfg = config::load(args.config.as_deref())?;
     let input = ReplayInput::read(&args.file)?;
+    // A recording with receiver fixes was made with the receiver on (`rins up --gnss`): the
+    // navigator aids with them here too.
+    let gnss = input.raw.iter().any(|s| matches!(s, RawSample::Gnss(_)));
+    if gnss {
+        cfg.enable_gnss();
+    }
     if input.raw.is_empty() {
         bail!(
             "{}: no raw sensor samples to replay (record with the raw topics: rins record FILE)",
@@ -83,7 +89,7 @@ pub fn run(args: &ReplayArgs) -> Result<ExitCode> {
     } else {
         (
             "live",
-            replay_live(args, &input, speed, cfg.deployment.navigator_lanes)?,
+            replay_live(args, &input, speed, cfg.deployment.navigator_lanes, gnss)?,
         )
     };
     let seconds = started.elapsed().as_secs_f64();
@@ -170,6 +176,7 @@ fn replay_live(
     input: &ReplayInput,
     speed: Option<f64>,
     lanes: u8,
+    gnss: bool,
 ) -> Result<[Vec<NavState>; 2]> {
     let shutdown = Shutdown::install()?;
     let options = LiveOptions {
@@ -179,6 +186,7 @@ fn replay_live(
         speed,
         private: None,
         log: None,
+        gnss,
     };
     let mut progress = Progress::new("replaying");
     let out = live::run(&input.raw, &options, &shutdown, &mut |done, total| {

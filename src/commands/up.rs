@@ -178,7 +178,9 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
             cfg.gnss.enabled,
         );
         for kind in kinds {
-            if args.external_source && kind == ServiceKind::Acquisition {
+            // An external source (a replay) publishes the raw topics and the receiver's fixes.
+            if args.external_source && matches!(kind, ServiceKind::Acquisition | ServiceKind::Gnss)
+            {
                 continue;
             }
             if shutdown.requested() {

@@ -47,6 +47,9 @@ pub struct LiveOptions {
     pub private: Option<IpcSettings>,
     /// Where the deployment's log goes (`None`: this process's standard error).
     pub log: Option<PathBuf>,
+    /// The navigator aids with the receiver fixes the feed publishes (`rins up --gnss`; no
+    /// receiver service is started).
+    pub gnss: bool,
 }
 
 /// What the deployment published while it was fed.
@@ -133,6 +136,9 @@ impl Deployment {
         cmd.args(["up", "--external-source", "--json"]);
         if let Some(config) = &options.config {
             cmd.arg("--config").arg(config);
+        }
+        if options.gnss {
+            cmd.arg("--gnss");
         }
         if let Some(s) = &options.private {
             cmd.env(ROOT_ENV, &s.root).env(PREFIX_ENV, &s.prefix);

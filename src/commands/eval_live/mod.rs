@@ -119,6 +119,7 @@ fn deploy(
         speed: None,
         log: Some(scratch.dir.join(format!("{name}.log"))),
         private: Some(live::private_settings("ev")?),
+        gnss: false,
     };
     live::run(raw, &options, shutdown, progress)
 }

@@ -96,6 +96,11 @@ impl<'a> AidingContext<'a> {
         self.records.is_stale(source, self.imu.time_us)
     }
 
+    /// Device time of the last accepted update from `source`, µs.
+    pub(crate) fn last_accepted_us(&self, source: AidingSource) -> Option<u64> {
+        self.records.last_accepted_us(source)
+    }
+
     /// A valid reading of `source` at `t_us`.
     pub(crate) fn note_reading(&mut self, source: AidingSource, t_us: u64) {
         self.records.note_reading(source, t_us);

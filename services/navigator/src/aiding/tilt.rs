@@ -44,6 +44,50 @@ impl TiltModel {
     }
 }
 
+/// When the drag model may also correct the heading (`[navigator.tilt] drag_heading`).
+///
+/// The drag ties the heading to the direction of the velocity through the air. Without a receiver
+/// the filter's horizontal velocity is what the drag itself made it, the velocity through the air,
+/// so the two agree whatever the (steady) wind, and the drag's heading information, through the
+/// accelerations the filter integrates, holds the heading. Once a receiver's fixes set the
+/// velocity over the ground, a wind of w at airspeed v turns that heading by up to w / v.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum DragHeading {
+    /// Never: the update's heading column is zeroed.
+    Never,
+    /// Always, receiver or not.
+    Always,
+    /// While no receiver update was accepted in the last [`GROUND_VELOCITY_HOLD_S`].
+    #[default]
+    WithoutGnss,
+}
+
+/// After a receiver update the filter's velocity stays the velocity over the ground for this
+/// long, s (a few of its fix intervals).
+pub const GROUND_VELOCITY_HOLD_S: f64 = 2.0;
+
+impl DragHeading {
+    /// Name as written in the configuration.
+    pub fn name(self) -> &'static str {
+        match self {
+            DragHeading::Never => "never",
+            DragHeading::Always => "always",
+            DragHeading::WithoutGnss => "without_gnss",
+        }
+    }
+
+    /// Whether the drag corrects the heading now; `ground_velocity`: the filter's velocity is
+    /// the receiver's, over the ground.
+    pub fn applies(self, ground_velocity: bool) -> bool {
+        match self {
+            DragHeading::Never => false,
+            DragHeading::Always => true,
+            DragHeading::WithoutGnss => !ground_velocity,
+        }
+    }
+}
+
 /// Settings of the tilt updates (`[navigator.tilt]`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -67,10 +111,8 @@ pub struct TiltAidingConfig {
     pub drag_per_s: f64,
     /// The same along body y, 1/s (an airframe is seldom as draggy sideways as forwards).
     pub lateral_drag_per_s: f64,
-    /// `drag` model: let the drag also correct the heading (the direction of the velocity through
-    /// the air). Off by default: the filter's velocity is over the ground, so wind biases that
-    /// heading (`ErrorStateEkf::rotor_drag`).
-    pub drag_heading: bool,
+    /// `drag` model: when the drag also corrects the heading (see [`DragHeading`]).
+    pub drag_heading: DragHeading,
     /// Innovation gate: largest accepted Mahalanobis distance.
     pub gate: f64,
     /// `gravity` model: the vehicle's acceleration is taken as the centripetal `ω × v` of its
@@ -91,7 +133,7 @@ impl Default for TiltAidingConfig {
             max_force_error_mps2: 2.0,
             drag_per_s: 0.6,
             lateral_drag_per_s: 0.6,
-            drag_heading: false,
+            drag_heading: DragHeading::WithoutGnss,
             gate: 5.0,
             centripetal_correction: false,
         }
@@ -198,15 +240,20 @@ impl TiltAiding {
         if !self.config.enabled {
             return;
         }
+        let hold_us = (GROUND_VELOCITY_HOLD_S * 1e6) as u64;
+        let ground_velocity = ctx
+            .last_accepted_us(AidingSource::Gnss)
+            .is_some_and(|last| t_us.saturating_sub(last) <= hold_us);
         let Some(ekf) = ctx.filter_mut() else {
             return;
         };
-        if let Some(result) = self.push(ekf, t_us, force_body, rate_body) {
+        if let Some(result) = self.push(ekf, t_us, force_body, rate_body, ground_velocity) {
             ctx.book_update(AidingSource::Gravity, t_us, result, 2);
         }
     }
 
-    /// One propagated sample at `t_us`: specific force as measured, rate bias-corrected. Returns
+    /// One propagated sample at `t_us`: specific force as measured, rate bias-corrected;
+    /// `ground_velocity`: a receiver has set the filter's velocity (see [`DragHeading`]). Returns
     /// the update made when a window closed (`None` while it is open or when it was not used).
     pub fn push(
         &mut self,
@@ -214,6 +261,7 @@ impl TiltAiding {
         t_us: u64,
         force_body: [f64; 3],
         rate_body: &Vector3<f64>,
+        ground_velocity: bool,
     ) -> Option<UpdateOutcome> {
         let config = &self.config;
         let mean =
@@ -242,7 +290,7 @@ impl TiltAiding {
                 mean.force.into(),
                 [config.drag_per_s, config.lateral_drag_per_s],
                 sigma,
-                config.drag_heading,
+                config.drag_heading.applies(ground_velocity),
                 config.gate,
             ),
         })
@@ -310,7 +358,7 @@ mod tests {
             let force = [0.0, 0.0, -g];
             assert!(ekf.predict([0.0; 3], force, 1.0 / RATE_HZ).is_applied());
             let t_us = k * 10_000;
-            if let Some(o) = aiding.push(&mut ekf, t_us, force, &Vector3::zeros()) {
+            if let Some(o) = aiding.push(&mut ekf, t_us, force, &Vector3::zeros(), false) {
                 assert!(o.is_accepted(), "{o:?}");
                 windows += 1;
             }
@@ -343,7 +391,7 @@ mod tests {
             let force = [0.0, 0.0, -g];
             assert!(ekf.predict(bias, force, 1.0 / RATE_HZ).is_applied());
             let rate = Vector3::from(bias) - ekf.bias().gyro_rps;
-            let _ = aiding.push(&mut ekf, k * 10_000, force, &rate);
+            let _ = aiding.push(&mut ekf, k * 10_000, force, &rate, false);
         }
         let learnt = ekf.bias().gyro_rps;
         for axis in 0..2 {
@@ -384,7 +432,7 @@ mod tests {
             };
             let mut aiding = TiltAiding::new(config);
             for k in 0..=10u64 {
-                let _ = aiding.push(&mut ekf, k * 10_000, force.into(), &rate);
+                let _ = aiding.push(&mut ekf, k * 10_000, force.into(), &rate, false);
             }
             (ekf.state().euler()[0], bank)
         };
@@ -420,7 +468,7 @@ mod tests {
         let mut aiding = TiltAiding::new(config);
         for k in 1..=(30.0 * RATE_HZ) as u64 {
             assert!(ekf.predict([0.0; 3], force, 1.0 / RATE_HZ).is_applied());
-            let _ = aiding.push(&mut ekf, k * 10_000, force, &Vector3::zeros());
+            let _ = aiding.push(&mut ekf, k * 10_000, force, &Vector3::zeros(), false);
         }
         let [_, estimated, _] = ekf.state().euler();
         assert!(
@@ -463,6 +511,22 @@ mod tests {
             turned.to_degrees()
         );
         assert!(kept.abs() < 1e-9, "{kept}");
+    }
+
+    #[test]
+    fn the_drag_heading_follows_the_receiver_only_when_asked_to() {
+        for (mode, without, with) in [
+            (DragHeading::Never, false, false),
+            (DragHeading::Always, true, true),
+            (DragHeading::WithoutGnss, true, false),
+        ] {
+            assert_eq!(mode.applies(false), without, "{}", mode.name());
+            assert_eq!(mode.applies(true), with, "{}", mode.name());
+        }
+        assert_eq!(
+            TiltAidingConfig::default().drag_heading,
+            DragHeading::WithoutGnss
+        );
     }
 
     #[test]

@@ -6,7 +6,7 @@
 //! sideways) and two σs, with and without σ growing with the rotation rate, with and without the
 //! drag's heading information (`drag_heading`). Every other setting is the profile's.
 
-use rins_navigator::aiding::tilt::{TiltAidingConfig, TiltModel};
+use rins_navigator::aiding::tilt::{DragHeading, TiltAidingConfig, TiltModel};
 use serde::Serialize;
 
 /// Windows further than this from g are not used by any candidate, m/s²: the quadrotor's
@@ -48,7 +48,8 @@ pub fn grid(base: &TiltAidingConfig) -> Vec<Candidate> {
             });
         }
     }
-    for drag_heading in [false, true] {
+    // Without a receiver `without_gnss` is `always`.
+    for drag_heading in [DragHeading::Never, DragHeading::Always] {
         for rate_gain in DRAG_RATE_GAINS_MPS {
             for forward in [0.3, 0.4, 0.6] {
                 for lateral in [0.4, 0.6] {
@@ -68,7 +69,7 @@ fn drag(
     lateral: f64,
     sigma: f64,
     rate_gain: f64,
-    drag_heading: bool,
+    drag_heading: DragHeading,
     base: &TiltAidingConfig,
 ) -> Candidate {
     let rate = if rate_gain > 0.0 {
@@ -76,7 +77,10 @@ fn drag(
     } else {
         String::new()
     };
-    let heading = if drag_heading { " heading" } else { "" };
+    let heading = match drag_heading {
+        DragHeading::Never => "",
+        _ => " heading",
+    };
     Candidate {
         name: format!("drag mu {forward}/{lateral} sigma {sigma}{rate}{heading}"),
         tilt: TiltAidingConfig {

@@ -29,7 +29,6 @@
 
 pub mod antenna;
 pub mod cross_validation;
-pub mod drag_heading;
 pub mod held_out_start;
 pub mod live;
 pub mod receiver;
@@ -39,6 +38,7 @@ pub mod results;
 pub mod run;
 #[cfg(test)]
 mod synthetic;
+pub mod tilt_choice;
 
 pub use results::{FlightResult, GnssMode, GnssReport, RunScores};
 
@@ -202,7 +202,7 @@ pub fn evaluate_trial(
         fused,
         median_single_end_error_m,
         drift_setting,
-        drag_heading: config.tilt.drag_heading,
+        tilt_setting: String::new(),
         antenna,
         fused_roll_pitch_rmse_mounted_deg,
         fused_window_rmse_deg,
@@ -253,7 +253,7 @@ pub fn evaluate(
     let entries = list_trials(dir)
         .with_context(|| format!("eval quadrotor: cannot list trials in {}", dir.display()))?;
     let n = cross_validation::CANDIDATES.len();
-    let passes = n + drag_heading::settings(&config.tilt).len() + 1;
+    let passes = n + tilt_choice::settings(&config.tilt).len() + 1;
     let total: usize = entries.iter().map(|e| (e.imus.len() + 1) * passes).sum();
     let mut done = 0;
     let mut loaded = Vec::new();
@@ -332,22 +332,21 @@ pub fn evaluate(
         usable.iter().map(|t| antenna_equations(t)).collect();
     let antennas = antenna::held_out(&equations);
     let antenna_in_sample = antenna::in_sample(&equations);
-    // First pass, under each drag-heading setting: every run from the airframe's attitude, no
-    // bias known.
-    let settings = drag_heading::settings(&config.tilt);
-    let with_heading = |drag_heading: bool| {
+    // First pass, under each tilt setting: every run from the airframe's attitude, no bias known.
+    let settings = tilt_choice::settings(&config.tilt);
+    let with_tilt = |setting: &tilt_choice::TiltSetting| {
         let mut c = *config;
-        c.tilt.drag_heading = drag_heading;
+        c.tilt = setting.tilt;
         c
     };
     let mut first: Vec<Vec<FlightResult>> = vec![Vec::with_capacity(usable.len()); settings.len()];
     let mut kept = Vec::with_capacity(usable.len());
     'flights: for ((trial, choice), antenna) in usable.into_iter().zip(chosen).zip(antennas) {
         let mut runs = Vec::with_capacity(settings.len());
-        for &setting in &settings {
+        for setting in &settings {
             let result = evaluate_trial(
                 trial,
-                &with_heading(setting),
+                &with_tilt(setting),
                 mode,
                 choice,
                 antenna,
@@ -373,17 +372,17 @@ pub fn evaluate(
         }
         kept.push((trial, choice, antenna));
     }
-    // Second pass, scored: each flight with the drag-heading setting the others' first pass
-    // preferred, started with what the others' first pass under it learnt.
-    let heading_choice = drag_heading::choose(&first);
+    // Second pass, scored: each flight with the tilt setting the others' first pass preferred,
+    // started with what the others' first pass under it learnt.
+    let tilt_choice = tilt_choice::choose(&first);
     let starts: Vec<Vec<FlightStarts>> = first
         .iter()
         .map(|f| held_out_start::held_out_starts(f))
         .collect();
     let mut trials = Vec::with_capacity(kept.len());
     for (f, (trial, choice, antenna)) in kept.into_iter().enumerate() {
-        let s = heading_choice[f];
-        let config = with_heading(settings[s]);
+        let s = tilt_choice[f];
+        let config = with_tilt(&settings[s]);
         let result = evaluate_trial(
             trial,
             &config,
@@ -397,7 +396,10 @@ pub fn evaluate(
             },
         );
         match result {
-            Ok(r) => trials.push(r),
+            Ok(r) => trials.push(FlightResult {
+                tilt_setting: settings[s].name.to_string(),
+                ..r
+            }),
             Err(e) => skipped.push(SkippedTrial {
                 trial: trial.name.clone(),
                 reason: format!("{e:#}"),

@@ -65,8 +65,8 @@ pub struct FlightResult {
     pub median_single_end_error_m: f64,
     /// The drift test's setting, chosen on the other flights.
     pub drift_setting: cross_validation::Choice,
-    /// `[navigator.tilt] drag_heading`, chosen on the other flights ([`super::drag_heading`]).
-    pub drag_heading: bool,
+    /// The tilt updates' setting, chosen on the other flights ([`super::tilt_choice`]).
+    pub tilt_setting: String,
     /// The antenna's lever arm and the position's lead, fitted on the other flights.
     pub antenna: antenna::Antenna,
     /// The fused roll/pitch RMSE with the units' mounting tilt fitted on the other flights, as

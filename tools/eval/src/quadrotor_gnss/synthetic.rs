@@ -118,7 +118,7 @@ pub fn flight_result(
             drift_slack: 0.0,
             drift_threshold: 0.0,
         },
-        drag_heading: false,
+        tilt_setting: String::new(),
         antenna: Antenna::default(),
         fused_roll_pitch_rmse_mounted_deg: f64::NAN,
         fused_roll_pitch_rmse_mounted_in_sample_deg: f64::NAN,

@@ -1,28 +1,73 @@
-//! The drag model's heading switch (`[navigator.tilt] drag_heading`) chosen leave-one-flight-out.
+//! The tilt updates' setting (`[navigator.tilt]`) chosen leave-one-flight-out, from a small set.
 //!
-//! Rotor drag ties the heading to the direction of the velocity through the air, and a
-//! GNSS-aided filter's velocity is over the ground: in wind, the two disagree by up to wind over
-//! airspeed. Whether the drag should still correct the heading is therefore a property of the
-//! flights, and it is learnt from them like every other setting: each flight gets the setting
-//! whose fused roll/pitch RMSE on the first pass (no gyro prior; each flight scored with the
-//! mounting fitted on the flights other than itself, as the report scores) is the smaller mean
-//! over the other flights.
+//! The profile's tilt settings were chosen for flight without position aiding. With the receiver,
+//! two things may change. Rotor drag ties the heading to the direction of the velocity through the
+//! air, and the receiver's velocity is over the ground: in wind the two disagree by up to wind
+//! over airspeed, which is why the profile's `drag_heading = "without_gnss"` drops that
+//! information while fixes come in; whether it is worth keeping anyway is tried. And the receiver now levels the filter too, so the tilt
+//! updates may be worth less (a larger σ) or nothing (off). Each flight gets the setting whose
+//! fused roll/pitch RMSE on the first pass (no gyro prior; each flight scored with the mounting
+//! fitted on the flights other than itself, as the report scores) is the smallest mean over the
+//! other flights; ties go to the earlier setting, the profile's own.
 
-use rins_navigator::aiding::tilt::{TiltAidingConfig, TiltModel};
+use rins_navigator::aiding::tilt::{DragHeading, TiltAidingConfig, TiltModel};
 
 use super::FlightResult;
 use crate::leave_one_out::choose_without_each;
 use crate::quadrotor_ahrs::SETTLE_S;
 use crate::quadrotor_ahrs::mounting::{Paired, fit_mounting, roll_pitch_rmse_deg};
 
-/// The settings tried: the profile's own only when its tilt updates do not use the drag model,
-/// where the switch does nothing.
-pub fn settings(tilt: &TiltAidingConfig) -> Vec<bool> {
-    if tilt.enabled && tilt.model == TiltModel::Drag {
-        vec![false, true]
-    } else {
-        vec![tilt.drag_heading]
+/// σ of the "looser" setting, m/s²: three times the profile's 1 m/s².
+pub const LOOSE_SIGMA_MPS2: f64 = 3.0;
+
+/// One candidate setting of the tilt updates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TiltSetting {
+    /// Short name for the report.
+    pub name: &'static str,
+    /// The settings.
+    pub tilt: TiltAidingConfig,
+}
+
+/// The settings tried, the profile's own first: with the drag's heading information always (or,
+/// where the profile has that, never; drag model only), with σ [`LOOSE_SIGMA_MPS2`], and off (only
+/// where the profile has them on).
+pub fn settings(tilt: &TiltAidingConfig) -> Vec<TiltSetting> {
+    let mut out = vec![TiltSetting {
+        name: "profile",
+        tilt: *tilt,
+    }];
+    if !tilt.enabled {
+        return out;
     }
+    if tilt.model == TiltModel::Drag {
+        let (name, drag_heading) = match tilt.drag_heading {
+            DragHeading::Always => ("drag heading never", DragHeading::Never),
+            _ => ("drag heading always", DragHeading::Always),
+        };
+        out.push(TiltSetting {
+            name,
+            tilt: TiltAidingConfig {
+                drag_heading,
+                ..*tilt
+            },
+        });
+    }
+    out.push(TiltSetting {
+        name: "sigma 3",
+        tilt: TiltAidingConfig {
+            sigma_mps2: LOOSE_SIGMA_MPS2,
+            ..*tilt
+        },
+    });
+    out.push(TiltSetting {
+        name: "off",
+        tilt: TiltAidingConfig {
+            enabled: false,
+            ..*tilt
+        },
+    });
+    out
 }
 
 /// `first_pass[s][f]`: flight `f`'s first pass under setting `s` (every row as long as the first).
@@ -64,19 +109,25 @@ mod tests {
     use rins_navigator::attitude::quaternion_from_euler;
 
     #[test]
-    fn the_switch_is_tried_only_where_the_drag_model_runs() {
+    fn the_profile_comes_first_and_the_heading_switch_only_with_the_drag_model() {
         let mut tilt = TiltAidingConfig {
             enabled: true,
             model: TiltModel::Drag,
             ..TiltAidingConfig::default()
         };
-        assert_eq!(settings(&tilt), vec![false, true]);
+        let names = |t: &TiltAidingConfig| settings(t).iter().map(|s| s.name).collect::<Vec<_>>();
+        assert_eq!(
+            names(&tilt),
+            ["profile", "drag heading always", "sigma 3", "off"]
+        );
+        let s = settings(&tilt);
+        assert_eq!(s[0].tilt, tilt);
+        assert!(s[1].tilt.drag_heading == DragHeading::Always && !s[3].tilt.enabled);
+        assert_eq!(s[2].tilt.sigma_mps2, LOOSE_SIGMA_MPS2);
         tilt.model = TiltModel::Gravity;
-        tilt.drag_heading = true;
-        assert_eq!(settings(&tilt), vec![true]);
-        tilt.model = TiltModel::Drag;
+        assert_eq!(names(&tilt), ["profile", "sigma 3", "off"]);
         tilt.enabled = false;
-        assert_eq!(settings(&tilt), vec![true]);
+        assert_eq!(names(&tilt), ["profile"]);
     }
 
     /// A flight whose fused roll is off by ±`error_deg`, alternating row by row (no mounting
