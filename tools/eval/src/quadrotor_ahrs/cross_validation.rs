@@ -8,8 +8,8 @@ use super::candidates::Candidate;
 use super::live::ScoredRun;
 use super::mounting::{Paired, fit_mounting, mounting_rotation, roll_pitch_rmse_deg};
 use super::run::{AttitudeTrace, GyroPrior, navigate_ahrs};
-use super::windows;
 use super::{CandidateFigure, Flight, FlightResult, SETTLE_S, pair, with_candidate};
+use super::{honesty, windows};
 use crate::datasets::quadrotor::MAX_IMUS;
 use crate::quadrotor_nav::frames::Motion;
 use crate::quadrotor_nav::metrics::mean;
@@ -316,6 +316,12 @@ pub(crate) fn run(
                 repairs: flight.repairs,
                 notes: flight.notes.clone(),
                 fused_window_rmse_deg: windows::of(&fused, tilt),
+                fused_error_over_sigma: honesty::error_over_sigma(
+                    &fused,
+                    tilt,
+                    &scored.trace,
+                    flight.start.t_s,
+                ),
                 peer_window_rmse_deg: peer_windows,
                 peer_average: Default::default(),
                 madgwick: Default::default(),

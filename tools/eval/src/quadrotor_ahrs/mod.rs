@@ -28,6 +28,7 @@
 
 pub mod candidates;
 pub mod cross_validation;
+pub mod honesty;
 pub mod live;
 pub mod mounting;
 pub mod peer_average;
@@ -69,8 +70,8 @@ pub const INITIAL_GYRO_BIAS_SIGMA_DPS: f64 = 0.5;
 /// Rows of the first seconds of a run are left out of mounting fits and of the choice of the
 /// candidate: a run started from the airframe's attitude needs them to find the unit's, s.
 pub const SETTLE_S: f64 = 5.0;
-/// The fused roll/pitch RMSE the mode is held to, degrees.
-pub const ROLL_PITCH_TARGET_DEG: f64 = 0.6;
+/// The fused roll/pitch RMSE the mode is held to on these flights, degrees.
+pub const ROLL_PITCH_TARGET_DEG: f64 = 0.5;
 
 /// A flight ready to run.
 pub(crate) struct Flight {
@@ -120,6 +121,9 @@ pub struct FlightResult {
     /// The fused RMSE over the windows of time since the start
     /// ([`windows::WINDOW_STARTS_S`]), degrees.
     pub fused_window_rmse_deg: WindowRmse,
+    /// The fused run's tilt error over its own σ, RMS over the first seconds and the rest
+    /// ([`honesty::WINDOWS_S`]): 1 where the σ is right.
+    pub fused_error_over_sigma: honesty::ErrorOverSigma,
     /// Each unit's own filter over the same windows, by unit number (null when absent).
     pub peer_window_rmse_deg: [Option<WindowRmse>; MAX_IMUS],
     /// The normalised average of the units' own filters, scored the same way.
@@ -174,6 +178,8 @@ pub struct AhrsReport {
     pub roll_pitch_target_met: bool,
     /// Every candidate's in-sample figure and how often it was chosen.
     pub candidates: Vec<CandidateFigure>,
+    /// Mean over flights of [`FlightResult::fused_error_over_sigma`].
+    pub fused_error_over_sigma: honesty::ErrorOverSigma,
     /// The reference filters and the average of the units' own filters, scored the same way,
     /// and the windows of time since the start.
     #[serde(flatten)]
@@ -227,6 +233,7 @@ fn prepare(trial: Trial) -> Result<Flight> {
                 .iter()
                 .map(|s| quaternion_from_euler(s.euler_rad[0], s.euler_rad[1], s.euler_rad[2]))
                 .collect::<Vec<UnitQuaternion<f64>>>(),
+            tilt_sigma_rad: Vec::new(),
         })
         .collect();
     let peers = traces

@@ -65,6 +65,13 @@ fn errors(p: &Paired, k: usize, m: &UnitQuaternion<f64>) -> [f64; 2] {
     ]
 }
 
+/// The tilt error of row `k` with mounting tilt `tilt_rad`: roll and pitch errors together,
+/// `sqrt(e_roll² + e_pitch²)`, rad.
+pub fn tilt_error_rad(p: &Paired, k: usize, tilt_rad: [f64; 2]) -> f64 {
+    let [r, q] = errors(p, k, &mounting_rotation(tilt_rad));
+    r.hypot(q)
+}
+
 /// Root mean square of the roll and pitch errors pooled, `sqrt(mean((e_roll² + e_pitch²) / 2))`,
 /// degrees, with mounting tilt `tilt_rad`, over the rows at least `from_s` after the run's start;
 /// NaN without such rows.

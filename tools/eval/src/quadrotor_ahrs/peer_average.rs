@@ -108,6 +108,7 @@ mod tests {
         let trace = |from: f64, angle: f64| AttitudeTrace {
             t_s: vec![from, 10.0],
             attitude: vec![about_x(angle), about_x(angle)],
+            tilt_sigma_rad: Vec::new(),
         };
         let traces = [trace(0.0, 0.1), trace(2.0, 0.3)];
         let rows = [(1.0, 0.0, 0.0), (3.0, 0.0, 0.0), (11.0, 0.0, 0.0)];

@@ -53,6 +53,9 @@ pub fn summarise(
         roll_pitch_target_deg: ROLL_PITCH_TARGET_DEG,
         roll_pitch_target_met: fused <= ROLL_PITCH_TARGET_DEG,
         candidates,
+        fused_error_over_sigma: super::windows::mean(
+            flights.iter().map(|f| &f.fused_error_over_sigma),
+        ),
         references: super::reference_report::ReferenceSummary::default(),
         flights,
         live: None,
@@ -131,6 +134,12 @@ pub fn to_table(r: &AhrsReport) -> String {
             c.name, c.in_sample_roll_pitch_rmse_deg, c.chosen
         );
     }
+    let [first, rest] = r.fused_error_over_sigma.map(cell);
+    let _ = writeln!(
+        s,
+        "fused tilt error over the filter's own σ, RMS over flights (1: the σ is right): first {} s {first}, after {rest}",
+        super::SETTLE_S
+    );
     super::reference_report::lines(&mut s, r);
     let p = &r.repairs;
     let _ = writeln!(

@@ -9,6 +9,7 @@
 
 use nalgebra::UnitQuaternion;
 use rins_navigator::attitude::{euler_from_quaternion, quaternion_from_euler};
+use rins_navigator::ekf::ATT;
 use rins_navigator::inertial_core::{AidedConfig, AidedNavigator};
 use rins_navigator::start::InFlightStart;
 
@@ -22,9 +23,19 @@ pub struct AttitudeTrace {
     pub t_s: Vec<f64>,
     /// Body → NED attitude at each time.
     pub attitude: Vec<UnitQuaternion<f64>>,
+    /// The filter's σ of its tilt (the horizontal attitude error, both axes together) at each
+    /// time, rad; empty where the source gives none (the units' own filters, a live run).
+    pub tilt_sigma_rad: Vec<f64>,
 }
 
 impl AttitudeTrace {
+    /// The filter's tilt σ at `t_s`: that of the last entry at or before it, rad; `None` outside
+    /// the trace or without σ.
+    pub fn tilt_sigma_at(&self, t_s: f64) -> Option<f64> {
+        let i = self.t_s.partition_point(|&t| t <= t_s).checked_sub(1)?;
+        self.tilt_sigma_rad.get(i).copied()
+    }
+
     /// The attitude at `t_s` (spherical interpolation between the neighbouring samples); `None`
     /// outside the trace.
     pub fn at(&self, t_s: f64) -> Option<UnitQuaternion<f64>> {
@@ -132,6 +143,9 @@ pub fn navigate_ahrs(
     let mut trace = AttitudeTrace::default();
     trace.t_s.push(start.t_s);
     trace.attitude.push(s.state.attitude);
+    trace
+        .tilt_sigma_rad
+        .push((s.variances[ATT] + s.variances[ATT + 1]).sqrt());
     let first = first_sample_after(motion, start.t_s);
     for (j, sample) in motion.samples.iter().enumerate().skip(first) {
         let t_s = motion.time(j);
@@ -142,6 +156,9 @@ pub fn navigate_ahrs(
         if let Some(ekf) = navigator.ekf() {
             trace.t_s.push(t_s);
             trace.attitude.push(ekf.state().attitude);
+            trace
+                .tilt_sigma_rad
+                .push(ekf.sigma(ATT).hypot(ekf.sigma(ATT + 1)));
         }
     }
     AhrsRun {

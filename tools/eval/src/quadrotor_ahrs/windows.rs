@@ -27,9 +27,11 @@ pub fn of(p: &Paired, tilt_rad: [f64; 2]) -> WindowRmse {
 }
 
 /// Per window, the mean over the flights that have rows in it.
-pub fn mean<'a>(flights: impl IntoIterator<Item = &'a WindowRmse>) -> WindowRmse {
-    let mut sum = [0.0; 3];
-    let mut n = [0usize; 3];
+pub fn mean<'a, const N: usize>(
+    flights: impl IntoIterator<Item = &'a [Option<f64>; N]>,
+) -> [Option<f64>; N] {
+    let mut sum = [0.0; N];
+    let mut n = [0usize; N];
     for f in flights {
         for (w, v) in f.iter().enumerate() {
             if let Some(v) = v {
