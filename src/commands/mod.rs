@@ -18,6 +18,7 @@ mod plot;
 mod probe;
 mod probe_gnss;
 mod probe_gnss_report;
+mod probe_rates;
 mod progress;
 mod readmit;
 mod record;

@@ -77,7 +77,7 @@ fn scan(port: &str, seconds: f64, json_out: bool) -> Result<()> {
     }
     let outcome = scan_outcome(&results);
     if json_out {
-        let rates = rates_json(&results, report_json);
+        let rates = super::probe_rates::rates_json(&results, report_json);
         let skipped: Vec<Value> = skipped
             .iter()
             .map(|(baud, why)| json!({ "baud": baud, "error": why }))
@@ -117,19 +117,6 @@ fn scan(port: &str, seconds: f64, json_out: bool) -> Result<()> {
 }
 
 /// The report's counters as JSON, names rather than codes.
-/// Each rate's report as JSON (`report`), with its `baud`: what `rins probe --scan` prints per
-/// rate, for the sensor block and the GNSS receiver alike.
-pub(super) fn rates_json<R>(results: &[(u32, R)], report: impl Fn(&R) -> Value) -> Vec<Value> {
-    results
-        .iter()
-        .map(|(baud, r)| {
-            let mut v = report(r);
-            v["baud"] = json!(baud);
-            v
-        })
-        .collect()
-}
-
 fn report_json(r: &LineReport) -> Value {
     let mut frames = serde_json::Map::new();
     for t in &r.types {

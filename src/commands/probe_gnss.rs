@@ -14,10 +14,10 @@ use rins_serial_reader::port;
 use serde_json::{Value, json};
 use serialport::{ClearBuffer, SerialPort};
 
-use super::probe::rates_json;
 use super::probe_gnss_report::{
     EpochTally, GnssLineReport, best_rate, counters, receiver_time_text, scan_verdict,
 };
+use super::probe_rates::rates_json;
 
 /// The rates receivers are set to, tried in this order: NMEA 0183's own 4800, then those every
 /// UART driver offers.
