@@ -105,7 +105,7 @@ fn alarms_after_gentle_flight(config: &FdiConfig) -> (usize, usize) {
     let mut rig = pyramid_gyros(config, 11);
     rig.inject(0, Fault::Scale(0.03));
     rig.learn([0.0; 3], false);
-    let mut alarms = |rig: &mut Rig, rate: f64, samples: usize| {
+    let alarms = |rig: &mut Rig, rate: f64, samples: usize| {
         (0..samples)
             .map(|k| rig.step(sweeping(rate, k), false).1)
             .filter(|st| st.detected_not_isolated || st.test_statistic > st.threshold)
