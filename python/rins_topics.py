@@ -238,7 +238,7 @@ def subscribe_nav(node, timeout_s: float = 0.0, config: "SelectorConfig | None" 
 # --- generated from the Rust layouts: do not edit ---
 
 #: Layout version every payload carries in `version`.
-PAYLOAD_VERSION = 9
+PAYLOAD_VERSION = 10
 
 # Topic names.
 RAW_IMU = "rins/raw/imu"
@@ -387,6 +387,7 @@ class ServiceKind(enum.IntEnum):
     NAVIGATOR_STANDBY = 6
     MAVLINK = 7
     GNSS = 8
+    BRIDGE = 9
 
 
 class ServiceState(enum.IntEnum):
@@ -483,6 +484,7 @@ WIRE_NAMES = {
         6: "navigator-standby",
         7: "mavlink",
         8: "gnss",
+        9: "bridge",
     },
     ServiceState: {
         0: "starting",
@@ -947,7 +949,7 @@ class NavReport(ctypes.Structure):
 
 
 class HealthReport(ctypes.Structure):
-    """`rins::HealthReport`: 624 bytes, aligned to 8."""
+    """`rins::HealthReport`: 672 bytes, aligned to 8."""
 
     _fields_ = [
         ("version", ctypes.c_uint16),
@@ -955,7 +957,7 @@ class HealthReport(ctypes.Structure):
         ("_pad", ctypes.c_uint8 * 5),
         ("now_ns", ctypes.c_uint64),
         ("uptime_ms", ctypes.c_uint64),
-        ("services", ServiceHealth * 8),
+        ("services", ServiceHealth * 10),
         ("link", LinkReport),
         ("redundancy", RedundancyReport),
         ("nav", NavReport),

@@ -7,6 +7,8 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 mod capture_args;
 mod data_args;
 mod eval_args;
+mod remote_args;
+mod up_args;
 
 pub use capture_args::{
     BenchCommand, BenchIpcArgs, BenchRatesArgs, LatencyArgs, RecordArgs, ReplayArgs,
@@ -19,6 +21,8 @@ pub use eval_args::{
     EvalCommand, EvalFdiArgs, EvalGnssCapturesArgs, EvalProfileArgs, EvalPyshoeArgs,
     EvalQuadrotorArgs, EvalXioArgs, FootMethodArg, QuadrotorMode, SweepArgs,
 };
+pub use remote_args::RemoteArgs;
+pub use up_args::{FaultArgs, UpArgs};
 
 /// The `rins echo` topic help: every short name it accepts, in the topic table's order.
 fn echo_topics_help() -> String {
@@ -93,6 +97,9 @@ pub enum Command {
         /// Fail when no report arrives within this many seconds.
         #[arg(long, allow_negative_numbers = true, default_value_t = 2.0)]
         timeout: f64,
+        /// A deployment on another host instead of this one.
+        #[command(flatten)]
+        remote: RemoteArgs,
     },
     /// Listen to a serial device and say what is on the line: bytes, frame types and their rates,
     /// CRC failures, malformed frames, discarded bytes, the last decode error and a verdict.
@@ -119,6 +126,9 @@ pub enum Command {
         /// Fail when no sample arrives for this many seconds (0: wait for ever).
         #[arg(long, allow_negative_numbers = true, default_value_t = 10.0)]
         timeout: f64,
+        /// A deployment on another host instead of this one.
+        #[command(flatten)]
+        remote: RemoteArgs,
     },
     /// Inject a fault into one channel of the running simulator ("kill a sensor").
     Inject(InjectArgs),
@@ -245,6 +255,8 @@ pub enum ServiceName {
     Mavlink,
     /// GNSS receiver acquisition (`[gnss]`): publishes one fix per receiver epoch.
     Gnss,
+    /// The Zenoh bridge (`[zenoh]`): the navigation, fused IMU and health as ROS 2 topics.
+    Bridge,
 }
 
 impl ServiceName {
@@ -258,6 +270,7 @@ impl ServiceName {
             ServiceName::NavigatorStandby => ipc_types::ServiceKind::NavigatorStandby,
             ServiceName::Mavlink => ipc_types::ServiceKind::Mavlink,
             ServiceName::Gnss => ipc_types::ServiceKind::Gnss,
+            ServiceName::Bridge => ipc_types::ServiceKind::Bridge,
         }
     }
 }
@@ -288,79 +301,6 @@ impl From<ScenarioArg> for rins_sim::Scenario {
             ScenarioArg::Calibrate => Self::Calibrate,
             ScenarioArg::Multirotor => Self::Multirotor,
         }
-    }
-}
-
-/// Options of `rins up`.
-#[derive(Debug, Args)]
-pub struct UpArgs {
-    /// Simulator scenario (overrides sim.scenario).
-    #[arg(long)]
-    pub scenario: Option<ScenarioArg>,
-    /// Stop after this many seconds and exit 0; non-zero when no valid frame arrived in all that
-    /// time (the message names the port and what the line carried).
-    #[arg(long, allow_negative_numbers = true)]
-    pub duration: Option<f64>,
-    /// Print the run's summary as one JSON object, the only thing on stdout (the status lines go
-    /// to stderr). Without it, a run with --duration ends with the summary as text.
-    #[arg(long)]
-    pub json: bool,
-    /// Configuration file (default: the built-in configuration).
-    #[arg(long)]
-    pub config: Option<PathBuf>,
-    /// Read a real sensor block on this serial device instead of starting the simulator.
-    #[arg(long)]
-    pub port: Option<PathBuf>,
-    /// Simulator random seed (overrides sim.seed).
-    #[arg(long)]
-    pub seed: Option<u64>,
-    /// Stream MAVLink 2 to this endpoint (`udpout:HOST:PORT`, `udpin:ADDR:PORT` or
-    /// `serial:PATH:BAUD`), enabling the MAVLink output whatever the configuration says.
-    #[arg(long, value_name = "ENDPOINT")]
-    pub mavlink: Option<String>,
-    /// A GNSS receiver is fitted: runs the gnss service (on the simulated receiver unless
-    /// `[gnss] port` names one) and turns on the navigator's GNSS updates.
-    #[arg(long)]
-    pub gnss: bool,
-    /// IMU sample rate of the simulated block and every stage, Hz (overrides
-    /// device.imu_rate_hz).
-    #[arg(long, value_name = "HZ")]
-    pub imu_rate: Option<f64>,
-    /// Every service asks for its `[realtime]` settings (SCHED_FIFO priority, CPU affinity,
-    /// locked memory; as `realtime.enabled = true`); what the system refuses is logged and the
-    /// service runs on without it.
-    #[arg(long)]
-    pub realtime: bool,
-    /// Record every topic into this MCAP file from the start (replaced if it exists), as
-    /// `rins record` does.
-    #[arg(long, value_name = "FILE")]
-    pub record: Option<PathBuf>,
-    /// Start neither acquisition nor the simulator: another process publishes the raw topics
-    /// (`rins replay`).
-    #[arg(long, hide = true)]
-    pub external_source: bool,
-    /// Faults for the simulator to apply.
-    #[command(flatten)]
-    pub faults: FaultArgs,
-}
-
-/// Faults the simulator applies at given device times.
-#[derive(Debug, Args, Default)]
-pub struct FaultArgs {
-    /// Apply a fault at a device time (s since the simulator started): CHANNEL:KIND[=PARAM]@TIME,
-    /// e.g. gyro2:dead@5s, accel1:bias=0.5@3.2s, gyro0:noise=10@2s; or unplug the serial device
-    /// for SECONDS: disconnect=SECONDS@TIME, e.g. disconnect=1.5@5s. Repeatable.
-    #[arg(long = "inject", value_name = "SPEC")]
-    pub inject: Vec<String>,
-    /// Scenario file of timed faults: [[fault]] tables with channel, kind, at_s and optional param.
-    #[arg(long, value_name = "FILE")]
-    pub faults: Option<PathBuf>,
-}
-
-impl FaultArgs {
-    /// Whether no fault was asked for.
-    pub fn is_empty(&self) -> bool {
-        self.inject.is_empty() && self.faults.is_none()
     }
 }
 

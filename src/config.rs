@@ -6,6 +6,7 @@ use std::path::Path;
 use anyhow::{Result, anyhow, bail};
 use rins_acquisition::config::AcquisitionConfig;
 use rins_altimeter::AltimeterConfig;
+use rins_bridge::config::ZenohConfig;
 use rins_fusion::FusionConfig;
 use rins_gnss::config::GnssConfig;
 use rins_mavlink::config::MavlinkConfig;
@@ -194,6 +195,8 @@ pub struct RinsConfig {
     pub mavlink: MavlinkConfig,
     /// `[gnss]`: the GNSS receiver's serial line.
     pub gnss: GnssConfig,
+    /// `[zenoh]`: the ROS 2 topics over Zenoh, beyond the host.
+    pub zenoh: ZenohConfig,
     /// `[realtime]`: scheduling, affinity and memory locking of each service.
     pub realtime: crate::realtime_config::RealtimeConfig,
     /// `[wait]`: how the stages wait for their input.
@@ -261,6 +264,7 @@ impl RinsConfig {
         self.watchdog.validate()?;
         self.deployment.validate()?;
         self.mavlink.validate()?;
+        self.zenoh.validate()?;
         self.realtime.validate()?;
         self.wait.validate()?;
         self.record.validate()?;

@@ -8,7 +8,7 @@ use rins_runtime::realtime::{MAX_CPU, RealtimePlan};
 use serde::{Deserialize, Serialize};
 
 /// The services `[realtime.priority]` and `[realtime.cpus]` may name.
-pub const SERVICES: [&str; 7] = [
+pub const SERVICES: [&str; 8] = [
     "acquisition",
     "fusion",
     "altimeter",
@@ -16,6 +16,7 @@ pub const SERVICES: [&str; 7] = [
     "navigator-standby",
     "gnss",
     "mavlink",
+    "bridge",
 ];
 
 /// Largest pre-faulted stack, KiB: well inside the main thread's 8 MiB.

@@ -27,6 +27,8 @@ wire_enum! {
         Mavlink = 7 => "mavlink",
         /// GNSS receiver acquisition, when a receiver is configured.
         Gnss = 8 => "gnss",
+        /// The Zenoh bridge (ROS 2 topics beyond the host), when enabled.
+        Bridge = 9 => "bridge",
     }
 }
 
@@ -117,7 +119,7 @@ wire_enum! {
 }
 
 /// Up to this many processes in a [`HealthReport`].
-pub const MAX_SUPERVISED: usize = 8;
+pub const MAX_SUPERVISED: usize = 10;
 
 wire_enum! {
     /// What the watchdog knows of one supervised process, [`ServiceHealth::state`].

@@ -42,7 +42,7 @@ pub use raw::*;
 pub use truth::*;
 
 /// Version of every payload layout in this crate. Bump it on any layout change.
-pub const PAYLOAD_VERSION: u16 = 9;
+pub const PAYLOAD_VERSION: u16 = 10;
 
 /// Up to this many single-axis channels per sensor type (gyro, accelerometer).
 pub const MAX_CHANNELS: usize = 16;

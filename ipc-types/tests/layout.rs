@@ -1,6 +1,6 @@
 //! The payload layouts are the contract between processes built at different times: their size
 //! and alignment must not change without a new [`PAYLOAD_VERSION`]. The figures are the layouts of
-//! version 9.
+//! version 10.
 
 use std::mem::{align_of, offset_of, size_of};
 
@@ -16,8 +16,8 @@ fn layout<T>() -> (usize, usize) {
 }
 
 #[test]
-fn the_layouts_are_those_of_version_9() {
-    assert_eq!(PAYLOAD_VERSION, 9);
+fn the_layouts_are_those_of_version_10() {
+    assert_eq!(PAYLOAD_VERSION, 10);
 }
 
 #[test]
@@ -43,7 +43,7 @@ fn every_payload_keeps_its_size_and_alignment() {
     assert_eq!(layout::<RedundancyReport>(), (88, 4));
     assert_eq!(layout::<NavReport>(), (16, 4));
     assert_eq!(layout::<GnssLinkReport>(), (248, 8));
-    assert_eq!(layout::<HealthReport>(), (624, 8));
+    assert_eq!(layout::<HealthReport>(), (672, 8));
 }
 
 /// A reader checks the version before anything else, so it must sit at the same place in every

@@ -174,6 +174,7 @@ fn service_kind() {
             (NavigatorStandby, 6, "navigator-standby"),
             (Mavlink, 7, "mavlink"),
             (Gnss, 8, "gnss"),
+            (Bridge, 9, "bridge"),
         ]
     );
     assert_eq!(

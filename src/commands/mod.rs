@@ -23,6 +23,7 @@ mod progress;
 mod readmit;
 mod record;
 mod record_report;
+mod remote;
 mod replay;
 mod report_out;
 mod service;
@@ -55,12 +56,33 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Echo {
             topic,
             count,
+            timeout,
+            remote,
+            ..
+        } if remote.remote.is_some() => {
+            let wait = (timeout > 0.0).then(|| std::time::Duration::from_secs_f64(timeout));
+            let remote =
+                remote::Remote::of(&remote).ok_or_else(|| anyhow::anyhow!("no --remote"))?;
+            remote::echo(&remote, &topic, count, wait).map(|()| ExitCode::SUCCESS)
+        }
+        Command::Echo {
+            topic,
+            count,
             csv,
             raw,
             timeout,
+            ..
         } => echo::run(&topic, count, csv, raw, timeout).map(|()| ExitCode::SUCCESS),
         Command::Soak(args) => rins_soak::run(&args.into()).map(|()| ExitCode::SUCCESS),
-        Command::Status { json, timeout } => status::run(json, timeout).map(|()| ExitCode::SUCCESS),
+        Command::Status {
+            json,
+            timeout,
+            remote,
+        } => match remote::Remote::of(&remote) {
+            Some(r) => remote::status(&r, json, timeout),
+            None => status::run(json, timeout),
+        }
+        .map(|()| ExitCode::SUCCESS),
         Command::Probe(args) => probe::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Inject(args) => inject::run(&args).map(|()| ExitCode::SUCCESS),
         Command::Record(args) => record::run(&args).map(|()| ExitCode::SUCCESS),

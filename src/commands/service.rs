@@ -85,6 +85,7 @@ pub fn run(args: &ServiceArgs) -> Result<()> {
         }
         .run(ctx),
         ServiceName::Gnss => rins_gnss::service::GnssService { config: cfg.gnss }.run(ctx),
+        ServiceName::Bridge => rins_bridge::service::BridgeService { config: cfg.zenoh }.run(ctx),
     };
     tracing::info!(service = %process, ok = result.is_ok(), "stopped");
     result

@@ -6,76 +6,16 @@
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, bail};
-use ipc_types::{HealthReport, ServiceKind, ServiceState, names};
+use ipc_types::{HealthReport, names};
 use rins_runtime::ipc::TopicSubscriber;
 use rins_runtime::payload::OtherVersionWarning;
 use rins_runtime::setup_guard::SetupGuard;
 use rins_runtime::tool_node::ToolNode;
-use rins_watchdog::gnss_line::{self, GnssRow};
-use rins_watchdog::redundancy_view::{
-    NavView, RedundancyView, SensorRow, nav_view, redundancy_view,
-};
-use serde::Serialize;
+use rins_watchdog::gnss_line;
+use rins_watchdog::redundancy_view::{RedundancyView, SensorRow};
+pub use rins_watchdog::status_rows::{StatusReport, rows};
 
 use super::status_link;
-
-/// One process as printed.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct ServiceRow {
-    pub service: String,
-    pub state: String,
-    pub pid: u32,
-    pub restarts: u32,
-    /// Its last heartbeat said its input is quiet.
-    pub input_stale: bool,
-    /// `None` before the first heartbeat.
-    pub heartbeat_age_ms: Option<u32>,
-    /// `None` for a process without an output topic.
-    pub output_rate_hz: Option<f64>,
-}
-
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct StatusReport {
-    pub uptime_s: f64,
-    pub services: Vec<ServiceRow>,
-    /// `None` before the first navigation sample.
-    pub navigation: Option<NavView>,
-    /// `None` before the first fused sample.
-    pub redundancy: Option<RedundancyView>,
-    pub link: Option<status_link::LinkRow>,
-    /// `None` without a gnss service, or before its first report.
-    pub gnss: Option<GnssRow>,
-}
-
-/// The printable form of a report; entries with unknown codes are named by their number.
-pub fn rows(report: &HealthReport) -> StatusReport {
-    let count = usize::from(report.count).min(report.services.len());
-    let services = report.services[..count]
-        .iter()
-        .map(|s| ServiceRow {
-            service: ServiceKind::from_u8(s.service)
-                .map_or_else(|| format!("service {}", s.service), |k| k.name().into()),
-            state: ServiceState::from_u8(s.state)
-                .map_or_else(|| format!("state {}", s.state), |k| k.name().into()),
-            pid: s.pid,
-            restarts: s.restarts,
-            input_stale: s.input_stale != 0,
-            heartbeat_age_ms: (s.heartbeat_age_ms != u32::MAX).then_some(s.heartbeat_age_ms),
-            output_rate_hz: s
-                .output_rate_hz
-                .is_finite()
-                .then_some(f64::from(s.output_rate_hz)),
-        })
-        .collect();
-    StatusReport {
-        uptime_s: report.uptime_ms as f64 * 1e-3,
-        services,
-        navigation: nav_view(&report.nav),
-        redundancy: redundancy_view(&report.redundancy),
-        link: status_link::link_row(&report.link),
-        gnss: gnss_line::gnss_row(&report.gnss),
-    }
-}
 
 pub fn table(report: &StatusReport) -> String {
     let mut out = format!("up {:.1} s\n", report.uptime_s);
@@ -201,7 +141,7 @@ pub fn run(json: bool, timeout_s: f64) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ipc_types::ServiceHealth;
+    use ipc_types::{ServiceHealth, ServiceKind, ServiceState};
 
     #[test]
     fn rows_name_services_and_states_and_leave_unknowns_as_none() {

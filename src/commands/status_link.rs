@@ -1,34 +1,8 @@
 //! The `link` part of `rins status`: the serial line as acquisition last reported it, with the
 //! last decode error by name.
 
-use ipc_types::LinkReport;
 use rins_watchdog::link::link_error_name;
-use serde::ser::{Serialize, SerializeStruct, Serializer};
-
-/// The serial line as printed (`link` in the JSON): the report's counters, the last decode error
-/// by name (`none`, `no-sync`, `crc-mismatch`, ...), without the layout's own fields.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LinkRow(pub LinkReport);
-
-impl Serialize for LinkRow {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let l = &self.0;
-        let mut row = s.serialize_struct("LinkRow", 7)?;
-        row.serialize_field("bytes_received", &l.bytes_received)?;
-        row.serialize_field("valid_frames", &l.valid_frames)?;
-        row.serialize_field("discarded_bytes", &l.discarded_bytes)?;
-        row.serialize_field("crc_errors", &l.crc_errors)?;
-        row.serialize_field("malformed", &l.malformed)?;
-        row.serialize_field("reconnects", &l.reconnects)?;
-        row.serialize_field("last_decode_error", &link_error_name(l.last_decode_error))?;
-        row.end()
-    }
-}
-
-/// The printable link of a report; `None` while acquisition has not been heard.
-pub fn link_row(link: &LinkReport) -> Option<LinkRow> {
-    (link.heard != 0).then_some(LinkRow(*link))
-}
+use rins_watchdog::status_rows::LinkRow;
 
 /// The table's `link` line.
 pub fn link_line(link: Option<&LinkRow>) -> String {
@@ -51,7 +25,8 @@ pub fn link_line(link: Option<&LinkRow>) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ipc_types::LinkError;
+    use ipc_types::{LinkError, LinkReport};
+    use rins_watchdog::status_rows::link_row;
 
     #[test]
     fn the_link_names_its_error_and_is_absent_until_heard() {

@@ -17,7 +17,7 @@ use rins_watchdog::deployment_checks::{ensure_no_live_deployment, refuse_foreign
 use rins_watchdog::health_publisher::HealthPublisher;
 use rins_watchdog::link::no_valid_frame;
 use rins_watchdog::monitor::Monitor;
-use rins_watchdog::process_graph::pipeline_services;
+use rins_watchdog::process_graph::{Optional, pipeline_services};
 use rins_watchdog::restart_timing::RestartTiming;
 use rins_watchdog::run_summary::summarise;
 use rins_watchdog::sim_start::wait_for_path;
@@ -79,6 +79,25 @@ fn apply_overrides(cfg: &mut RinsConfig, args: &UpArgs) -> Result<()> {
         cfg.mavlink.enabled = true;
         cfg.mavlink.endpoints = vec![endpoint.clone()];
     }
+    if args.zenoh.is_some() || args.zenoh_listen.is_some() {
+        for (flag, endpoint) in [
+            ("--zenoh", &args.zenoh),
+            ("--zenoh-listen", &args.zenoh_listen),
+        ] {
+            if let Some(e) = endpoint {
+                rins_bridge::endpoint::Endpoint::parse(e)
+                    .map_err(|why| anyhow::anyhow!("{flag} {e:?}: {why}"))?;
+            }
+        }
+        cfg.zenoh.enabled = true;
+        if let Some(e) = &args.zenoh {
+            cfg.zenoh.connect = vec![e.clone()];
+        }
+        if let Some(e) = &args.zenoh_listen {
+            cfg.zenoh.listen = vec![e.clone()];
+        }
+        cfg.validate().map_err(|e| anyhow::anyhow!("{e}"))?;
+    }
     if !args.faults.is_empty() {
         if args.port.is_some() {
             bail!("--inject and --faults need the simulator: they cannot be used with --port");
@@ -112,6 +131,12 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     cfg.build_services()?;
     if cfg.mavlink.enabled {
         rins_mavlink::signing::key_for(&cfg.mavlink)?;
+    }
+    if cfg.zenoh.enabled {
+        rins_bridge::session_config::session_config(
+            &cfg.zenoh,
+            rins_runtime::user::effective_uid(),
+        )?;
     }
     if shutdown.requested() {
         return Ok(std::process::ExitCode::SUCCESS);
@@ -174,8 +199,11 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     let outcome = (|| -> Result<()> {
         let kinds = pipeline_services(
             cfg.deployment.navigator_lanes,
-            cfg.mavlink.enabled,
-            cfg.gnss.enabled,
+            Optional {
+                mavlink: cfg.mavlink.enabled,
+                gnss: cfg.gnss.enabled,
+                bridge: cfg.zenoh.enabled,
+            },
         );
         for kind in kinds {
             // An external source (a replay) publishes the raw topics and the receiver's fixes.

@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 pub mod device;
+pub mod netns;
 pub mod python;
 pub mod topic_stream;
 

@@ -7,10 +7,14 @@
 //! rins's own conventions are NED and FRD ([`ipc_types::NavState`]); [`frames`] converts, and
 //! [`from_rins`] builds the messages from rins's payloads.
 
+pub mod decode;
+pub mod diagnostics;
 pub mod encode;
 pub mod frames;
 pub mod from_rins;
 pub mod messages;
 
+pub use decode::{DecodeError, decode};
+pub use diagnostics::{DiagnosticArray, DiagnosticStatus, KeyValue};
 pub use encode::encode;
 pub use messages::{Imu, NavSatFix, Odometry};

@@ -1,10 +1,11 @@
 //! The message definitions, field for field in the order of their `.msg` files (the order CDR
 //! writes them in).
 
+use serde::de::{Deserialize, Deserializer, SeqAccess, Visitor};
 use serde::ser::{Serialize, SerializeTuple, Serializer};
 
 /// `builtin_interfaces/msg/Time`.
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Time {
     /// Seconds.
     pub sec: i32,
@@ -23,7 +24,7 @@ impl Time {
 }
 
 /// `std_msgs/msg/Header`.
-#[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Header {
     /// When the data was measured.
     pub stamp: Time,
@@ -32,7 +33,7 @@ pub struct Header {
 }
 
 /// `geometry_msgs/msg/Point`, `geometry_msgs/msg/Vector3` (the same layout).
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Vector3 {
     /// x.
     pub x: f64,
@@ -49,7 +50,7 @@ impl From<[f64; 3]> for Vector3 {
 }
 
 /// `geometry_msgs/msg/Quaternion`: vector part first, scalar last.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Quaternion {
     /// x.
     pub x: f64,
@@ -92,8 +93,30 @@ impl<const N: usize> Serialize for Fixed<N> {
     }
 }
 
+impl<'de, const N: usize> Deserialize<'de> for Fixed<N> {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Elements<const N: usize>;
+        impl<'de, const N: usize> Visitor<'de> for Elements<N> {
+            type Value = Fixed<N>;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                write!(f, "{N} float64 values")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Fixed<N>, A::Error> {
+                let mut out = [0.0; N];
+                for (k, slot) in out.iter_mut().enumerate() {
+                    *slot = seq
+                        .next_element()?
+                        .ok_or_else(|| serde::de::Error::invalid_length(k, &self))?;
+                }
+                Ok(Fixed(out))
+            }
+        }
+        deserializer.deserialize_tuple(N, Elements::<N>)
+    }
+}
+
 /// `geometry_msgs/msg/Pose`.
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Pose {
     /// Position (a `geometry_msgs/msg/Point`).
     pub position: Vector3,
@@ -103,7 +126,7 @@ pub struct Pose {
 
 /// `geometry_msgs/msg/PoseWithCovariance`: the covariance of (x, y, z, rotation about X, Y, Z),
 /// row-major.
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct PoseWithCovariance {
     /// The pose.
     pub pose: Pose,
@@ -112,7 +135,7 @@ pub struct PoseWithCovariance {
 }
 
 /// `geometry_msgs/msg/Twist`.
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Twist {
     /// Linear velocity.
     pub linear: Vector3,
@@ -121,7 +144,7 @@ pub struct Twist {
 }
 
 /// `geometry_msgs/msg/TwistWithCovariance`.
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct TwistWithCovariance {
     /// The twist.
     pub twist: Twist,
@@ -130,7 +153,7 @@ pub struct TwistWithCovariance {
 }
 
 /// `nav_msgs/msg/Odometry`: the pose in `header.frame_id`, the twist in `child_frame_id`.
-#[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Odometry {
     /// Stamp and the pose's frame.
     pub header: Header,
@@ -143,7 +166,7 @@ pub struct Odometry {
 }
 
 /// `sensor_msgs/msg/Imu`. A covariance whose first element is −1 says the quantity is not given.
-#[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Imu {
     /// Stamp and the body frame.
     pub header: Header,
@@ -162,7 +185,7 @@ pub struct Imu {
 }
 
 /// `sensor_msgs/msg/NavSatStatus`.
-#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct NavSatStatus {
     /// `STATUS_NO_FIX` −1, `STATUS_FIX` 0, `STATUS_SBAS_FIX` 1, `STATUS_GBAS_FIX` 2.
     pub status: i8,
@@ -178,7 +201,7 @@ impl NavSatStatus {
 }
 
 /// `sensor_msgs/msg/NavSatFix`: WGS84 latitude and longitude in degrees, altitude in metres.
-#[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct NavSatFix {
     /// Stamp and the frame of the antenna.
     pub header: Header,

@@ -11,6 +11,25 @@ pub fn monotonic_ns() -> u64 {
     ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64
 }
 
+/// Nanoseconds of the system's real time (CLOCK_REALTIME, since 1970), the clock ROS nodes stamp
+/// with; 0 for a clock set before 1970.
+pub fn realtime_ns() -> u64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: clock_gettime writes into the timespec we own; CLOCK_REALTIME always exists.
+    unsafe { libc::clock_gettime(libc::CLOCK_REALTIME, &mut ts) };
+    u64::try_from(ts.tv_sec).map_or(0, |s| s * 1_000_000_000 + ts.tv_nsec as u64)
+}
+
+/// `monotonic` (a CLOCK_MONOTONIC stamp) on the real-time clock, as of now: the two clocks'
+/// current difference added (a real-time clock stepped since moves the result with it).
+pub fn monotonic_to_realtime_ns(monotonic: u64) -> u64 {
+    let (real, mono) = (realtime_ns(), monotonic_ns());
+    real.saturating_sub(mono.saturating_sub(monotonic))
+}
+
 /// Sleeps until CLOCK_MONOTONIC reaches `deadline_ns` (at once when it has); a signal may end the
 /// sleep early, so a caller that must not act before the deadline reads the clock again.
 pub fn sleep_until(deadline_ns: u64) {

@@ -15,6 +15,7 @@ pub mod logging;
 pub mod paced_loop;
 pub mod payload;
 pub mod private_dir;
+pub mod rate_gate;
 pub mod realtime;
 pub mod root_lock;
 pub mod service;

@@ -43,7 +43,7 @@ pub mod odometry;
 pub mod origin;
 pub mod pipeline_cpu;
 pub mod position;
-pub mod rate_gate;
+pub use rins_runtime::rate_gate;
 pub mod serial_link;
 pub mod service;
 pub mod signing;

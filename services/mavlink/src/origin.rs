@@ -18,7 +18,8 @@
 // takes only the message.
 #![allow(deprecated)]
 
-use ipc_types::{NavState, integrity_reason};
+use ipc_types::NavState;
+pub use rins_navigator::consumer_origin::{OriginChange, OriginTracker, position_known};
 
 use crate::dialect::{COMMAND_INT_DATA, MavCmd, MavFrame, MavMessage, SET_GPS_GLOBAL_ORIGIN_DATA};
 use crate::local_frame::LocalOrigin;
@@ -26,65 +27,6 @@ use crate::time_usec;
 
 /// How often the origin is announced again while it stays the same, ns.
 pub const ANNOUNCE_INTERVAL_NS: u64 = 10_000_000_000;
-
-/// What [`OriginTracker::observe`] did with a solution.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum OriginChange {
-    /// The origin stays as it was (or there is still none).
-    None,
-    /// The frame got its first origin.
-    Set,
-    /// The origin moved: every local position jumps.
-    Moved,
-}
-
-/// The local frame's origin, and whether it is a known position.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct OriginTracker {
-    origin: Option<LocalOrigin>,
-    known: bool,
-}
-
-/// Whether `nav`'s horizontal position is a position rather than a placeholder.
-pub fn position_known(nav: &NavState) -> bool {
-    nav.integrity_reasons & integrity_reason::POSITION_UNKNOWN == 0
-        && nav.latitude_rad.is_finite()
-        && nav.longitude_rad.is_finite()
-        && nav.altitude_m.is_finite()
-}
-
-impl OriginTracker {
-    /// The origin, once a shown solution set it.
-    pub fn origin(&self) -> Option<&LocalOrigin> {
-        self.origin.as_ref()
-    }
-
-    /// The origin when it is a known position: the one to announce.
-    pub fn known(&self) -> Option<&LocalOrigin> {
-        self.origin.as_ref().filter(|_| self.known)
-    }
-
-    /// Takes `nav` (shown or not): the first shown solution sets the origin, the first shown one
-    /// with a known position moves a placeholder origin there.
-    pub fn observe(&mut self, nav: &NavState, shown: bool) -> OriginChange {
-        if !shown || self.known {
-            return OriginChange::None;
-        }
-        let known = position_known(nav);
-        let change = match (self.origin, known) {
-            (None, _) => OriginChange::Set,
-            (Some(_), true) => OriginChange::Moved,
-            (Some(_), false) => return OriginChange::None,
-        };
-        self.origin = Some(LocalOrigin::new(
-            nav.latitude_rad,
-            nav.longitude_rad,
-            nav.altitude_m,
-        ));
-        self.known = known;
-        change
-    }
-}
 
 /// `value × scale` rounded, within the range of an `i32` (a value out of it, or not finite, is no
 /// origin to announce).
@@ -191,6 +133,7 @@ impl OriginAnnouncer {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use ipc_types::integrity_reason;
 
     fn at(t_s: f64, lat_deg: f64, lon_deg: f64, known: bool) -> NavState {
         let mut nav = NavState {

@@ -12,6 +12,7 @@ pub mod attitude;
 pub mod attitude_recovery;
 mod checks;
 pub mod config;
+pub mod consumer_origin;
 pub mod ekf;
 pub mod force_window;
 mod held_inputs;

@@ -24,6 +24,7 @@ pub mod run_summary;
 pub mod seq_gaps;
 pub mod sim_start;
 pub mod status;
+pub mod status_rows;
 pub mod summary;
 pub mod summary_text;
 pub mod supervision_loop;

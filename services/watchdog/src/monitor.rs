@@ -137,7 +137,8 @@ impl Monitor {
             ServiceKind::Simulator
             | ServiceKind::Watchdog
             | ServiceKind::Mavlink
-            | ServiceKind::Gnss => None,
+            | ServiceKind::Gnss
+            | ServiceKind::Bridge => None,
         }
     }
 
@@ -153,7 +154,8 @@ impl Monitor {
             | ServiceKind::Simulator
             | ServiceKind::Watchdog
             | ServiceKind::Mavlink
-            | ServiceKind::Gnss => None,
+            | ServiceKind::Gnss
+            | ServiceKind::Bridge => None,
         }
     }
 
