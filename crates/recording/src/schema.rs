@@ -199,7 +199,7 @@ uint64[4] stage_pub_ns
     #[test]
     fn nested_definitions_are_appended_once_each() {
         let text = ros2msg(&HEALTH_REPORT);
-        assert!(text.contains("rins/ServiceHealth[8] services\n"));
+        assert!(text.contains("rins/ServiceHealth[10] services\n"));
         for name in [
             "ServiceHealth",
             "LinkReport",
