@@ -307,3 +307,13 @@ impl Default for NavState {
         }
     }
 }
+
+impl NavState {
+    /// Whether a consumer may show this sample as a solution: its mode usable and its integrity
+    /// not invalid. Everything rins hands to another system (MAVLink, ROS 2) asks this one
+    /// question, so no output claims a solution another withholds.
+    pub fn is_shown(&self) -> bool {
+        NavMode::from_u8(self.mode).is_some_and(NavMode::is_usable)
+            && Integrity::from_u8(self.integrity).is_some_and(|i| i != Integrity::Invalid)
+    }
+}

@@ -1,7 +1,7 @@
 //! The messages made from rins's payloads. Stamps are given by the caller in the clock ROS nodes
 //! use (the system's real time), since rins stamps its samples with the monotonic clock.
 
-use ipc_types::{FusedImu, NavMode, NavState};
+use ipc_types::{FusedImu, NavState};
 use rins_earth::LocalOrigin;
 
 use crate::frames::{
@@ -111,7 +111,7 @@ pub fn imu(fused: &FusedImu, nav: Option<&NavState>, body: &str, stamp_ns: u64) 
         }
         Fixed(m)
     };
-    let usable = nav.filter(|n| NavMode::from_u8(n.mode).is_some_and(NavMode::is_usable));
+    let usable = nav.filter(|n| n.is_shown());
     let (orientation, orientation_covariance) = match usable {
         Some(n) => (
             quaternion(attitude_enu_flu(n.quaternion)),
@@ -141,7 +141,7 @@ pub fn imu(fused: &FusedImu, nav: Option<&NavState>, body: &str, stamp_ns: u64) 
 /// receiver's): a fix while the solution is usable, its position variances (east, north, up) on
 /// the diagonal.
 pub fn nav_sat_fix(nav: &NavState, frame: &str, stamp_ns: u64) -> NavSatFix {
-    let usable = NavMode::from_u8(nav.mode).is_some_and(NavMode::is_usable);
+    let usable = nav.is_shown();
     let var = ned_variances_to_enu(slice3(&nav.covariance_diag[POSITION..]));
     let mut cov = [0.0; 9];
     for k in 0..3 {
@@ -171,6 +171,7 @@ pub fn nav_sat_fix(nav: &NavState, frame: &str, stamp_ns: u64) -> NavSatFix {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use ipc_types::NavMode;
 
     const FRAMES: FrameNames<'static> = FrameNames {
         world: "map",
@@ -275,6 +276,23 @@ mod tests {
         assert_eq!(
             nav_sat_fix(&invalid, "gps", 0).status.status,
             NavSatStatus::STATUS_NO_FIX
+        );
+        // A navigating solution whose integrity is invalid is no fix either, and orients no IMU
+        // sample: what MAVLink withholds, ROS is not told.
+        let untrusted = NavState {
+            integrity: ipc_types::Integrity::Invalid as u8,
+            ..nav
+        };
+        assert_eq!(
+            nav_sat_fix(&untrusted, "gps", 0).status.status,
+            NavSatStatus::STATUS_NO_FIX
+        );
+        let (_, fused, _) = state();
+        assert_eq!(
+            imu(&fused, Some(&untrusted), "base_link", 0)
+                .orientation_covariance
+                .0[0],
+            -1.0
         );
     }
 }

@@ -11,7 +11,7 @@ use std::time::Duration;
 
 use anyhow::{Context, Result};
 use crossbeam_channel::{Receiver, RecvTimeoutError, Sender, TrySendError};
-use ipc_types::{NavMode, Stage};
+use ipc_types::Stage;
 use rins_navigator::consumer_origin::OriginTracker;
 use rins_ros2_messages::from_rins::{self, FrameNames};
 use rins_runtime::clock::monotonic_to_realtime_ns;
@@ -249,7 +249,7 @@ impl Side {
             // attachment's source timestamp, so that a receiver sees the way from rins to it.
             let sent = match m {
                 Outgoing::Odometry { nav, imu } => {
-                    let usable = NavMode::from_u8(nav.mode).is_some_and(NavMode::is_usable);
+                    let usable = nav.is_shown();
                     origin.observe(&nav, usable);
                     match (origin.origin(), topics.odometry.as_mut()) {
                         (Some(o), Some(t)) if usable => {

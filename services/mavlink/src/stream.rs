@@ -2,7 +2,7 @@
 //! go in, the messages due go out, each paced by its own rate. The service around it only moves
 //! samples in and messages out.
 
-use ipc_types::{FusedImu, HealthReport, Integrity, NavMode, NavState};
+use ipc_types::{FusedImu, HealthReport, NavState};
 
 use crate::attitude::attitude_quaternion;
 use crate::autopilot::Autopilot;
@@ -55,12 +55,6 @@ pub struct MavlinkStream {
     quality_sigma_m: f64,
     /// The pipeline's CPU load, ‰, for SYS_STATUS (0: not measured).
     load_permille: u16,
-}
-
-/// Whether `nav` may be shown as a solution: usable, integrity not invalid.
-fn trustworthy(nav: &NavState) -> bool {
-    NavMode::from_u8(nav.mode).is_some_and(NavMode::is_usable)
-        && Integrity::from_u8(nav.integrity).is_some_and(|i| i != Integrity::Invalid)
 }
 
 impl MavlinkStream {
@@ -128,7 +122,7 @@ impl MavlinkStream {
         self.events
             .on_switches(switches, |m| emit(MavMessage::STATUSTEXT(m)));
         let switches = switches.0;
-        let shown = trustworthy(nav);
+        let shown = nav.is_shown();
         if self.origin.observe(nav, shown) == OriginChange::Moved {
             self.resets.bump();
         }
@@ -226,7 +220,7 @@ impl MavlinkStream {
 
 #[cfg(test)]
 mod tests {
-    use ipc_types::aiding;
+    use ipc_types::{Integrity, NavMode, aiding};
 
     use super::*;
     use crate::dialect::{MavSysStatusSensor, MavSysStatusSensorExtended};
