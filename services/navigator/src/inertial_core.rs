@@ -315,7 +315,9 @@ impl AidedNavigator {
                         .on_imu(&mut ctx, t_us, specific_force, &rate);
                 }
                 let g = ekf.strapdown().gravity();
-                step.stance = self.stance.push(rate.into(), force.into(), pressure, g);
+                step.stance = self
+                    .stance
+                    .push(rate.into(), force.into(), pressure, g, dt_s);
                 self.in_stance = step.stance;
                 if step.stance && outcome.is_applied() {
                     let imu = ImuNow {

@@ -68,7 +68,24 @@ pub struct StanceConfig {
     pub raise_after_samples: usize,
     /// Factor on the SHOE threshold while raised (≥ 1).
     pub raise_factor: f64,
+    /// SHOE only: the threshold follows the gait, `γ · (E / 1 (rad/s)²)^gait_exponent`, with `E`
+    /// the mean of `|ω|²` over the last `gait_time_constant_s` (exponentially weighted). A run's
+    /// stance is never as quiet as a walk's, and a foot standing still is quieter than either,
+    /// so one fixed γ is too strict for the one or too lax for the other. 0: a fixed threshold.
+    pub gait_exponent: f64,
+    /// Time constant of the gait's mean `|ω|²`, s.
+    pub gait_time_constant_s: f64,
 }
+
+/// Largest `gait_exponent`.
+pub const MAX_GAIT_EXPONENT: f64 = 2.0;
+/// Largest `gait_time_constant_s`, s.
+pub const MAX_GAIT_TIME_CONSTANT_S: f64 = 60.0;
+/// The gait's mean `|ω|²` before any sample, (rad/s)²: the threshold starts at γ.
+const GAIT_ENERGY_START: f64 = 1.0;
+/// Floor of the gait's mean `|ω|²`, (rad/s)²: a unit lying still for minutes does not drive the
+/// threshold to nothing.
+const GAIT_ENERGY_FLOOR: f64 = 1e-6;
 
 impl Default for StanceConfig {
     /// SHOE with the noise figures and threshold used for every foot-mounted data set.
@@ -78,6 +95,8 @@ impl Default for StanceConfig {
             min_samples: 1,
             raise_after_samples: 0,
             raise_factor: 1.0,
+            gait_exponent: 0.0,
+            gait_time_constant_s: 1.0,
             detector: StanceTest::Shoe {
                 accel_sigma_mps2: 0.01,
                 gyro_sigma_rps: 0.1_f64.to_radians(),
@@ -98,6 +117,14 @@ impl StanceConfig {
         }
         if !(self.raise_factor.is_finite() && self.raise_factor >= 1.0) {
             return Err(("raise_factor", self.raise_factor));
+        }
+        if !(0.0..=MAX_GAIT_EXPONENT).contains(&self.gait_exponent) {
+            return Err(("gait_exponent", self.gait_exponent));
+        }
+        if !(self.gait_time_constant_s > 0.0
+            && self.gait_time_constant_s <= MAX_GAIT_TIME_CONSTANT_S)
+        {
+            return Err(("gait_time_constant_s", self.gait_time_constant_s));
         }
         match self.detector {
             StanceTest::Thresholds {
@@ -148,6 +175,10 @@ pub struct StanceDetector {
     since_stance: usize,
     /// The SHOE threshold is raised (see [`StanceConfig::raise_after_samples`]).
     raised: bool,
+    /// The gait's mean `|ω|²`, (rad/s)² (see [`StanceConfig::gait_exponent`]).
+    gait_energy: f64,
+    /// The SHOE threshold of the last decision before any raise, adapted to the gait.
+    last_threshold: f64,
 }
 
 impl StanceDetector {
@@ -165,7 +196,15 @@ impl StanceDetector {
             run: 0,
             since_stance: 0,
             raised: false,
+            gait_energy: GAIT_ENERGY_START,
+            last_threshold: f64::NAN,
         }
+    }
+
+    /// The SHOE threshold of the last decision, adapted to the gait and not raised (NaN before
+    /// the window fills or for the other detectors).
+    pub fn last_threshold(&self) -> f64 {
+        self.last_threshold
     }
 
     /// The test statistic of the last decision (SHOE's T, the largest magnitude excess for the
@@ -174,15 +213,22 @@ impl StanceDetector {
         self.last_statistic
     }
 
-    /// Adds a sample (rate rad/s, specific force m/s², optional foot pressure 0..1) and decides
-    /// whether the foot is in stance; `gravity` is the local g, m/s². False until the window is full.
+    /// Adds a sample (rate rad/s, specific force m/s², optional foot pressure 0..1) taken `dt_s`
+    /// after the previous one and decides whether the foot is in stance; `gravity` is the local
+    /// g, m/s². False until the window is full.
     pub fn push(
         &mut self,
         gyro: [f64; 3],
         accel: [f64; 3],
         pressure: Option<f64>,
         gravity: f64,
+        dt_s: f64,
     ) -> bool {
+        let energy: f64 = gyro.iter().map(|x| x * x).sum();
+        if energy.is_finite() && dt_s.is_finite() && dt_s > 0.0 {
+            let k = (dt_s / self.config.gait_time_constant_s).min(1.0);
+            self.gait_energy += k * (energy - self.gait_energy);
+        }
         let scale = if self.raised {
             self.config.raise_factor
         } else {
@@ -198,9 +244,7 @@ impl StanceDetector {
         if stance {
             self.since_stance = 0;
             // Quiet enough for the unraised threshold: back to it.
-            if let StanceTest::Shoe { threshold, .. } = self.config.detector
-                && self.last_statistic < threshold
-            {
+            if self.last_statistic < self.last_threshold {
                 self.raised = false;
             }
         } else {
@@ -212,6 +256,17 @@ impl StanceDetector {
             }
         }
         stance
+    }
+
+    /// The gait's factor on the SHOE threshold (1 with a fixed threshold).
+    fn gait_factor(&self) -> f64 {
+        if self.config.gait_exponent > 0.0 {
+            self.gait_energy
+                .max(GAIT_ENERGY_FLOOR)
+                .powf(self.config.gait_exponent)
+        } else {
+            1.0
+        }
     }
 
     /// Whether the SHOE threshold is raised now.
@@ -277,7 +332,8 @@ impl StanceDetector {
                 }
                 t /= w as f64;
                 self.last_statistic = t;
-                t < threshold * shoe_scale
+                self.last_threshold = threshold * self.gait_factor();
+                t < self.last_threshold * shoe_scale
             }
         }
     }

@@ -3,6 +3,8 @@
 use rins_navigator::stance::{StanceConfig, StanceDetector, StanceTest};
 
 const G: f64 = 9.81;
+/// 200 Hz.
+const DT: f64 = 0.005;
 const REST_FORCE: [f64; 3] = [0.0, 0.0, -G];
 
 fn shoe() -> StanceConfig {
@@ -16,6 +18,8 @@ fn shoe() -> StanceConfig {
         min_samples: 1,
         raise_after_samples: 0,
         raise_factor: 1.0,
+        gait_exponent: 0.0,
+        gait_time_constant_s: 1.0,
     }
 }
 
@@ -24,23 +28,23 @@ fn shoe_statistic_is_the_closed_form_and_separates_rest_from_swing() {
     let mut d = StanceDetector::new(shoe());
     // Not before the window is full.
     for _ in 0..4 {
-        assert!(!d.push([0.0; 3], REST_FORCE, None, G));
+        assert!(!d.push([0.0; 3], REST_FORCE, None, G, DT));
     }
-    assert!(d.push([0.0; 3], REST_FORCE, None, G));
+    assert!(d.push([0.0; 3], REST_FORCE, None, G, DT));
     assert!(d.last_statistic().abs() < 1e-9);
     // A constant 0.01 rad/s rate: T = |ω|²/σ_ω² exactly (the specific force term is zero).
     for _ in 0..5 {
-        d.push([0.0, 0.0, 0.01], REST_FORCE, None, G);
+        d.push([0.0, 0.0, 0.01], REST_FORCE, None, G, DT);
     }
     let expected = (0.01 / 0.1f64.to_radians()).powi(2);
     assert!((d.last_statistic() - expected).abs() < 1e-6 * expected);
     // Swing: 3 rad/s and 5 m/s² of acceleration.
     for _ in 0..5 {
-        assert!(!d.push([3.0, 0.0, 0.0], [5.0, 0.0, -G], None, G));
+        assert!(!d.push([3.0, 0.0, 0.0], [5.0, 0.0, -G], None, G, DT));
     }
     // Back at rest, a full window later.
     let fired: Vec<bool> = (0..5)
-        .map(|_| d.push([0.0; 3], REST_FORCE, None, G))
+        .map(|_| d.push([0.0; 3], REST_FORCE, None, G, DT))
         .collect();
     assert_eq!(fired, [false, false, false, false, true]);
 }
@@ -50,7 +54,7 @@ fn shoe_ignores_the_direction_of_gravity() {
     // A tilted foot at rest: the specific force is g along any direction.
     let mut d = StanceDetector::new(shoe());
     let f = [G * 0.6, 0.0, -G * 0.8];
-    let fired = (0..5).map(|_| d.push([0.0; 3], f, None, G)).last();
+    let fired = (0..5).map(|_| d.push([0.0; 3], f, None, G, DT)).last();
     assert_eq!(fired, Some(true));
 }
 
@@ -65,18 +69,20 @@ fn magnitude_thresholds_need_every_sample_of_the_window() {
         min_samples: 1,
         raise_after_samples: 0,
         raise_factor: 1.0,
+        gait_exponent: 0.0,
+        gait_time_constant_s: 1.0,
     });
-    assert!(!d.push([0.0; 3], REST_FORCE, None, G));
-    assert!(!d.push([0.0; 3], REST_FORCE, None, G));
-    assert!(d.push([0.0; 3], REST_FORCE, None, G));
+    assert!(!d.push([0.0; 3], REST_FORCE, None, G, DT));
+    assert!(!d.push([0.0; 3], REST_FORCE, None, G, DT));
+    assert!(d.push([0.0; 3], REST_FORCE, None, G, DT));
     // One rotating sample keeps the window out of stance for three samples.
-    assert!(!d.push([0.3, 0.0, 0.0], REST_FORCE, None, G));
-    assert!(!d.push([0.0; 3], REST_FORCE, None, G));
-    assert!(!d.push([0.0; 3], REST_FORCE, None, G));
-    assert!(d.push([0.0; 3], REST_FORCE, None, G));
+    assert!(!d.push([0.3, 0.0, 0.0], REST_FORCE, None, G, DT));
+    assert!(!d.push([0.0; 3], REST_FORCE, None, G, DT));
+    assert!(!d.push([0.0; 3], REST_FORCE, None, G, DT));
+    assert!(d.push([0.0; 3], REST_FORCE, None, G, DT));
     // |f| 1 m/s² off g is not stance.
     for _ in 0..3 {
-        assert!(!d.push([0.0; 3], [0.0, 0.0, -G - 1.0], None, G));
+        assert!(!d.push([0.0; 3], [0.0, 0.0, -G - 1.0], None, G, DT));
     }
 }
 
@@ -88,10 +94,12 @@ fn foot_pressure_decides_alone_and_a_missing_reading_is_swing() {
         min_samples: 1,
         raise_after_samples: 0,
         raise_factor: 1.0,
+        gait_exponent: 0.0,
+        gait_time_constant_s: 1.0,
     });
-    assert!(d.push([5.0; 3], [9.0; 3], Some(0.8), G));
-    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.2), G));
-    assert!(!d.push([0.0; 3], REST_FORCE, None, G));
+    assert!(d.push([5.0; 3], [9.0; 3], Some(0.8), G, DT));
+    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.2), G, DT));
+    assert!(!d.push([0.0; 3], REST_FORCE, None, G, DT));
 }
 
 #[test]
@@ -111,6 +119,8 @@ fn bad_settings_name_the_field() {
         min_samples: 1,
         raise_after_samples: 0,
         raise_factor: 1.0,
+        gait_exponent: 0.0,
+        gait_time_constant_s: 1.0,
     };
     assert_eq!(c.check().map_err(|e| e.0), Err("gyro_sigma_rps"));
     c = shoe();
@@ -127,17 +137,19 @@ fn stance_is_declared_only_after_min_samples_consecutive_detections() {
         min_samples: 3,
         raise_after_samples: 0,
         raise_factor: 1.0,
+        gait_exponent: 0.0,
+        gait_time_constant_s: 1.0,
     });
     // A two-sample touch is not stance; the third consecutive loaded sample is.
-    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.9), G));
-    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.9), G));
-    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.1), G));
-    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.9), G));
-    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.9), G));
-    assert!(d.push([0.0; 3], REST_FORCE, Some(0.9), G));
-    assert!(d.push([0.0; 3], REST_FORCE, Some(0.9), G));
+    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.9), G, DT));
+    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.9), G, DT));
+    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.1), G, DT));
+    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.9), G, DT));
+    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.9), G, DT));
+    assert!(d.push([0.0; 3], REST_FORCE, Some(0.9), G, DT));
+    assert!(d.push([0.0; 3], REST_FORCE, Some(0.9), G, DT));
     // One unloaded sample ends it at once.
-    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.1), G));
+    assert!(!d.push([0.0; 3], REST_FORCE, Some(0.1), G, DT));
 }
 
 #[test]
@@ -153,26 +165,76 @@ fn a_long_run_without_stance_raises_the_threshold_until_a_quiet_window_returns()
     let (t_busy, threshold) = ((0.9 / 0.1f64.to_radians()).powi(2), 1e5);
     assert!(t_busy > threshold && t_busy < 10.0 * threshold);
     for k in 0..19 {
-        assert!(!d.push(busy, REST_FORCE, None, G), "sample {k}");
+        assert!(!d.push(busy, REST_FORCE, None, G, DT), "sample {k}");
     }
     assert!(!d.is_raised());
     // The 20th sample without stance raises it: from the next sample on the busy stance passes.
-    assert!(!d.push(busy, REST_FORCE, None, G));
+    assert!(!d.push(busy, REST_FORCE, None, G, DT));
     assert!(d.is_raised());
-    assert!(d.push(busy, REST_FORCE, None, G));
+    assert!(d.push(busy, REST_FORCE, None, G, DT));
     // Swing, then a busy stance again: still raised (the stance was not quiet).
     for _ in 0..5 {
-        assert!(!d.push([6.0, 0.0, 0.0], [5.0, 0.0, -G], None, G));
+        assert!(!d.push([6.0, 0.0, 0.0], [5.0, 0.0, -G], None, G, DT));
     }
-    let fired = (0..5).map(|_| d.push(busy, REST_FORCE, None, G)).last();
+    let fired = (0..5).map(|_| d.push(busy, REST_FORCE, None, G, DT)).last();
     assert_eq!(fired, Some(true));
     assert!(d.is_raised());
     // A truly quiet window passes the base threshold and lowers it again.
     for _ in 0..5 {
-        d.push([0.0; 3], REST_FORCE, None, G);
+        d.push([0.0; 3], REST_FORCE, None, G, DT);
     }
     assert!(!d.is_raised());
     let mut c = shoe();
     c.raise_factor = 0.5;
     assert_eq!(c.check(), Err(("raise_factor", 0.5)));
+}
+
+/// Decisions over `n` samples of rate `w` about x with the foot level (the last one returned).
+fn hold(d: &mut StanceDetector, w: f64, n: usize) -> bool {
+    (0..n)
+        .map(|_| d.push([w, 0.0, 0.0], REST_FORCE, None, G, DT))
+        .last()
+        .unwrap_or(false)
+}
+
+#[test]
+fn the_gait_adapted_threshold_passes_a_running_stance_and_tightens_at_rest() {
+    let adaptive = StanceConfig {
+        gait_exponent: 0.5,
+        gait_time_constant_s: 1.0,
+        ..shoe()
+    };
+    let (mut fixed, mut adapted) = (StanceDetector::new(shoe()), StanceDetector::new(adaptive));
+    // A second of swing at 6 rad/s: the mean |ω|² climbs from 1 towards 36, to
+    // 36 − 35 · 0.995²⁰⁰ = 23.1 (rad/s)², so the threshold becomes 1e5 · √23.1 = 4.8e5.
+    for d in [&mut fixed, &mut adapted] {
+        assert!(!hold(d, 6.0, 200));
+    }
+    // A running stance, 0.9 rad/s: T = (0.9 / σ_ω)² = 2.66e5, above γ and below the adapted one.
+    assert!(!hold(&mut fixed, 0.9, 5));
+    assert!(hold(&mut adapted, 0.9, 5));
+    let expected = 1e5 * (36.0 - 35.0 * 0.995f64.powi(200) - 0.0).sqrt();
+    let got = adapted.last_threshold();
+    assert!(
+        (got / expected - 1.0).abs() < 0.05,
+        "{got} against {expected}"
+    );
+    // Ten seconds standing still: the mean |ω|² falls to 23 · 0.995²⁰⁰⁰ ≈ 1e-3, the threshold to
+    // about 3e3, and a foot turning at 0.2 rad/s (T = 1.3e4) is no longer in stance; the fixed
+    // threshold still calls it stance.
+    assert!(hold(&mut fixed, 0.0, 2000));
+    assert!(hold(&mut adapted, 0.0, 2000));
+    assert!(hold(&mut fixed, 0.2, 5));
+    assert!(!hold(&mut adapted, 0.2, 5));
+    // Settings out of range are named.
+    let bad = StanceConfig {
+        gait_exponent: 3.0,
+        ..shoe()
+    };
+    assert_eq!(bad.check(), Err(("gait_exponent", 3.0)));
+    let bad = StanceConfig {
+        gait_time_constant_s: 0.0,
+        ..shoe()
+    };
+    assert_eq!(bad.check(), Err(("gait_time_constant_s", 0.0)));
 }

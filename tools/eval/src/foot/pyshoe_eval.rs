@@ -1,6 +1,7 @@
 //! `rins eval pyshoe DIR`: every trial through rins and through the peer's method, each scored on
 //! our metric and on the peer's, beside the peer's own per-trial-tuned figures.
 
+use std::convert::Infallible;
 use std::path::Path;
 
 use anyhow::{Context, Result, anyhow};
@@ -20,6 +21,12 @@ use crate::datasets::foot::{FootTrial, PeerResult};
 use crate::datasets::pyshoe;
 use crate::integrity_tally::IntegritySummary;
 use crate::leave_one_out::{choose_on_all, choose_without_each};
+use crate::parallel::run_indexed;
+
+/// Threads the candidate settings of one trial are scored on: the machine's.
+fn threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
 
 /// One pyshoe trial's figures.
 #[derive(Debug, Clone, Serialize)]
@@ -41,6 +48,8 @@ pub struct PyshoeTrial {
     pub rins_threshold: f64,
     /// The stance threshold's raise factor rins was scored with here (1: never raised).
     pub rins_raise_factor: f64,
+    /// The stance threshold's gait exponent rins was scored with here (0: a fixed threshold).
+    pub rins_gait_exponent: f64,
     /// The peer's method on the peer's metric, threshold chosen on the other trials, m.
     pub reference_armse_m: f64,
     /// The threshold the peer's method was scored with here.
@@ -98,6 +107,8 @@ pub struct PyshoeReport {
     pub rins_threshold_all: f64,
     /// The raise factor of rins chosen on every trial.
     pub rins_raise_factor_all: f64,
+    /// The gait exponent of rins chosen on every trial.
+    pub rins_gait_exponent_all: f64,
     /// The threshold of the peer's method chosen on every trial.
     pub reference_threshold_all: f64,
     /// Mean over the trials of Σ estimated / Σ true stride length.
@@ -257,10 +268,12 @@ fn evaluate(
     let mut reference_scores = Vec::with_capacity(loaded.len());
     let mut profile_scores = Vec::with_capacity(loaded.len());
     for l in &loaded {
-        let row: Vec<f64> = rins
-            .iter()
-            .map(|c| score_rins(&l.trial, &l.truth, c).armse_m)
-            .collect();
+        let Ok(row) = run_indexed(
+            rins.len(),
+            threads(),
+            |k| Ok::<f64, Infallible>(score_rins(&l.trial, &l.truth, &rins[k]).armse_m),
+            |_, _| {},
+        );
         done += rins.len();
         progress(done, total);
         profile_scores.push(score_rins(&l.trial, &l.truth, config).armse_m);
@@ -331,6 +344,7 @@ fn evaluate(
             rins_profile_armse_m: profile_scores[i],
             rins_threshold: shoe_threshold(rins_config),
             rins_raise_factor: rins_config.stance.raise_factor,
+            rins_gait_exponent: rins_config.stance.gait_exponent,
             reference_armse_m: reference_scores[i][reference_choice[i]],
             reference_threshold,
             peer_armse_m: peer,
@@ -368,6 +382,7 @@ fn evaluate(
         reference_mean_armse_m: mean(trials.iter().map(|t| t.reference_armse_m)),
         rins_threshold_all: shoe_threshold(&rins[choose_on_all(&rins_logs)]),
         rins_raise_factor_all: rins[choose_on_all(&rins_logs)].stance.raise_factor,
+        rins_gait_exponent_all: rins[choose_on_all(&rins_logs)].stance.gait_exponent,
         reference_threshold_all: thresholds[choose_on_all(&reference_logs)],
         mean_stride_length_ratio: mean(
             trials

@@ -93,12 +93,13 @@ pub fn pyshoe_table(r: &PyshoeReport) -> String {
     let _ = writeln!(
         s,
         "ARMSE by estimator: rins {:.3} m (profile as configured {:.3} m; threshold chosen on all \
-         trials {:.3e}, raised ×{} after a second without stance), the peer's method with one \
-         threshold {:.3} m (chosen on all trials {:.3e})",
+         trials {:.3e}, raised ×{} after a second without stance, gait exponent {}), the peer's \
+         method with one threshold {:.3} m (chosen on all trials {:.3e})",
         r.rins_mean_armse_m,
         r.rins_profile_mean_armse_m,
         r.rins_threshold_all,
         r.rins_raise_factor_all,
+        r.rins_gait_exponent_all,
         r.reference_mean_armse_m,
         r.reference_threshold_all
     );
