@@ -74,6 +74,13 @@ fn a_still_foot_scores_zero_on_both_metrics_and_a_broken_file_is_listed_not_fata
         "--method",
         "reference",
     ]);
+    let smoothed = run_json(&[
+        "eval",
+        "pyshoe",
+        dir.to_str().unwrap(),
+        "--json",
+        "--smooth",
+    ]);
     let _ = std::fs::remove_dir_all(&dir);
 
     assert_eq!(r["trials"].as_array().map(Vec::len), Some(2), "{r}");
@@ -101,6 +108,16 @@ fn a_still_foot_scores_zero_on_both_metrics_and_a_broken_file_is_listed_not_fata
     assert!(png_a, "no plot for trial a");
     assert_eq!(reference["method"], "reference");
     assert!(num(&reference, "mean_armse_m").abs() < 1e-3, "{reference}");
+    // Smoothed after the fact, a still foot stays still; without --smooth nothing is reported.
+    for t in smoothed["trials"].as_array().expect("trials") {
+        assert!(num(t, "smoothed_armse_m").abs() < 1e-3, "{t}");
+    }
+    assert!(
+        num(&smoothed, "smoothed_mean_armse_m").abs() < 1e-3,
+        "{smoothed}"
+    );
+    assert!(r["smoothed_mean_armse_m"].is_null(), "{r}");
+    assert!(r["trials"][0]["smoothed_armse_m"].is_null(), "{r}");
 }
 
 /// The held-out run of each walk repeated by the running processes (a private deployment per
@@ -168,11 +185,12 @@ fn real_walks_carry_both_metrics_the_peer_and_the_reference_method() {
         return;
     };
     let walk = xio.join("short_walk.csv");
-    let x = run_json(&["eval", "xio", walk.to_str().unwrap(), "--json"]);
+    let x = run_json(&["eval", "xio", walk.to_str().unwrap(), "--json", "--smooth"]);
     assert!(
         num(&x, "end_error_m") > 0.0 && num(&x, "pct_distance") > 0.0,
         "{x}"
     );
+    assert!(num(&x, "smoothed_end_error_m").is_finite(), "{x}");
     assert!(
         (num(&x["trials"][0], "distance_m") - 22.5).abs() < 2.0,
         "{x}"

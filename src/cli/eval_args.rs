@@ -108,6 +108,10 @@ pub struct EvalPyshoeArgs {
     /// in-process ones.
     #[arg(long)]
     pub live: bool,
+    /// Also smooth each trial's held-out rins run after the fact (Rauch–Tung–Striebel over the
+    /// filter's history) and report `smoothed_armse_m` beside the causal figure.
+    #[arg(long)]
+    pub smooth: bool,
     /// Output format and navigator profile.
     #[command(flatten)]
     pub common: EvalProfileArgs,
@@ -125,6 +129,10 @@ pub struct EvalXioArgs {
     /// Write one PNG per walk into this directory.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
+    /// Also smooth each walk after the fact (Rauch–Tung–Striebel over the filter's history) and
+    /// report `smoothed_end_error_m` beside the causal `end_error_m` (rins method only).
+    #[arg(long)]
+    pub smooth: bool,
     /// Output format and navigator profile.
     #[command(flatten)]
     pub common: EvalProfileArgs,

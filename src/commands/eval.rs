@@ -67,22 +67,15 @@ pub fn run_pyshoe(args: &EvalPyshoeArgs) -> Result<()> {
     let aided = profile.navigator.aided_config();
     let mut bar = super::progress::Progress::new("eval pyshoe");
     let mut progress = |d, t| bar.set(d, t);
+    let options = rins_eval::foot::PyshoeOptions {
+        method: foot_method(args.method),
+        plot_dir: args.plot.as_deref(),
+        smooth: args.smooth,
+    };
     let (mut report, walks) = if args.live {
-        rins_eval::foot::evaluate_pyshoe_with_runs(
-            &args.dir,
-            &aided,
-            foot_method(args.method),
-            args.plot.as_deref(),
-            &mut progress,
-        )?
+        rins_eval::foot::evaluate_pyshoe_with_runs(&args.dir, &aided, options, &mut progress)?
     } else {
-        let report = rins_eval::foot::evaluate_pyshoe(
-            &args.dir,
-            &aided,
-            foot_method(args.method),
-            args.plot.as_deref(),
-            &mut progress,
-        )?;
+        let report = rins_eval::foot::evaluate_pyshoe(&args.dir, &aided, options, &mut progress)?;
         (report, Vec::new())
     };
     bar.finish();
@@ -110,6 +103,7 @@ pub fn run_xio(args: &EvalXioArgs) -> Result<()> {
         &aided,
         foot_method(args.method),
         args.plot.as_deref(),
+        args.smooth,
         &mut |d, t| bar.set(d, t),
     )?;
     bar.finish();

@@ -24,6 +24,7 @@ pub mod mag_calibration;
 pub mod mechanisation;
 pub mod navigator;
 pub mod service;
+pub mod smoother;
 pub mod stance;
 pub mod start;
 pub mod state_history;

@@ -3,6 +3,7 @@
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 use super::noise::EkfNoise;
+use super::prediction::PredictionRecord;
 use super::{ATT, BA, BG, Covariance, POS, STATES, VEL};
 use crate::attitude::{rotation_vector_to_quaternion, wrap_pi};
 use crate::mechanisation::{ImuBias, NominalState, StepOutcome, Strapdown, StrapdownConfig};
@@ -72,6 +73,7 @@ pub struct ErrorStateEkf {
     noise: EkfNoise,
     counts: [AidingCounts; AidingSource::COUNT],
     corrections: CorrectionTotals,
+    last_prediction: PredictionRecord,
 }
 
 /// `[v×]`, the matrix of `x ↦ v × x`.
@@ -107,6 +109,7 @@ impl ErrorStateEkf {
             noise,
             counts: [AidingCounts::default(); AidingSource::COUNT],
             corrections: CorrectionTotals::default(),
+            last_prediction: PredictionRecord::default(),
         }
     }
 
@@ -223,6 +226,13 @@ impl ErrorStateEkf {
         }
         self.p = (p + p.transpose()) * 0.5;
         self.corrections.elapsed_s += dt_s;
+        self.last_prediction = PredictionRecord {
+            c,
+            f_skew,
+            dt_s,
+            prior: self.p,
+            injected: SVector::zeros(),
+        };
         outcome
     }
 
@@ -272,8 +282,14 @@ impl ErrorStateEkf {
         UpdateOutcome::Accepted { d2 }
     }
 
+    /// The last prediction and the corrections since, for a smoother over the filter's history.
+    pub fn last_prediction(&self) -> &PredictionRecord {
+        &self.last_prediction
+    }
+
     /// Moves the estimated error into the nominal state and biases (the error resets to zero).
     fn inject(&mut self, dx: &SVector<f64, STATES>) {
+        self.last_prediction.injected += dx;
         let d_theta = Vector3::new(dx[ATT], dx[ATT + 1], dx[ATT + 2]);
         let d_v = Vector3::new(dx[VEL], dx[VEL + 1], dx[VEL + 2]);
         let s = self.strapdown.state_mut();

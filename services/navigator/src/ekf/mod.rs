@@ -23,11 +23,13 @@ pub mod gnss;
 mod linearised;
 mod measurements;
 mod noise;
+mod prediction;
 
 pub use filter::{AidingCounts, AidingSource, CorrectionTotals, ErrorStateEkf, UpdateOutcome};
 pub use linearised::Linearised;
 pub use measurements::heading_jacobian;
 pub use noise::EkfNoise;
+pub use prediction::PredictionRecord;
 
 /// Size of the error state.
 pub const STATES: usize = 15;

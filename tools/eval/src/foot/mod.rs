@@ -23,7 +23,9 @@ use serde::Serialize;
 
 use crate::datasets::foot::FootTrial;
 
-pub use pyshoe_eval::{PyshoeReport, PyshoeTrial, evaluate_pyshoe, evaluate_pyshoe_with_runs};
+pub use pyshoe_eval::{
+    PyshoeOptions, PyshoeReport, PyshoeTrial, evaluate_pyshoe, evaluate_pyshoe_with_runs,
+};
 pub use xio_eval::{XioReport, XioWalk, evaluate_xio};
 
 /// Which estimator the per-trial figures, the means and the plots are of.

@@ -12,7 +12,7 @@ use super::live::{LiveWalk, LiveWalkSummary, ScoredWalk, score_positions};
 use super::metrics::{aligned_rmse_2d, peer_armse_2d, round_mm};
 use super::plot::{TrialPlot, draw_trial};
 use super::reference::{ReferenceConfig, run_with_statistic, shoe_statistic};
-use super::run::run_trial;
+use super::run::{run_trial, run_trial_smoothed};
 use super::strides::{StrideAnalysis, analyse};
 use super::{
     FootMethod, Skipped, columns, mean, reference_thresholds, rins_candidates, shoe_threshold,
@@ -71,9 +71,24 @@ pub struct PyshoeTrial {
     pub zupt_rejected: u64,
     /// How much of the walk the navigator judged usable (rins only).
     pub integrity: Option<IntegritySummary>,
+    /// With `--smooth`: the held-out rins run smoothed after the fact (Rauch–Tung–Striebel over
+    /// the filter's history), on the peer's metric, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub smoothed_armse_m: Option<f64>,
     /// The held-out rins run repeated through the running processes (`--live`).
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     pub live: Option<LiveWalk>,
+}
+
+/// How `rins eval pyshoe` runs.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct PyshoeOptions<'a> {
+    /// The estimator of the per-trial figures, the means and the plots.
+    pub method: FootMethod,
+    /// One PNG per trial into this directory.
+    pub plot_dir: Option<&'a Path>,
+    /// Also smooth each held-out rins run and report it beside the causal figure.
+    pub smooth: bool,
 }
 
 /// The pyshoe evaluation of a whole directory.
@@ -113,6 +128,12 @@ pub struct PyshoeReport {
     pub reference_threshold_all: f64,
     /// Mean over the trials of Σ estimated / Σ true stride length.
     pub mean_stride_length_ratio: f64,
+    /// With `--smooth`: mean of the smoothed held-out rins runs on the peer's metric, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub smoothed_mean_armse_m: Option<f64>,
+    /// With `--smooth`: trials on which the smoothed run beat the peer's best (1 mm rounding).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub smoothed_trials_better_than_peer: Option<usize>,
     /// Every held-out rins run repeated through the running processes (`--live`).
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     pub live: Option<LiveWalkSummary>,
@@ -209,11 +230,10 @@ fn load(file: &Path) -> Result<Loaded> {
 pub fn evaluate_pyshoe(
     dir: &Path,
     config: &AidedConfig,
-    method: FootMethod,
-    plot_dir: Option<&Path>,
+    options: PyshoeOptions,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<PyshoeReport> {
-    Ok(evaluate(dir, config, method, plot_dir, false, progress)?.0)
+    Ok(evaluate(dir, config, options, false, progress)?.0)
 }
 
 /// As [`evaluate_pyshoe`], with each trial's held-out rins run kept (in the report's trial
@@ -221,21 +241,30 @@ pub fn evaluate_pyshoe(
 pub fn evaluate_pyshoe_with_runs(
     dir: &Path,
     config: &AidedConfig,
-    method: FootMethod,
-    plot_dir: Option<&Path>,
+    options: PyshoeOptions,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<(PyshoeReport, Vec<ScoredWalk>)> {
-    evaluate(dir, config, method, plot_dir, true, progress)
+    evaluate(dir, config, options, true, progress)
+}
+
+/// The held-out rins run smoothed, on the peer's metric.
+fn smoothed_armse(trial: &FootTrial, truth: &[[f64; 3]], config: &AidedConfig) -> f64 {
+    let run = run_trial_smoothed(trial, config);
+    score_positions(&run.smoothed_ned_m, run.aligned_at, truth).armse_m
 }
 
 fn evaluate(
     dir: &Path,
     config: &AidedConfig,
-    method: FootMethod,
-    plot_dir: Option<&Path>,
+    options: PyshoeOptions,
     keep_runs: bool,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<(PyshoeReport, Vec<ScoredWalk>)> {
+    let PyshoeOptions {
+        method,
+        plot_dir,
+        smooth,
+    } = options;
     let files = pyshoe::list_trials(dir)
         .with_context(|| format!("eval pyshoe: cannot list {}", dir.display()))?;
     if files.is_empty() {
@@ -356,6 +385,7 @@ fn evaluate(
                 / scored.stance.len().max(1) as f64,
             zupt_rejected: scored.zupt_rejected,
             integrity: scored.integrity,
+            smoothed_armse_m: smooth.then(|| smoothed_armse(&l.trial, &l.truth, rins_config)),
             live: None,
         });
         done += 1;
@@ -390,6 +420,16 @@ fn evaluate(
                 .map(|t| t.strides.length_ratio)
                 .filter(|r| r.is_finite()),
         ),
+        smoothed_mean_armse_m: all(&|t| t.smoothed_armse_m),
+        smoothed_trials_better_than_peer: smooth.then(|| {
+            trials
+                .iter()
+                .filter(|t| match (t.smoothed_armse_m, t.peer_armse_m) {
+                    (Some(s), Some(p)) => round_mm(s) < p,
+                    _ => false,
+                })
+                .count()
+        }),
         trials,
         skipped,
         live: None,

@@ -90,6 +90,16 @@ pub fn pyshoe_table(r: &PyshoeReport) -> String {
         r.trials_better_than_peer,
         r.trials_compared
     );
+    if let (Some(mean), Some(better)) =
+        (r.smoothed_mean_armse_m, r.smoothed_trials_better_than_peer)
+    {
+        let _ = writeln!(
+            s,
+            "smoothed after the fact (rins, held-out settings): ARMSE {mean:.3} m; better than the \
+             peer on {better} of {}",
+            r.trials_compared
+        );
+    }
     let _ = writeln!(
         s,
         "ARMSE by estimator: rins {:.3} m (profile as configured {:.3} m; threshold chosen on all \
@@ -191,6 +201,15 @@ pub fn xio_table(r: &XioReport) -> String {
             t.dropped_duplicate_rows,
             integrity(&t.integrity)
         );
+    }
+    for t in &r.trials {
+        if let (Some(e), Some(p)) = (t.smoothed_end_error_m, t.smoothed_pct_distance) {
+            let _ = writeln!(
+                s,
+                "{}: smoothed after the fact {e:.3} m ({p:.2}% of the distance)",
+                t.trial
+            );
+        }
     }
     skipped(&mut s, &r.skipped);
     s

@@ -10,7 +10,7 @@ use serde::Serialize;
 use super::metrics::path_length_2d;
 use super::plot::{TrialPlot, draw_trial};
 use super::reference::{ReferenceConfig, run_reference};
-use super::run::run_trial;
+use super::run::{run_trial, run_trial_smoothed};
 use super::{FootMethod, Skipped, columns};
 use crate::datasets::foot::{FootTrial, PeerResult};
 use crate::datasets::xio;
@@ -39,6 +39,13 @@ pub struct XioWalk {
     pub zupt_rejected: u64,
     /// How much of the walk the navigator judged usable (rins only).
     pub integrity: Option<IntegritySummary>,
+    /// With `--smooth`: the end error of the smoothed trajectory, m (start and end both
+    /// smoothed; the end has no future, so only the start moves).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub smoothed_end_error_m: Option<f64>,
+    /// With `--smooth`: the smoothed end error as a percentage of the distance walked.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub smoothed_pct_distance: Option<f64>,
 }
 
 /// The closed-loop evaluation of every walk given.
@@ -54,22 +61,36 @@ pub struct XioReport {
     pub end_error_m: f64,
     /// The first walk's end error as a percentage of its distance (NaN without walks).
     pub pct_distance: f64,
+    /// With `--smooth`: the first walk's smoothed end error, m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub smoothed_end_error_m: Option<f64>,
 }
 
 /// Positions per sample from the navigator's alignment on (or from the first sample for the
 /// reference), stance flags, and the rins-only extras.
 struct Walked {
     positions: Vec<[f64; 3]>,
+    /// The smoothed positions on the same samples (rins with `smooth` only).
+    smoothed: Option<Vec<[f64; 3]>>,
     stance: Vec<bool>,
     foot_down: Vec<[f64; 3]>,
     zupt_rejected: u64,
     integrity: Option<IntegritySummary>,
 }
 
-fn walk(trial: &FootTrial, config: &AidedConfig, method: FootMethod) -> Result<Walked> {
+fn walk(
+    trial: &FootTrial,
+    config: &AidedConfig,
+    method: FootMethod,
+    smooth: bool,
+) -> Result<Walked> {
     match method {
         FootMethod::Rins => {
-            let run = run_trial(trial, config);
+            let run = if smooth {
+                run_trial_smoothed(trial, config)
+            } else {
+                run_trial(trial, config)
+            };
             let start = run.aligned_at.ok_or_else(|| {
                 anyhow!(
                     "{}: the navigator never aligned (the recording must start with the foot still)",
@@ -77,6 +98,7 @@ fn walk(trial: &FootTrial, config: &AidedConfig, method: FootMethod) -> Result<W
                 )
             })?;
             Ok(Walked {
+                smoothed: smooth.then(|| run.smoothed_ned_m[start..].to_vec()),
                 positions: run.ned_m[start..].to_vec(),
                 stance: run.stance[start..].to_vec(),
                 foot_down: run.foot_down_m,
@@ -96,7 +118,15 @@ fn walk(trial: &FootTrial, config: &AidedConfig, method: FootMethod) -> Result<W
                 .filter(|&k| run.stance[k] && (k == 0 || !run.stance[k - 1]))
                 .map(|k| run.position_m[k])
                 .collect();
+            if smooth {
+                return Err(anyhow!(
+                    "{}: --smooth needs the rins method (the reference method keeps no filter \
+                     history)",
+                    trial.name
+                ));
+            }
             Ok(Walked {
+                smoothed: None,
                 positions: run.position_m,
                 stance: run.stance,
                 foot_down,
@@ -113,15 +143,12 @@ pub fn evaluate_xio_walk(
     config: &AidedConfig,
     method: FootMethod,
     plot_dir: Option<&Path>,
+    smooth: bool,
 ) -> Result<XioWalk> {
-    let walked = walk(trial, config, method)?;
-    let first = walked.positions.first().copied().unwrap_or([0.0; 3]);
-    let last = walked.positions.last().copied().unwrap_or(first);
-    let end_error = (0..3)
-        .map(|k| (last[k] - first[k]).powi(2))
-        .sum::<f64>()
-        .sqrt();
+    let walked = walk(trial, config, method, smooth)?;
+    let end_error = end_to_start(&walked.positions);
     let distance = path_length_2d(&walked.foot_down);
+    let smoothed_end_error = walked.smoothed.as_deref().map(end_to_start);
     if let Some(dir) = plot_dir {
         let offset = trial.samples.len() - walked.positions.len();
         let times: Vec<f64> = trial.samples[offset..].iter().map(|s| s.t_s).collect();
@@ -153,7 +180,20 @@ pub fn evaluate_xio_walk(
             / walked.stance.len().max(1) as f64,
         zupt_rejected: walked.zupt_rejected,
         integrity: walked.integrity,
+        smoothed_end_error_m: smoothed_end_error,
+        smoothed_pct_distance: smoothed_end_error
+            .map(|e| 100.0 * e / distance.max(f64::MIN_POSITIVE)),
     })
+}
+
+/// Distance between the first and the last position (3-D), m; 0 without positions.
+fn end_to_start(positions: &[[f64; 3]]) -> f64 {
+    let first = positions.first().copied().unwrap_or([0.0; 3]);
+    let last = positions.last().copied().unwrap_or(first);
+    (0..3)
+        .map(|k| (last[k] - first[k]).powi(2))
+        .sum::<f64>()
+        .sqrt()
 }
 
 /// Each walk file; `progress(done, total)` after each. A file that cannot be read or walked is
@@ -163,6 +203,7 @@ pub fn evaluate_xio(
     config: &AidedConfig,
     method: FootMethod,
     plot_dir: Option<&Path>,
+    smooth: bool,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<XioReport> {
     progress(0, files.len());
@@ -171,7 +212,7 @@ pub fn evaluate_xio(
     for (i, file) in files.iter().enumerate() {
         let outcome = xio::load_walk(file)
             .map_err(anyhow::Error::from)
-            .and_then(|trial| evaluate_xio_walk(&trial, config, method, plot_dir));
+            .and_then(|trial| evaluate_xio_walk(&trial, config, method, plot_dir, smooth));
         match outcome {
             Ok(w) => trials.push(w),
             Err(e) => skipped.push(Skipped {
@@ -191,6 +232,7 @@ pub fn evaluate_xio(
         method,
         end_error_m: trials[0].end_error_m,
         pct_distance: trials[0].pct_distance,
+        smoothed_end_error_m: trials[0].smoothed_end_error_m,
         trials,
         skipped,
     })
