@@ -6,7 +6,9 @@
 //! * `fsr` — the foot-pressure reading of the latest sample exceeds `threshold` (\[R3\]);
 //! * `shoe` — the stance hypothesis likelihood test (Skog et al.):
 //!   `T = (1/W) Σ ( |y_a − g ȳ_a/|ȳ_a||²/σ_a² + |y_ω|²/σ_ω² ) < γ`, with `ȳ_a` the window's mean
-//!   specific force.
+//!   specific force;
+//! * `ared` — the angular rate energy detector of the same evaluation: SHOE's rate term alone,
+//!   `T = (1/W) Σ |y_ω|²/σ_ω² < γ`.
 //!
 //! A trailing window delays the decision by half a window (12 ms for W = 5 at 200 Hz), which
 //! costs nothing in a stance phase of 100 ms or more, and keeps the detector causal for the live
@@ -45,6 +47,13 @@ pub enum StanceTest {
         /// Threshold γ on T.
         threshold: f64,
     },
+    /// The angular rate energy detector (Skog et al.): SHOE without its specific-force term.
+    Ared {
+        /// Gyro noise σ, rad/s.
+        gyro_sigma_rps: f64,
+        /// Threshold γ on T.
+        threshold: f64,
+    },
 }
 
 /// Detector settings.
@@ -60,15 +69,15 @@ pub struct StanceConfig {
     /// there pulls the position back along the whole stride through the velocity–position
     /// correlation, so brief detections are not trusted.
     pub min_samples: usize,
-    /// SHOE only: after this many samples without stance (0: never), the threshold is raised by
+    /// SHOE and ARED: after this many samples without stance (0: never), the threshold is raised by
     /// `raise_factor` until a window passes the unraised threshold again. A walk finds stance
     /// every second; a run or a fast turn on the spot can go on for many seconds without a window
     /// as quiet as a walking stance, and with no zero-velocity update at all the solution is
     /// lost within seconds.
     pub raise_after_samples: usize,
-    /// Factor on the SHOE threshold while raised (≥ 1).
+    /// Factor on the SHOE or ARED threshold while raised (≥ 1).
     pub raise_factor: f64,
-    /// SHOE only: the threshold follows the gait, `γ · (E / 1 (rad/s)²)^gait_exponent`, with `E`
+    /// SHOE and ARED: the threshold follows the gait, `γ · (E / 1 (rad/s)²)^gait_exponent`, with `E`
     /// the mean of `|ω|²` over the last `gait_time_constant_s` (exponentially weighted). A run's
     /// stance is never as quiet as a walk's, and a foot standing still is quieter than either,
     /// so one fixed γ is too strict for the one or too lax for the other. 0: a fixed threshold.
@@ -141,6 +150,13 @@ impl StanceConfig {
                 threshold,
             } => {
                 positive("accel_sigma_mps2", accel_sigma_mps2)?;
+                positive("gyro_sigma_rps", gyro_sigma_rps)?;
+                positive("threshold", threshold)
+            }
+            StanceTest::Ared {
+                gyro_sigma_rps,
+                threshold,
+            } => {
                 positive("gyro_sigma_rps", gyro_sigma_rps)?;
                 positive("threshold", threshold)
             }
@@ -258,7 +274,15 @@ impl StanceDetector {
         stance
     }
 
-    /// The gait's factor on the SHOE threshold (1 with a fixed threshold).
+    /// SHOE's or ARED's decision on statistic `t`: below `threshold` adapted to the gait, times
+    /// `scale` while raised.
+    fn energy_test(&mut self, t: f64, threshold: f64, scale: f64) -> bool {
+        self.last_statistic = t;
+        self.last_threshold = threshold * self.gait_factor();
+        t < self.last_threshold * scale
+    }
+
+    /// The gait's factor on the SHOE or ARED threshold (1 with a fixed threshold).
     fn gait_factor(&self) -> f64 {
         if self.config.gait_exponent > 0.0 {
             self.gait_energy
@@ -331,9 +355,18 @@ impl StanceDetector {
                         + dg / (gyro_sigma_rps * gyro_sigma_rps);
                 }
                 t /= w as f64;
-                self.last_statistic = t;
-                self.last_threshold = threshold * self.gait_factor();
-                t < self.last_threshold * shoe_scale
+                self.energy_test(t, threshold, shoe_scale)
+            }
+            StanceTest::Ared {
+                gyro_sigma_rps,
+                threshold,
+            } => {
+                let t = window
+                    .iter()
+                    .map(|e| e.gyro.iter().map(|x| x * x).sum::<f64>())
+                    .sum::<f64>()
+                    / (w as f64 * gyro_sigma_rps * gyro_sigma_rps);
+                self.energy_test(t, threshold, shoe_scale)
             }
         }
     }

@@ -238,3 +238,37 @@ fn the_gait_adapted_threshold_passes_a_running_stance_and_tightens_at_rest() {
     };
     assert_eq!(bad.check(), Err(("gait_time_constant_s", 0.0)));
 }
+
+#[test]
+fn ared_is_the_rate_energy_alone() {
+    let mut d = StanceDetector::new(StanceConfig {
+        detector: StanceTest::Ared {
+            gyro_sigma_rps: 0.01,
+            threshold: 100.0,
+        },
+        ..shoe()
+    });
+    // A rate of 0.05 rad/s: T = (0.05 / 0.01)² = 25 < 100, whatever the specific force does
+    // (SHOE's own term would see the 3 m/s² swing).
+    let rocking = [0.0, 0.0, -G + 3.0];
+    assert!(hold(&mut d, 0.0, 5));
+    let fired = (0..5)
+        .map(|_| d.push([0.05, 0.0, 0.0], rocking, None, G, DT))
+        .last();
+    assert_eq!(fired, Some(true));
+    assert!(
+        (d.last_statistic() - 25.0).abs() < 1e-9,
+        "{}",
+        d.last_statistic()
+    );
+    // 0.2 rad/s: T = 400, no stance.
+    assert!(!hold(&mut d, 0.2, 5));
+    let bad = StanceConfig {
+        detector: StanceTest::Ared {
+            gyro_sigma_rps: 0.0,
+            threshold: 1.0,
+        },
+        ..shoe()
+    };
+    assert_eq!(bad.check(), Err(("gyro_sigma_rps", 0.0)));
+}

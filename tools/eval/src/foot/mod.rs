@@ -7,6 +7,7 @@
 //! is made leave-one-trial-out: every trial is scored with the threshold that did best on the
 //! other trials, and that held-out figure is the one reported.
 
+pub mod detectors;
 pub mod live;
 pub mod metrics;
 pub mod plot;

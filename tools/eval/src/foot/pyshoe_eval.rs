@@ -8,6 +8,7 @@ use anyhow::{Context, Result, anyhow};
 use rins_navigator::inertial_core::AidedConfig;
 use serde::Serialize;
 
+use super::detectors::{DetectorFigure, compare, comparison_candidates};
 use super::live::{LiveWalk, LiveWalkSummary, ScoredWalk, score_positions};
 use super::metrics::{aligned_rmse_2d, peer_armse_2d, round_mm};
 use super::plot::{TrialPlot, draw_trial};
@@ -128,6 +129,8 @@ pub struct PyshoeReport {
     pub reference_threshold_all: f64,
     /// Mean over the trials of Σ estimated / Σ true stride length.
     pub mean_stride_length_ratio: f64,
+    /// The stance detectors side by side, each cross-validated the same way.
+    pub detectors: Vec<DetectorFigure>,
     /// With `--smooth`: mean of the smoothed held-out rins runs on the peer's metric, m.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub smoothed_mean_armse_m: Option<f64>,
@@ -288,25 +291,28 @@ fn evaluate(
             skipped.first().map_or("", |s| s.reason.as_str())
         ));
     }
-    let rins = rins_candidates(config);
+    // The SHOE grid (what the headline chooses among) first, then the other detectors compared.
+    let candidates = comparison_candidates(config);
+    let every: Vec<AidedConfig> = candidates.iter().map(|c| c.1).collect();
+    let rins = &every[..rins_candidates(config).len()];
     let thresholds = reference_thresholds();
-    let total = loaded.len() * (rins.len() + thresholds.len() + 2);
+    let total = loaded.len() * (every.len() + thresholds.len() + 2);
     let mut done = 0;
     progress(done, total);
-    let mut rins_scores = Vec::with_capacity(loaded.len());
+    let mut all_scores: Vec<Vec<f64>> = Vec::with_capacity(loaded.len());
     let mut reference_scores = Vec::with_capacity(loaded.len());
     let mut profile_scores = Vec::with_capacity(loaded.len());
     for l in &loaded {
         let Ok(row) = run_indexed(
-            rins.len(),
+            every.len(),
             threads(),
-            |k| Ok::<f64, Infallible>(score_rins(&l.trial, &l.truth, &rins[k]).armse_m),
+            |k| Ok::<f64, Infallible>(score_rins(&l.trial, &l.truth, &every[k]).armse_m),
             |_, _| {},
         );
-        done += rins.len();
+        done += every.len();
         progress(done, total);
         profile_scores.push(score_rins(&l.trial, &l.truth, config).armse_m);
-        rins_scores.push(row);
+        all_scores.push(row);
         reference_scores.push(
             thresholds
                 .iter()
@@ -324,7 +330,19 @@ fn evaluate(
             .map(|r| r.iter().map(|v| v.max(1e-6).ln()).collect())
             .collect()
     };
+    let rins_scores: Vec<Vec<f64>> = all_scores
+        .iter()
+        .map(|row| row[..rins.len()].to_vec())
+        .collect();
     let (rins_logs, reference_logs) = (logs(&rins_scores), logs(&reference_scores));
+    let peers: Vec<Option<f64>> = loaded
+        .iter()
+        .map(|l| match l.trial.peer {
+            Some(PeerResult::Armse2d { best_m, .. }) => Some(best_m),
+            _ => None,
+        })
+        .collect();
+    let detectors = compare(&candidates, &all_scores, &logs(&all_scores), &peers);
     let rins_choice = choose_without_each(&rins_logs);
     let reference_choice = choose_without_each(&reference_logs);
     let mut trials = Vec::with_capacity(loaded.len());
@@ -421,6 +439,7 @@ fn evaluate(
                 .filter(|r| r.is_finite()),
         ),
         smoothed_mean_armse_m: all(&|t| t.smoothed_armse_m),
+        detectors,
         smoothed_trials_better_than_peer: smooth.then(|| {
             trials
                 .iter()

@@ -90,6 +90,19 @@ pub fn pyshoe_table(r: &PyshoeReport) -> String {
         r.trials_better_than_peer,
         r.trials_compared
     );
+    for d in &r.detectors {
+        let _ = writeln!(
+            s,
+            "detector {:<10} ARMSE {:.3} m held out, better than the peer on {} (chosen on all: \
+             threshold {:.3e}, gait exponent {}, raised ×{})",
+            d.detector.name(),
+            d.mean_armse_m,
+            d.trials_better_than_peer,
+            d.threshold_all,
+            d.gait_exponent_all,
+            d.raise_factor_all
+        );
+    }
     if let (Some(mean), Some(better)) =
         (r.smoothed_mean_armse_m, r.smoothed_trials_better_than_peer)
     {
