@@ -65,6 +65,15 @@ fn apply_overrides(cfg: &mut RinsConfig, args: &UpArgs) -> Result<()> {
     if args.gnss {
         cfg.enable_gnss();
     }
+    // The built-in simulator samples its gyros and accelerometers at the same instant: the lag a
+    // profile sets for a real unit (its gyro channel behind its accelerometer's) is not its.
+    if args.port.is_none() && !args.external_source && cfg.navigator.gyro_lag_s != 0.0 {
+        eprintln!(
+            "rins up: [navigator] gyro_lag_s = {} s is for a real unit; the simulated one has none (0 s used)",
+            cfg.navigator.gyro_lag_s
+        );
+        cfg.navigator.gyro_lag_s = 0.0;
+    }
     if args.realtime {
         cfg.realtime.enabled = true;
     }

@@ -53,6 +53,9 @@ pub struct AidedConfig {
     pub origin_known: bool,
     /// The integrity monitor and its recovery policies (`[navigator.integrity]`).
     pub integrity: IntegrityConfig,
+    /// How long the unit's gyro channel lags its accelerometer's, s: each rate sample is paired
+    /// with the specific force of this long before (see [`crate::force_delay`]).
+    pub gyro_lag_s: f64,
 }
 
 impl AidedConfig {

@@ -21,6 +21,8 @@ use rins_earth::normal_gravity;
 
 pub use rins_runtime::config_error::ConfigError;
 
+use crate::force_delay::MAX_GYRO_LAG_S;
+
 /// Navigator settings. Degrees only here, at the edge; everything inside is radians.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -54,6 +56,9 @@ pub struct NavigatorConfig {
     pub align_max_rate_std_rps: f64,
     /// Alignment: take the gyro bias from the window's mean rate (off: start from zero bias).
     pub align_gyro_bias: bool,
+    /// How long the unit's gyro channel lags its accelerometer's, s (0..=0.05): each rate sample
+    /// is paired with the specific force of this long before.
+    pub gyro_lag_s: f64,
     /// Error-state filter noise (`[navigator.ekf]`).
     pub ekf: EkfNoise,
     /// Zero-velocity updates (`[navigator.zupt]`).
@@ -99,6 +104,7 @@ impl Default for NavigatorConfig {
             align_max_specific_force_std_mps2: align.max_specific_force_std_mps2,
             align_max_rate_std_rps: align.max_rate_std_rps,
             align_gyro_bias: align.gyro_bias_from_window,
+            gyro_lag_s: 0.0,
             ekf: EkfNoise::default(),
             zupt: ZuptConfig::default(),
             stance: StanceConfig::default(),
@@ -177,6 +183,12 @@ impl NavigatorConfig {
             self.max_dt_s,
             |x| x > 0.0 && x <= 10.0,
             "must be in (0, 10] s",
+        )?;
+        NAVIGATOR.check(
+            "gyro_lag_s",
+            self.gyro_lag_s,
+            |x| (0.0..=MAX_GYRO_LAG_S).contains(&x),
+            "must be in [0, 0.05] s",
         )?;
         NAVIGATOR.check(
             "aiding_timeout_s",
@@ -280,6 +292,7 @@ impl NavigatorConfig {
             ],
             origin_known: self.initial_latitude_deg.is_some(),
             integrity: self.integrity,
+            gyro_lag_s: self.gyro_lag_s,
         }
     }
 

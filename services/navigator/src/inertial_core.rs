@@ -24,6 +24,7 @@ pub use crate::aiding::zupt::ZuptConfig;
 use crate::alignment::{AlignError, Alignment, StaticAligner};
 use crate::attitude_recovery::AttitudeRecovery;
 use crate::ekf::{AidingSource, ErrorStateEkf};
+use crate::force_delay::ForceDelay;
 pub use crate::imu_step::ImuStep;
 use crate::integrity::IntegrityMonitor;
 use crate::mechanisation::{ImuBias, NominalState, StepOutcome};
@@ -64,6 +65,8 @@ pub struct AidedNavigator {
     sources: AidingSources,
     /// A fault fusion detected and has not isolated (see [`crate::unisolated_fault`]).
     fusion_fault: UnisolatedFaultBound,
+    /// The specific force delayed to the rate's instant (see [`crate::force_delay`]).
+    force_delay: ForceDelay,
 }
 
 impl AidedNavigator {
@@ -84,6 +87,7 @@ impl AidedNavigator {
             attitude_recovery: AttitudeRecovery::default(),
             sources: config.sources(),
             fusion_fault: UnisolatedFaultBound::default(),
+            force_delay: ForceDelay::new(config.gyro_lag_s),
         }
     }
 
@@ -128,6 +132,7 @@ impl AidedNavigator {
         let mut ekf = ErrorStateEkf::new(state, bias, self.config.strapdown, self.config.noise);
         ekf.set_covariance_diagonal(covariance_diag);
         self.stance = StanceDetector::new(self.config.stance);
+        self.force_delay = ForceDelay::new(self.config.gyro_lag_s);
         self.alignment = None;
         self.last_align_error = None;
         self.last_time_us = Some(t_us);
@@ -227,6 +232,7 @@ impl AidedNavigator {
         specific_force: [f64; 3],
         pressure: Option<f64>,
     ) -> ImuStep {
+        let specific_force = self.force_delay.push(t_us, specific_force);
         let previous_time_us = self.last_time_us;
         let dt_s = previous_time_us.map_or(0.0, |last| t_us.saturating_sub(last) as f64 * 1e-6);
         self.last_time_us = Some(t_us);

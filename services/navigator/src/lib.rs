@@ -14,6 +14,7 @@ mod checks;
 pub mod config;
 pub mod consumer_origin;
 pub mod ekf;
+pub mod force_delay;
 pub mod force_window;
 mod held_inputs;
 mod imu_step;

@@ -19,7 +19,7 @@ use rins_runtime::shutdown::Shutdown;
 use super::{Scratch, deploy, device_index, each_live, fused, in_process, navigating, reparsed};
 
 /// The deployment's configuration for `walk`: the imported recording's (device, block,
-/// fusion), with the profile's navigator carrying the walk's stance setting. Refused when the
+/// fusion), with the profile's navigator carrying the walk's stance and gyro lag settings. Refused when the
 /// navigator it describes is not the one the walk was scored with.
 fn live_config(
     recorded: &RinsConfig,
@@ -30,6 +30,7 @@ fn live_config(
     cfg.navigator = profile.navigator.clone();
     let expected = walk.navigator_config();
     cfg.navigator.stance = expected.stance;
+    cfg.navigator.gyro_lag_s = expected.gyro_lag_s;
     cfg.navigator.baro = expected.baro;
     cfg.navigator.mag = expected.mag;
     let parsed = reparsed(&cfg, "the live configuration")?;

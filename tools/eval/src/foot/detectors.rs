@@ -8,7 +8,7 @@ use rins_navigator::stance::StanceTest;
 use serde::Serialize;
 
 use super::metrics::round_mm;
-use super::{mean, rins_candidates};
+use super::{RINS_GYRO_LAGS_S, RINS_THRESHOLD_FACTORS, mean, rins_candidates};
 use crate::leave_one_out::{choose_on_all, choose_without_each};
 
 /// A detector family the evaluation compares.
@@ -51,14 +51,15 @@ pub struct DetectorFigure {
     pub raise_factor_all: f64,
 }
 
-/// Multiples of the profile's SHOE threshold tried for ARED: its statistic is SHOE's rate term
-/// alone, so it sits below SHOE's for the same window; the range reaches four octaves lower.
+/// Multiples of 2.625e4 (the smallest SHOE threshold tried with the pedestrian profile) tried for
+/// ARED: its statistic is SHOE's rate term alone, so it sits below SHOE's for the same window;
+/// the range reaches four octaves lower.
 pub const ARED_THRESHOLD_FACTORS: [f64; 7] = [0.0625, 0.125, 0.25, 0.5, 1.0, 2.0, 4.0];
 
 /// Every candidate of the comparison with its family: the SHOE grid of [`rins_candidates`]
 /// (fixed when its gait exponent is 0), then ARED with the profile's gyro σ, each of
-/// [`ARED_THRESHOLD_FACTORS`] and the SHOE grid's raise factors. Only the SHOE grid when the
-/// profile's detector is not SHOE.
+/// [`ARED_THRESHOLD_FACTORS`] of the smallest SHOE threshold, the SHOE grid's raise factors and
+/// each of [`RINS_GYRO_LAGS_S`]. Only the SHOE grid when the profile's detector is not SHOE.
 pub fn comparison_candidates(config: &AidedConfig) -> Vec<(Detector, AidedConfig)> {
     let shoe = rins_candidates(config);
     let mut out: Vec<(Detector, AidedConfig)> = shoe
@@ -80,23 +81,27 @@ pub fn comparison_candidates(config: &AidedConfig) -> Vec<(Detector, AidedConfig
     else {
         return out;
     };
+    let threshold = threshold * RINS_THRESHOLD_FACTORS[0];
     let mut raises: Vec<(f64, usize)> = shoe
         .iter()
         .map(|c| (c.stance.raise_factor, c.stance.raise_after_samples))
         .collect();
     raises.sort_by(|a, b| a.0.total_cmp(&b.0));
     raises.dedup();
-    for (raise_factor, raise_after_samples) in raises {
-        for f in ARED_THRESHOLD_FACTORS {
-            let mut ared = *config;
-            ared.stance.detector = StanceTest::Ared {
-                gyro_sigma_rps,
-                threshold: threshold * f,
-            };
-            ared.stance.gait_exponent = 0.0;
-            ared.stance.raise_factor = raise_factor;
-            ared.stance.raise_after_samples = raise_after_samples;
-            out.push((Detector::Ared, ared));
+    for gyro_lag_s in RINS_GYRO_LAGS_S {
+        for &(raise_factor, raise_after_samples) in &raises {
+            for f in ARED_THRESHOLD_FACTORS {
+                let mut ared = *config;
+                ared.stance.detector = StanceTest::Ared {
+                    gyro_sigma_rps,
+                    threshold: threshold * f,
+                };
+                ared.stance.gait_exponent = 0.0;
+                ared.stance.raise_factor = raise_factor;
+                ared.stance.raise_after_samples = raise_after_samples;
+                ared.gyro_lag_s = gyro_lag_s;
+                out.push((Detector::Ared, ared));
+            }
         }
     }
     out

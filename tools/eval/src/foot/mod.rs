@@ -50,14 +50,16 @@ pub struct Skipped {
 }
 
 /// Multiples of the profile's SHOE threshold tried for rins, smallest first: 2.625e4 … 1.05e5
-/// with the pedestrian profile, the range the fixed threshold was chosen from before it followed
-/// the gait.
-pub const RINS_THRESHOLD_FACTORS: [f64; 5] = [1.0, 1.4, 2.0, 2.8, 4.0];
+/// with the pedestrian profile (7.35e4), the range the threshold has been chosen from since the
+/// profile's first walks.
+pub const RINS_THRESHOLD_FACTORS: [f64; 5] = [1.0 / 2.8, 1.4 / 2.8, 2.0 / 2.8, 1.0, 4.0 / 2.8];
 /// Raise factors tried for rins (`[navigator.stance] raise_factor`; 1 = never raised), each
 /// after the profile's `raise_after_samples` (1 s at 200 Hz when the profile leaves it off).
 pub const RINS_RAISE_FACTORS: [f64; 4] = [1.0, 2.0, 4.0, 8.0];
 /// Gait exponents tried for rins (`[navigator.stance] gait_exponent`; 0 = a fixed threshold).
 pub const RINS_GAIT_EXPONENTS: [f64; 3] = [0.0, 0.25, 0.5];
+/// Gyro lags tried for rins (`[navigator] gyro_lag_s`, s; 0 = rate and force taken as sampled).
+pub const RINS_GYRO_LAGS_S: [f64; 3] = [0.0, 0.005, 0.01];
 /// `raise_after_samples` tried when the profile has none.
 pub const DEFAULT_RAISE_AFTER_SAMPLES: usize = 200;
 
@@ -70,8 +72,9 @@ pub fn reference_thresholds() -> Vec<f64> {
 }
 
 /// The rins candidates: the profile with its SHOE threshold scaled by each of
-/// [`RINS_THRESHOLD_FACTORS`], raised by each of [`RINS_RAISE_FACTORS`] and adapted to the gait
-/// with each of [`RINS_GAIT_EXPONENTS`]; the profile alone when its detector is not SHOE.
+/// [`RINS_THRESHOLD_FACTORS`], raised by each of [`RINS_RAISE_FACTORS`], adapted to the gait
+/// with each of [`RINS_GAIT_EXPONENTS`] and its rate paired with the force of each of
+/// [`RINS_GYRO_LAGS_S`] earlier; the profile alone when its detector is not SHOE.
 pub fn rins_candidates(config: &AidedConfig) -> Vec<AidedConfig> {
     let StanceTest::Shoe { threshold, .. } = config.stance.detector else {
         return vec![*config];
@@ -81,17 +84,20 @@ pub fn rins_candidates(config: &AidedConfig) -> Vec<AidedConfig> {
         n => n,
     };
     let mut out = Vec::new();
-    for gait_exponent in RINS_GAIT_EXPONENTS {
-        for raise in RINS_RAISE_FACTORS {
-            for f in RINS_THRESHOLD_FACTORS {
-                let mut c = *config;
-                if let StanceTest::Shoe { threshold: t, .. } = &mut c.stance.detector {
-                    *t = threshold * f;
+    for gyro_lag_s in RINS_GYRO_LAGS_S {
+        for gait_exponent in RINS_GAIT_EXPONENTS {
+            for raise in RINS_RAISE_FACTORS {
+                for f in RINS_THRESHOLD_FACTORS {
+                    let mut c = *config;
+                    if let StanceTest::Shoe { threshold: t, .. } = &mut c.stance.detector {
+                        *t = threshold * f;
+                    }
+                    c.stance.raise_factor = raise;
+                    c.stance.raise_after_samples = if raise > 1.0 { raise_after } else { 0 };
+                    c.stance.gait_exponent = gait_exponent;
+                    c.gyro_lag_s = gyro_lag_s;
+                    out.push(c);
                 }
-                c.stance.raise_factor = raise;
-                c.stance.raise_after_samples = if raise > 1.0 { raise_after } else { 0 };
-                c.stance.gait_exponent = gait_exponent;
-                out.push(c);
             }
         }
     }

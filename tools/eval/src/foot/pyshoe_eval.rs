@@ -51,6 +51,8 @@ pub struct PyshoeTrial {
     pub rins_raise_factor: f64,
     /// The stance threshold's gait exponent rins was scored with here (0: a fixed threshold).
     pub rins_gait_exponent: f64,
+    /// The gyro lag rins was scored with here, s.
+    pub rins_gyro_lag_s: f64,
     /// The peer's method on the peer's metric, threshold chosen on the other trials, m.
     pub reference_armse_m: f64,
     /// The threshold the peer's method was scored with here.
@@ -125,6 +127,8 @@ pub struct PyshoeReport {
     pub rins_raise_factor_all: f64,
     /// The gait exponent of rins chosen on every trial.
     pub rins_gait_exponent_all: f64,
+    /// The gyro lag of rins chosen on every trial, s.
+    pub rins_gyro_lag_s_all: f64,
     /// The threshold of the peer's method chosen on every trial.
     pub reference_threshold_all: f64,
     /// Mean over the trials of Σ estimated / Σ true stride length.
@@ -392,6 +396,7 @@ fn evaluate(
             rins_threshold: shoe_threshold(rins_config),
             rins_raise_factor: rins_config.stance.raise_factor,
             rins_gait_exponent: rins_config.stance.gait_exponent,
+            rins_gyro_lag_s: rins_config.gyro_lag_s,
             reference_armse_m: reference_scores[i][reference_choice[i]],
             reference_threshold,
             peer_armse_m: peer,
@@ -431,6 +436,7 @@ fn evaluate(
         rins_threshold_all: shoe_threshold(&rins[choose_on_all(&rins_logs)]),
         rins_raise_factor_all: rins[choose_on_all(&rins_logs)].stance.raise_factor,
         rins_gait_exponent_all: rins[choose_on_all(&rins_logs)].stance.gait_exponent,
+        rins_gyro_lag_s_all: rins[choose_on_all(&rins_logs)].gyro_lag_s,
         reference_threshold_all: thresholds[choose_on_all(&reference_logs)],
         mean_stride_length_ratio: mean(
             trials
