@@ -308,8 +308,10 @@ fn configuration_parses_partially_and_rejects_unknown_or_out_of_range_fields() {
     assert!(toml::from_str::<NavigatorConfig>("align_seconds = 2.0\n").is_err());
 
     type Spoil = fn(&mut NavigatorConfig);
-    let cases: [(&str, Spoil); 12] = [
+    let cases: [(&str, Spoil); 14] = [
         ("align_s", |c| c.align_s = -1.0),
+        ("gyro_lag_s", |c| c.gyro_lag_s = 0.2),
+        ("gyro_lag_s", |c| c.gyro_lag_s = -0.001),
         ("initial_latitude_deg", |c| {
             (c.initial_latitude_deg, c.initial_longitude_deg) = (Some(91.0), Some(0.0))
         }),
