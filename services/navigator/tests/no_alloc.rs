@@ -84,13 +84,16 @@ fn the_error_state_filter_and_stance_detector_do_not_allocate_per_sample() {
     use rins_navigator::ekf::AidingSource;
     use rins_navigator::inertial_core::{AidedNavigator, ZuptConfig};
 
-    let config = NavigatorConfig {
+    // With the pedestrian profile's gyro lag (the force's delay line) and a gait-adapted threshold.
+    let mut config = NavigatorConfig {
         zupt: ZuptConfig {
             enabled: true,
             ..ZuptConfig::default()
         },
+        gyro_lag_s: 0.01,
         ..NavigatorConfig::default()
     };
+    config.stance.gait_exponent = 0.25;
     let g = normal_gravity(0.0, 0.0);
     let mut nav = AidedNavigator::new(config.aided_config());
     let mut t = 0u64;
