@@ -57,10 +57,11 @@ pub fn run_trial_smoothed(trial: &FootTrial, config: &AidedConfig) -> FootRun {
         .zip(&run.recorded)
         .map(|(p, &was_recorded)| {
             recorded += usize::from(was_recorded);
-            match recorded {
-                0 => *p,
-                n => smoothed.position_ned_m[n - 1],
-            }
+            recorded
+                .checked_sub(1)
+                .and_then(|i| smoothed.position_ned_m.get(i))
+                .copied()
+                .unwrap_or(*p)
         })
         .collect();
     run
