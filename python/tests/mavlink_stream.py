@@ -281,8 +281,11 @@ def check(rins, listener, measured):
             exact += 1
         p = s["covariance_diag"]
         expected = [p[6], p[7], p[8], p[0], p[1], p[2]]
+        # The same lane's sample (the attitude equal to the f32 rounding): the covariance to 1 %. The
+        # other lane's, after an aiding reading reached one of them late: to 10 %.
+        tolerance = 1e-2 if worst <= 1e-7 else 1e-1
         for i, e in zip(COVARIANCE_DIAGONAL, expected):
-            if not math.isclose(m.pose_covariance[i], e, rel_tol=1e-2, abs_tol=1e-30):
+            if not math.isclose(m.pose_covariance[i], e, rel_tol=tolerance, abs_tol=1e-30):
                 fail(f"pose covariance [{i}] {m.pose_covariance[i]} != {e}", measured)
     if matched < 10:
         fail(f"{matched} ODOMETRY samples matched `rins echo nav`, {exact} exactly", measured)
