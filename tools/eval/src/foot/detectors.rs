@@ -8,7 +8,7 @@ use rins_navigator::stance::StanceTest;
 use serde::Serialize;
 
 use super::metrics::round_mm;
-use super::{RINS_GYRO_LAGS_S, RINS_THRESHOLD_FACTORS, mean, rins_candidates};
+use super::{RINS_GYRO_LAGS_S, RINS_THRESHOLD_FACTORS, mean, rins_candidates, stance_threshold};
 use crate::leave_one_out::{choose_on_all, choose_without_each};
 
 /// A detector family the evaluation compares.
@@ -142,12 +142,7 @@ pub fn compare(
                 .map(|(trial, &c)| armse[trial][members[c]])
                 .collect();
             let all = candidates[members[choose_on_all(&sub(log_scores))]].1;
-            let threshold_all = match all.stance.detector {
-                StanceTest::Shoe { threshold, .. } | StanceTest::Ared { threshold, .. } => {
-                    threshold
-                }
-                _ => f64::NAN,
-            };
+            let threshold_all = stance_threshold(&all);
             Some(DetectorFigure {
                 detector,
                 mean_armse_m: mean(held_out.iter().copied()),

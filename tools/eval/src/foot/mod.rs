@@ -104,10 +104,10 @@ pub fn rins_candidates(config: &AidedConfig) -> Vec<AidedConfig> {
     out
 }
 
-/// The SHOE threshold of a configuration (NaN for other detectors).
-pub fn shoe_threshold(config: &AidedConfig) -> f64 {
+/// The SHOE or ARED threshold of a configuration (NaN for the other detectors).
+pub fn stance_threshold(config: &AidedConfig) -> f64 {
     match config.stance.detector {
-        StanceTest::Shoe { threshold, .. } => threshold,
+        StanceTest::Shoe { threshold, .. } | StanceTest::Ared { threshold, .. } => threshold,
         _ => f64::NAN,
     }
 }

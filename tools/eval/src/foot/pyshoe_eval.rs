@@ -13,10 +13,10 @@ use super::live::{LiveWalk, LiveWalkSummary, ScoredWalk, score_positions};
 use super::metrics::{aligned_rmse_2d, peer_armse_2d, round_mm};
 use super::plot::{TrialPlot, draw_trial};
 use super::reference::{ReferenceConfig, run_with_statistic, shoe_statistic};
-use super::run::{run_trial, run_trial_smoothed};
+use super::run::{FootRun, run_trial, run_trial_smoothed};
 use super::strides::{StrideAnalysis, analyse};
 use super::{
-    FootMethod, Skipped, columns, mean, reference_thresholds, rins_candidates, shoe_threshold,
+    FootMethod, Skipped, columns, mean, reference_thresholds, rins_candidates, stance_threshold,
 };
 use crate::datasets::foot::{FootTrial, PeerResult};
 use crate::datasets::pyshoe;
@@ -164,7 +164,10 @@ fn horizontal(points: &[[f64; 3]]) -> Vec<[f64; 2]> {
 // The estimate's first two axes (north, east) against the export's Vicon x, y: see
 // [`score_positions`].
 fn score_rins(trial: &FootTrial, truth: &[[f64; 3]], config: &AidedConfig) -> Scored {
-    let run = run_trial(trial, config);
+    score_run(run_trial(trial, config), truth)
+}
+
+fn score_run(run: FootRun, truth: &[[f64; 3]]) -> Scored {
     let score = score_positions(&run.ned_m, run.aligned_at, truth);
     Scored {
         armse_m: score.armse_m,
@@ -252,12 +255,6 @@ pub fn evaluate_pyshoe_with_runs(
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<(PyshoeReport, Vec<ScoredWalk>)> {
     evaluate(dir, config, options, true, progress)
-}
-
-/// The held-out rins run smoothed, on the peer's metric.
-fn smoothed_armse(trial: &FootTrial, truth: &[[f64; 3]], config: &AidedConfig) -> f64 {
-    let run = run_trial_smoothed(trial, config);
-    score_positions(&run.smoothed_ned_m, run.aligned_at, truth).armse_m
 }
 
 fn evaluate(
@@ -361,11 +358,22 @@ fn evaluate(
             ));
         }
         let reference_threshold = thresholds[reference_choice[i]];
-        let scored = match method {
-            FootMethod::Rins => score_rins(&l.trial, &l.truth, rins_config),
-            FootMethod::Reference => {
-                score_reference(&l.trial, &l.truth, &l.statistic, reference_threshold)
+        // The held-out rins run, once: scored, and smoothed when asked.
+        let held_out = (method == FootMethod::Rins || smooth).then(|| {
+            if smooth {
+                run_trial_smoothed(&l.trial, rins_config)
+            } else {
+                run_trial(&l.trial, rins_config)
             }
+        });
+        let smoothed_armse_m = held_out
+            .as_ref()
+            .filter(|_| smooth)
+            .map(|run| score_positions(&run.smoothed_ned_m, run.aligned_at, &l.truth).armse_m);
+        // With rins evaluated the held-out run is always there.
+        let scored = match held_out.filter(|_| method == FootMethod::Rins) {
+            Some(run) => score_run(run, &l.truth),
+            None => score_reference(&l.trial, &l.truth, &l.statistic, reference_threshold),
         };
         let (peer, peer_shoe) = match l.trial.peer {
             Some(PeerResult::Armse2d { best_m, shoe_m }) => (Some(best_m), shoe_m),
@@ -393,7 +401,7 @@ fn evaluate(
             rmse_2d_m: scored.rmse_2d_m,
             rins_armse_m: rins_scores[i][rins_choice[i]],
             rins_profile_armse_m: profile_scores[i],
-            rins_threshold: shoe_threshold(rins_config),
+            rins_threshold: stance_threshold(rins_config),
             rins_raise_factor: rins_config.stance.raise_factor,
             rins_gait_exponent: rins_config.stance.gait_exponent,
             rins_gyro_lag_s: rins_config.gyro_lag_s,
@@ -408,7 +416,7 @@ fn evaluate(
                 / scored.stance.len().max(1) as f64,
             zupt_rejected: scored.zupt_rejected,
             integrity: scored.integrity,
-            smoothed_armse_m: smooth.then(|| smoothed_armse(&l.trial, &l.truth, rins_config)),
+            smoothed_armse_m,
             live: None,
         });
         done += 1;
@@ -433,7 +441,7 @@ fn evaluate(
         rins_mean_armse_m: mean(trials.iter().map(|t| t.rins_armse_m)),
         rins_profile_mean_armse_m: mean(trials.iter().map(|t| t.rins_profile_armse_m)),
         reference_mean_armse_m: mean(trials.iter().map(|t| t.reference_armse_m)),
-        rins_threshold_all: shoe_threshold(&rins[choose_on_all(&rins_logs)]),
+        rins_threshold_all: stance_threshold(&rins[choose_on_all(&rins_logs)]),
         rins_raise_factor_all: rins[choose_on_all(&rins_logs)].stance.raise_factor,
         rins_gait_exponent_all: rins[choose_on_all(&rins_logs)].stance.gait_exponent,
         rins_gyro_lag_s_all: rins[choose_on_all(&rins_logs)].gyro_lag_s,
