@@ -175,6 +175,12 @@ class LaneSelector:
         a consumer leaves a lane's samples in its queue while not."""
         return lane in range(LANES) and len(self._pending[lane]) < PENDING
 
+    def next_seq(self, lane: int) -> "int | None":
+        """Sequence number of `lane`'s oldest pending sample."""
+        if lane not in range(LANES) or not self._pending[lane]:
+            return None
+        return seq_of(self._pending[lane][0])
+
     def push(self, lane: int, sample) -> None:
         """Takes one sample of `lane` (a lane's samples arrive in sequence order). Samples at or
         before the output are useless and dropped; when the ring is full the oldest pending one

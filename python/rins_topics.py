@@ -166,6 +166,8 @@ class NavSubscription:
         self._standby_due = 0.0
         #: Samples received from each lane.
         self.lane_totals = [0] * len(NAV_LANES)
+        # Sequence number of the newest sample received from each lane.
+        self._lane_newest = [None] * len(NAV_LANES)
         #: Sequence numbers the output stepped over: missing in both lanes (a hole in the input),
         #: or dropped from a full subscriber queue while this process did not receive.
         self.skipped = 0
@@ -204,19 +206,42 @@ class NavSubscription:
             if state is not None:
                 return state
             pulled = False
-            for lane, subscriber in enumerate(self._lanes):
-                if subscriber is None or not self.selector.has_room(lane):
-                    continue
-                sample = subscriber.receive()
-                if sample is None:
-                    continue
-                state = NavState.from_buffer_copy(sample.payload().contents)
-                sample.delete()
-                self.lane_totals[lane] += 1
-                self.selector.push(lane, state)
-                pulled = True
+            for lane in range(len(self._lanes)):
+                if self.selector.has_room(lane) and self._pull(lane):
+                    pulled = True
             if not pulled:
                 return None
+            self._catch_up()
+
+    def _pull(self, lane: int) -> bool:
+        """One sample of `lane` into the selector; whether there was one."""
+        subscriber = self._lanes[lane]
+        if subscriber is None:
+            return False
+        sample = subscriber.receive()
+        if sample is None:
+            return False
+        state = NavState.from_buffer_copy(sample.payload().contents)
+        sample.delete()
+        self.lane_totals[lane] += 1
+        self._lane_newest[lane] = state.header.origin_seq
+        self.selector.push(lane, state)
+        return True
+
+    def _catch_up(self) -> None:
+        """Pulls the other lane up to the selected lane's next sample: a hole in the selected lane
+        is filled only from what the selector holds, and the standby publishes in batches while
+        the primary serves."""
+        other = 1 - self.selector.selected
+        nxt = self.selector.next_seq(self.selector.selected)
+        if nxt is None:
+            return
+        while (
+            (self._lane_newest[other] is None or self._lane_newest[other] + 1 < nxt)
+            and self.selector.has_room(other)
+            and self._pull(other)
+        ):
+            pass
 
     def _open_standby(self) -> None:
         """Opens the standby lane's topic once it exists (it starts with its navigator)."""

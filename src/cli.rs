@@ -11,7 +11,7 @@ mod remote_args;
 mod up_args;
 
 pub use capture_args::{
-    BenchCommand, BenchIpcArgs, BenchRatesArgs, LatencyArgs, RecordArgs, ReplayArgs,
+    BenchCommand, BenchIpcArgs, BenchRatesArgs, ChainStage, LatencyArgs, RecordArgs, ReplayArgs,
 };
 pub use data_args::{
     CalibrateCommand, CalibrateMagArgs, DataCommand, DataFetchArgs, DataListArgs, ImportArgs,
@@ -22,7 +22,7 @@ pub use eval_args::{
     EvalQuadrotorArgs, EvalXioArgs, FootMethodArg, QuadrotorMode, SweepArgs,
 };
 pub use remote_args::RemoteArgs;
-pub use up_args::{FaultArgs, UpArgs};
+pub use up_args::{FaultArgs, RequestedProfile, UpArgs};
 
 /// The `rins echo` topic help: every short name it accepts, in the topic table's order.
 fn echo_topics_help() -> String {
@@ -424,6 +424,9 @@ pub struct SoakArgs {
     /// Print the summary as one JSON object on stdout (progress stays on stderr).
     #[arg(long)]
     pub json: bool,
+    /// The deployment profile of the `rins up` it starts (as `rins up --profile`).
+    #[arg(long, value_enum, value_name = "PROFILE", default_value = "shared")]
+    pub profile: RequestedProfile,
 }
 
 impl From<SoakArgs> for rins_soak::SoakArgs {
@@ -435,6 +438,7 @@ impl From<SoakArgs> for rins_soak::SoakArgs {
             max_interval_s: a.max_interval_s,
             faults: a.faults,
             json: a.json,
+            profile: a.profile.name().to_string(),
         }
     }
 }

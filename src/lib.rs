@@ -4,6 +4,8 @@
 pub mod built_services;
 pub mod cli;
 pub mod config;
+pub mod deploy_profile;
+pub mod deploy_profile_file;
 pub mod realtime_config;
 pub mod record;
 pub mod replay;

@@ -15,7 +15,7 @@ pub const STAGES: [&str; 4] = ["fusion", "altimeter", "navigator", "navigator-st
 const MAX_SPIN_US: u32 = 20_000;
 
 /// A strategy by name.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum WaitKind {
     /// Sleep on the listener until notified.

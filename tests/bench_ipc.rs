@@ -51,6 +51,31 @@ fn the_bench_sets_each_pipeline_hop_against_its_bare_hop() {
     for b in r["bare"].as_array().unwrap() {
         assert_eq!(b["samples"], 1000, "{b}");
     }
+    // The bare chain: the same hops measured from the same stamps, every sample of the source
+    // through both relays to this consumer, and the pipeline's figures as ratios to its own.
+    assert_eq!(r["wait"], "event", "{r}");
+    let chain = r["chain"].as_array().unwrap();
+    let e2e = chain
+        .iter()
+        .find(|h| h["hop"] == "serial rx -> nav state published")
+        .unwrap();
+    assert_eq!(e2e["samples"], 1000, "{e2e}");
+    let chain_p50 = r["chain_p50_us"].as_f64().unwrap();
+    assert_eq!(e2e["p50_us"].as_f64().unwrap(), chain_p50);
+    // Two event hops cannot take less than a few microseconds, nor does a quiet relay of no work
+    // take a whole sample period at p50.
+    assert!(chain_p50 > 2.0 && chain_p50 < 1000.0, "{r}");
+    assert!(chain_p50 <= r["chain_p99_us"].as_f64().unwrap(), "{r}");
+    assert!((r["ratio_chain_p50"].as_f64().unwrap() - p50 / chain_p50).abs() < 1e-9);
+    let relayed: Vec<&str> = chain
+        .iter()
+        .filter(|h| h["samples"] == 1000)
+        .map(|h| h["hop"].as_str().unwrap())
+        .collect();
+    assert!(
+        relayed.contains(&"fusion -> navigator published"),
+        "{relayed:?}"
+    );
     // The bench's own deployment is gone (no other test runs a bench), and it never touched the
     // test's.
     let leftovers: Vec<String> = std::fs::read_dir("/dev/shm")

@@ -44,6 +44,18 @@ fn up_json_prints_one_json_document_and_the_status_lines_on_stderr() {
         );
         assert!(p["cpu_s"].as_f64().is_some_and(|c| c >= 0.0), "{summary}");
     }
+    // The standby lane reads its input in batches of 20 samples while the primary serves: a
+    // twentieth of the primary's wake-ups, under half of them even with a second of serving
+    // sample by sample (the primary lagging once on a loaded machine).
+    let wakeups = |name: &str| {
+        processes.iter().find(|p| p["name"] == name).unwrap()["wakeups"]
+            .as_u64()
+            .unwrap()
+    };
+    assert!(
+        2 * wakeups("navigator-standby") < wakeups("navigator"),
+        "{summary}"
+    );
     let cores = std::thread::available_parallelism().map_or(1, usize::from) as f64;
     let pipeline = summary["pipeline_cpu_pct"]
         .as_f64()

@@ -123,6 +123,28 @@ pub enum BenchCommand {
         /// Longest wait for a phase to end, s.
         #[arg(long, default_value_t = 60.0)]
         phase_limit: f64,
+        /// The bench's configuration, whose `[wait]` the receiver follows.
+        #[arg(long)]
+        config: PathBuf,
+    },
+    /// One process of the bare chain (started by `rins bench ipc`).
+    #[command(hide = true)]
+    IpcChain {
+        /// Which process of the chain.
+        #[arg(long, value_enum)]
+        stage: ChainStage,
+        /// The bench's configuration, whose `[wait]` a relay follows.
+        #[arg(long)]
+        config: PathBuf,
+        /// The source's rate, Hz.
+        #[arg(long, default_value_t = 1000.0)]
+        rate: f64,
+        /// The source's sample count.
+        #[arg(long, default_value_t = 0)]
+        samples: u64,
+        /// Longest wait for the phase to end, s.
+        #[arg(long, default_value_t = 60.0)]
+        phase_limit: f64,
     },
 }
 
@@ -159,7 +181,37 @@ pub struct BenchIpcArgs {
     /// Time the pipeline runs after its first navigation output before it is measured, s.
     #[arg(long, allow_negative_numbers = true, default_value_t = 5.0)]
     pub warmup: f64,
+    /// How every stage waits for its input, in the bare hops, the bare chain and the pipeline
+    /// alike (default: the configuration's `[wait]`).
+    #[arg(long, value_enum)]
+    pub wait: Option<crate::wait_config::WaitKind>,
+    /// Configuration of the pipeline (default: the built-in configuration); its `[wait]` is
+    /// the bare measurements' too.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
     /// One JSON object as the last line of stdout instead of the table.
     #[arg(long)]
     pub json: bool,
+}
+
+/// Which process of the chain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ChainStage {
+    /// Paced publisher of `RawImu`, stamped as received and as published by acquisition.
+    Source,
+    /// `RawImu` in, `FusedImu` out, stamped as fusion.
+    Fusion,
+    /// `FusedImu` in, `NavState` on the primary lane out, stamped as the navigator.
+    Navigator,
+}
+
+impl ChainStage {
+    /// The pipeline stage whose `[wait]` entry this relay follows.
+    pub fn service(self) -> &'static str {
+        match self {
+            ChainStage::Source => "acquisition",
+            ChainStage::Fusion => "fusion",
+            ChainStage::Navigator => "navigator",
+        }
+    }
 }

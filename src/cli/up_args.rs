@@ -55,6 +55,14 @@ pub struct UpArgs {
     /// service runs on without it.
     #[arg(long)]
     pub realtime: bool,
+    /// How the deployment uses the CPUs: `shared` runs `[wait]` and `[realtime]` as configured;
+    /// `dedicated` gives acquisition, fusion and the primary navigator lane a CPU each (the
+    /// highest-numbered of this process's affinity mask; at least 4 needed) at SCHED_FIFO, fusion
+    /// and the navigator spinning, and confines everything else to the remaining CPUs, memory
+    /// locked; `auto` is `dedicated` when at least 4 CPUs are free (usable CPUs minus the
+    /// 1-minute load average, rounded up), else `shared`.
+    #[arg(long, value_enum, value_name = "PROFILE", default_value = "shared")]
+    pub profile: RequestedProfile,
     /// Record every topic into this MCAP file from the start (replaced if it exists), as
     /// `rins record` does.
     #[arg(long, value_name = "FILE")]
@@ -85,5 +93,28 @@ impl FaultArgs {
     /// Whether no fault was asked for.
     pub fn is_empty(&self) -> bool {
         self.inject.is_empty() && self.faults.is_none()
+    }
+}
+
+/// What `--profile` asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum RequestedProfile {
+    /// `[wait]` and `[realtime]` as configured.
+    #[default]
+    Shared,
+    /// A CPU of its own for acquisition, fusion and the primary navigator lane.
+    Dedicated,
+    /// `dedicated` when enough CPUs are free, else `shared`.
+    Auto,
+}
+
+impl RequestedProfile {
+    /// The name as the command line spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Shared => "shared",
+            Self::Dedicated => "dedicated",
+            Self::Auto => "auto",
+        }
     }
 }

@@ -94,9 +94,18 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Bench { what } => match what {
             BenchCommand::Ipc(args) => bench::run_ipc(&args).map(|()| ExitCode::SUCCESS),
             BenchCommand::Rates(args) => bench::run_rates(&args).map(|()| ExitCode::SUCCESS),
-            BenchCommand::IpcReceiver { phase_limit } => {
-                bench::run_receiver(phase_limit).map(|()| ExitCode::SUCCESS)
-            }
+            BenchCommand::IpcReceiver {
+                phase_limit,
+                config,
+            } => bench::run_receiver(phase_limit, &config).map(|()| ExitCode::SUCCESS),
+            BenchCommand::IpcChain {
+                stage,
+                config,
+                rate,
+                samples,
+                phase_limit,
+            } => bench::run_chain_process(stage, &config, rate, samples, phase_limit)
+                .map(|()| ExitCode::SUCCESS),
         },
         Command::Geometry { config, json } => {
             geometry::run(config.as_deref(), json).map(|()| ExitCode::SUCCESS)

@@ -77,6 +77,7 @@ pub fn run(args: &ServiceArgs) -> Result<()> {
                 navigator: built.navigator,
                 lane: u8::from(name == ServiceName::NavigatorStandby),
                 lanes: cfg.deployment.navigator_lanes,
+                imu_rate_hz: cfg.device.imu_rate_hz,
             }
             .run(ctx)
         }

@@ -1,12 +1,13 @@
 //! `rins status [--json] [--timeout S]`: the watchdog's latest health report as a table (or one
 //! JSON object): per process its state, pid, restarts, heartbeat age and output rate; the
 //! navigation mode, lane and aiding; every redundant channel with its state and reason, and the
-//! parity test statistics.
+//! parity test statistics; and the deployment profile `rins up` chose, with why.
 
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, bail};
 use ipc_types::{HealthReport, names};
+use rins::deploy_profile_file::{self, ProfileRecord};
 use rins_runtime::ipc::TopicSubscriber;
 use rins_runtime::payload::OtherVersionWarning;
 use rins_runtime::setup_guard::SetupGuard;
@@ -14,6 +15,7 @@ use rins_runtime::tool_node::ToolNode;
 use rins_watchdog::gnss_line;
 use rins_watchdog::redundancy_view::{RedundancyView, SensorRow};
 pub use rins_watchdog::status_rows::{StatusReport, rows};
+use serde::Serialize;
 
 use super::status_link;
 
@@ -54,6 +56,22 @@ pub fn table(report: &StatusReport) -> String {
     }
     out.push_str(&status_link::link_line(report.link.as_ref()));
     out.push_str(&gnss_line::gnss_lines(report.gnss.as_ref()));
+    out
+}
+
+/// The report with the deployment's profile: in the JSON, `profile` and `profile_reason` beside the
+/// report's own fields; in the table, a line above it.
+#[derive(Serialize)]
+struct WithProfile<'a> {
+    #[serde(flatten)]
+    report: &'a StatusReport,
+    #[serde(flatten)]
+    profile: &'a ProfileRecord,
+}
+
+fn table_with_profile(w: &WithProfile<'_>) -> String {
+    let mut out = w.profile.line();
+    out.push_str(&table(w.report));
     out
 }
 
@@ -135,7 +153,13 @@ pub fn run(json: bool, timeout_s: f64) -> Result<()> {
         }
     };
     let report = rows(&report);
-    super::report_out::print_report(json, &report, table)
+    // The file of this same deployment: the run directory of the settings joined.
+    let profile = deploy_profile_file::read(settings);
+    let out = WithProfile {
+        report: &report,
+        profile: &profile,
+    };
+    super::report_out::print_report(json, &out, table_with_profile)
 }
 
 #[cfg(test)]
@@ -236,6 +260,31 @@ mod tests {
         assert_eq!(json["redundancy"]["channels"][1]["reason"], "parity");
         assert_eq!(json["navigation"]["lane"], 1);
         assert_eq!(json["navigation"]["output_flowing"], true);
+    }
+
+    /// The profile leads the table and sits beside the report's fields in the JSON.
+    #[test]
+    fn the_profile_is_printed_with_the_report() {
+        let r = rows(&HealthReport::default());
+        let profile = ProfileRecord {
+            profile: "shared".into(),
+            profile_reason: "auto: 2 usable CPUs, 2 free; dedicated needs 4: shared".into(),
+        };
+        let w = WithProfile {
+            report: &r,
+            profile: &profile,
+        };
+        let t = table_with_profile(&w);
+        assert!(
+            t.starts_with(
+                "profile: shared — auto: 2 usable CPUs, 2 free; dedicated needs 4: shared\nup "
+            ),
+            "{t}"
+        );
+        let json = serde_json::to_value(&w).expect("serialises");
+        assert_eq!(json["profile"], "shared");
+        assert_eq!(json["profile_reason"], profile.profile_reason.as_str());
+        assert!(json["services"].is_array(), "{json}");
     }
 
     /// A report whose navigation sample is old says the output stopped, in the table and the

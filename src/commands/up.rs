@@ -31,6 +31,8 @@ use crate::commands::fault_args;
 use crate::commands::record;
 use crate::commands::up_recording::{self, RecordingOutcome};
 use crate::config::{self, RinsConfig};
+use rins::deploy_profile::{self, RequestedProfile};
+use rins::deploy_profile_file::{self, ProfileRecord};
 
 /// Applies the command line's overrides to the configuration and checks them.
 fn apply_overrides(cfg: &mut RinsConfig, args: &UpArgs) -> Result<()> {
@@ -124,6 +126,21 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     let shutdown = Shutdown::install()?;
     let mut cfg = config::load(args.config.as_deref())?;
     apply_overrides(&mut cfg, args)?;
+    // Planned on the configuration as the command line left it, and written over it before it is
+    // resolved: every child, a restarted one too, starts with the profile's settings.
+    let profile = deploy_profile::resolve(args.profile, &mut cfg).map_err(anyhow::Error::msg)?;
+    if args.profile != RequestedProfile::Shared {
+        eprintln!(
+            "rins up: profile {} — {}",
+            profile.profile.name(),
+            profile.reason
+        );
+    }
+    // The simulator and the recorder are started by this process and inherit its CPUs.
+    if let Some(why) = deploy_profile::confine_this_process(&profile) {
+        eprintln!("rins up: {why}; it runs on without it");
+    }
+    let profile = ProfileRecord::of(&profile);
     // A recording that cannot be made is refused before anything starts, naming the path.
     // `[record]` records into systemd's state directory when the unit gives one.
     let state_directory = std::env::var("STATE_DIRECTORY").ok();
@@ -185,6 +202,11 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     // Resolved once, here: every child reads this file as it is, with nothing applied on top.
     let resolved = config::resolved::write(&cfg, &run_dir)
         .inspect_err(|_| settings.remove_iceoryx_config_file())?;
+    // Read by `rins status`: what runs, and why.
+    deploy_profile_file::write(&run_dir, &profile).inspect_err(|_| {
+        settings.remove_iceoryx_config_file();
+        let _ = std::fs::remove_file(&resolved);
+    })?;
     let resolved_args = [
         "--resolved-config".to_string(),
         resolved.to_string_lossy().into_owned(),
@@ -276,6 +298,7 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
         .map(|(child, target)| stop_recorder(child, target.path()));
     settings.remove_iceoryx_config_file();
     let _ = std::fs::remove_file(&resolved);
+    deploy_profile_file::remove(&run_dir);
     // Drain what the children published while stopping, then release our own ports.
     let _ = monitor.drain();
     let summary = summarise(&monitor, &supervisor, &timing, started.elapsed(), simulate);
@@ -291,6 +314,8 @@ pub fn run(args: &UpArgs) -> Result<std::process::ExitCode> {
     outcome?;
     let summary = Summary {
         shm_leaked: leaked,
+        profile: profile.profile,
+        profile_reason: profile.profile_reason,
         ..summary
     };
     if args.json {

@@ -67,6 +67,15 @@ impl<T: Versioned + Debug + ZeroCopySend + Copy + 'static> StageInput<T> {
     ) -> Result<bool, IpcError> {
         strategy.wait(&self.topic, timeout)
     }
+
+    /// Sleeps `period`, then takes the notifications of the samples queued meanwhile off the
+    /// listener (so they neither pile up nor wake a later wait for nothing); returns whether a
+    /// sample is there.
+    pub fn sleep_for_batch(&self, period: Duration) -> Result<bool, IpcError> {
+        std::thread::sleep(period);
+        self.topic.clear_signals()?;
+        self.topic.has_samples()
+    }
 }
 
 /// A topic a stage publishes: each sample leaves stamped with the stage's publish time.

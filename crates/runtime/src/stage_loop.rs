@@ -74,6 +74,12 @@ pub trait PipelineStage {
         let _ = output;
     }
 
+    /// How long to sleep before reading the input instead of waiting for it, when the stage
+    /// reads in batches for now (a standby lane); `None`: wait the loop's way.
+    fn batch_period(&self) -> Option<Duration> {
+        None
+    }
+
     /// Once per wake-up, after the input was drained; `received` samples were read this time.
     fn after_input(&mut self, received: u64, counters: &mut Health) {
         let _ = (received, counters);
@@ -137,7 +143,10 @@ where
         stage: &mut S,
     ) -> Result<Health, IpcError> {
         while self.service.running() {
-            self.input.wait_with(&self.strategy, self.wait)?;
+            match stage.batch_period() {
+                Some(period) => self.input.sleep_for_batch(period.min(self.wait))?,
+                None => self.input.wait_with(&self.strategy, self.wait)?,
+            };
             let counters = &mut self.service.counters;
             stage.before_input(counters)?;
             let mut received = 0;

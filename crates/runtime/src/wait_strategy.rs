@@ -43,8 +43,11 @@ impl WaitStrategy {
     }
 }
 
-/// Polls `topic`'s queue for up to `limit`; the notifications the publisher sent meanwhile are
-/// taken off the listener, so that they neither pile up nor wake a later sleep for nothing.
+/// Polls `topic`'s queue for up to `limit`. The notifications the publisher sends meanwhile are
+/// taken off the listener only when the poll finds nothing (before a sleep, which they would
+/// otherwise cut short for nothing), not per sample found: that would cost a system call per
+/// sample on the path a polling stage exists to make short. Between, they wait in the listener's
+/// socket, which a publisher's notification finding full does not fail.
 fn poll<T>(topic: &TopicSubscriber<T>, limit: Duration) -> Result<bool, IpcError>
 where
     T: std::fmt::Debug + iceoryx2::prelude::ZeroCopySend + Copy + 'static,
@@ -52,7 +55,6 @@ where
     let until = Instant::now() + limit;
     loop {
         if topic.has_samples()? {
-            topic.clear_signals()?;
             return Ok(true);
         }
         if Instant::now() >= until {

@@ -21,6 +21,7 @@ use crate::aiding::hold::HOLD_US;
 use crate::aiding::readings::AidingQueue;
 use crate::ekf::AidingSource;
 use crate::held_inputs::HeldInputs;
+use crate::lanes::{SelectorConfig, StandbyPacer};
 use crate::navigator::{Navigator, fused_sample_usable};
 use crate::takeover::Handover;
 
@@ -162,6 +163,10 @@ struct NavigatorStage {
     peer_in: Option<TopicSubscriber<NavState>>,
     /// Whether this batch listens to the peer (the lane aligns and has one).
     listening: bool,
+    /// When the standby lane reads in batches (the standby of two lanes only).
+    pacer: Option<StandbyPacer>,
+    /// Whether it reads in batches, as last logged.
+    batching: bool,
     handover: Handover,
     resets: [u64; AidingSource::COUNT],
     /// The last state published.
@@ -192,12 +197,27 @@ impl PipelineStage for NavigatorStage {
         self.listening = self.peer_in.is_some()
             && self.nav.mode() == NavMode::Aligning
             && !self.nav.start_pending();
-        if let Some(peer_in) = self.peer_in.as_ref().filter(|_| self.listening) {
+        // The peer is read while this lane aligns (a solution to take over) and, on the standby,
+        // always (whether the primary serves).
+        if let Some(peer_in) = self
+            .peer_in
+            .as_ref()
+            .filter(|_| self.listening || self.pacer.is_some())
+        {
             while let Some(peer) = peer_in.receive()? {
-                self.handover.push_peer(peer);
+                if let Some(pacer) = &mut self.pacer {
+                    pacer.peer(&peer);
+                }
+                if self.listening {
+                    self.handover.push_peer(peer);
+                }
             }
         }
         Ok(())
+    }
+
+    fn batch_period(&self) -> Option<Duration> {
+        self.pacer.as_ref().and_then(StandbyPacer::batch_period)
     }
 
     fn step(&mut self, imu: &FusedImu) -> Step<NavState> {
@@ -206,6 +226,9 @@ impl PipelineStage for NavigatorStage {
         if self.last.header.origin_seq != 0 && imu.header.origin_seq <= self.last.header.origin_seq
         {
             return Step::Skip;
+        }
+        if let Some(pacer) = &mut self.pacer {
+            pacer.input(imu.header.origin_seq);
         }
         self.aiding
             .release_to(imu.header.origin_device_time_us, &mut self.nav);
@@ -234,6 +257,9 @@ impl PipelineStage for NavigatorStage {
     }
 
     fn published(&mut self, state: &NavState) {
+        if let Some(pacer) = &mut self.pacer {
+            pacer.own(state);
+        }
         let aligned = NavMode::from_u8(state.mode).is_some_and(|m| m != NavMode::Aligning);
         if aligned && state.integrity != self.last.integrity {
             log_integrity(state);
@@ -255,6 +281,18 @@ impl PipelineStage for NavigatorStage {
     }
 
     fn after_input(&mut self, _received: u64, counters: &mut Health) {
+        if let Some(pacer) = self
+            .pacer
+            .as_ref()
+            .filter(|p| p.batching() != self.batching)
+        {
+            // Rare: the primary failed or came back.
+            self.batching = pacer.batching();
+            match self.batching {
+                true => tracing::info!("standby: the primary serves; reading input in batches"),
+                false => tracing::info!("standby: serving sample by sample"),
+            }
+        }
         counters.lost = self.nav.rejected_imu_samples();
         counters.late = self.aiding.late();
         if self.aiding.late() != self.late_logged {
@@ -279,6 +317,8 @@ pub struct NavigatorService {
     pub lane: u8,
     /// How many lanes the deployment runs (1 or 2).
     pub lanes: u8,
+    /// The block's IMU rate, Hz: the standby's batches are sized by it.
+    pub imu_rate_hz: f64,
 }
 
 impl Service for NavigatorService {
@@ -306,7 +346,8 @@ impl Service for NavigatorService {
         // With two lanes, a lane that aligns listens to its peer: restarted in flight, it takes the
         // peer's solution over instead of waiting for a rest it will not get (see `takeover`).
         let peer_in = match lanes {
-            2 => Some(TopicSubscriber::<NavState>::new(
+            // Read between samples, never waited on: no listener for the peer to notify.
+            2 => Some(TopicSubscriber::<NavState>::polled(
                 &node,
                 names::NAV_LANES[usize::from(1 - lane)],
             )?),
@@ -327,6 +368,9 @@ impl Service for NavigatorService {
             held_in,
             peer_in,
             listening: false,
+            pacer: (kind == ServiceKind::NavigatorStandby)
+                .then(|| StandbyPacer::new(self.imu_rate_hz, SelectorConfig::default().settle)),
+            batching: false,
             handover: Handover::default(),
             last: NavState {
                 lane,

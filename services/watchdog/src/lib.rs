@@ -2,6 +2,7 @@
 //! topics, prints a status line per second and, at the end of a timed run, a summary.
 
 pub mod accuracy;
+pub mod child_exit_wait;
 pub mod config;
 pub mod deployment_checks;
 pub mod device_counters;

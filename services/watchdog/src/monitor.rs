@@ -78,19 +78,20 @@ pub struct Monitor {
 }
 
 impl Monitor {
-    /// Subscribes to every topic the watchdog counts, on `node`.
+    /// Subscribes to every topic the watchdog counts, on `node`. Polled: the loop drains them at
+    /// its turns and never waits on them, so no publisher spends a notification on the watchdog.
     pub fn new(node: &IpcNode) -> Result<Self> {
         Ok(Self {
-            imu: TopicSubscriber::new(node, names::RAW_IMU)?,
-            baro: TopicSubscriber::new(node, names::RAW_BARO)?,
-            mag: TopicSubscriber::new(node, names::RAW_MAG)?,
-            fused: TopicSubscriber::new(node, names::FUSED_IMU)?,
-            alt: TopicSubscriber::new(node, names::ALTITUDE)?,
-            nav: NavSubscriber::new(node)?,
-            truth: TopicSubscriber::new(node, names::TRUTH)?,
-            health: TopicSubscriber::new(node, names::HEARTBEAT)?,
-            fault_events: TopicSubscriber::new(node, names::SIM_FAULT_APPLIED)?,
-            gnss_link: TopicSubscriber::new(node, names::GNSS_LINK)?,
+            imu: TopicSubscriber::polled(node, names::RAW_IMU)?,
+            baro: TopicSubscriber::polled(node, names::RAW_BARO)?,
+            mag: TopicSubscriber::polled(node, names::RAW_MAG)?,
+            fused: TopicSubscriber::polled(node, names::FUSED_IMU)?,
+            alt: TopicSubscriber::polled(node, names::ALTITUDE)?,
+            nav: NavSubscriber::polled(node)?,
+            truth: TopicSubscriber::polled(node, names::TRUTH)?,
+            health: TopicSubscriber::polled(node, names::HEARTBEAT)?,
+            fault_events: TopicSubscriber::polled(node, names::SIM_FAULT_APPLIED)?,
+            gnss_link: TopicSubscriber::polled(node, names::GNSS_LINK)?,
             last_gnss_link: GnssLinkReport::default(),
             totals: [0; COUNTED.len()],
             nav_gaps: SeqGaps::default(),

@@ -10,7 +10,8 @@ use crate::summary::Summary;
 use crate::supervisor::Supervisor;
 
 /// The run's summary; the accuracy figures only when the simulator was the device (they compare
-/// with its truth). `shm_leaked` is left 0: it is known only once the shared memory is removed.
+/// with its truth). `shm_leaked` is left 0: it is known only once the shared memory is removed;
+/// `profile` and `profile_reason` are left empty: `rins up` chose them, not the watchdog.
 pub fn summarise(
     monitor: &Monitor,
     supervisor: &Supervisor,
@@ -73,6 +74,8 @@ pub fn summarise(
         horiz_end_err_m: sim(acc.horizontal.end_error_m()),
         horiz_end_err_pct: sim(acc.horizontal.end_error_pct()),
         shm_leaked: 0,
+        profile: String::new(),
+        profile_reason: String::new(),
         pipeline_cpu_pct: pipeline_cpu_pct(&usage),
         pipeline_wakeups_per_frame: pipeline_wakeups_per_frame(&usage, monitor.totals[0]),
         processes: usage,

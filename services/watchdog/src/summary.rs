@@ -162,6 +162,10 @@ pub struct Summary {
     pub horiz_end_err_pct: Option<f64>,
     /// Shared-memory entries of this deployment left after shutdown.
     pub shm_leaked: u64,
+    /// The deployment profile that ran (`rins up --profile`): `shared` or `dedicated`.
+    pub profile: String,
+    /// Why that profile ran: the CPUs counted and, under `dedicated`, which stage had which CPU.
+    pub profile_reason: String,
     /// CPU time and peak resident memory per process (`watchdog` is `rins up` itself), from
     /// `/proc`.
     pub processes: Vec<ProcessUsage>,

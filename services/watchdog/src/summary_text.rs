@@ -2,9 +2,9 @@
 
 use crate::summary::Summary;
 
-/// A few lines for a person: the run and its losses, then, in simulator mode, the navigation
-/// error against truth (attitude, altitude, and the horizontal end-point error as a share of the
-/// distance travelled), then the faults.
+/// A few lines for a person: the run and its losses, the deployment profile, then, in simulator
+/// mode, the navigation error against truth (attitude, altitude, and the horizontal end-point error
+/// as a share of the distance travelled), then the faults.
 pub fn summary_text(s: &Summary) -> String {
     let mut out = format!(
         "summary: {:.1} s, {} IMU frames, {} dropped, {} lost on the line, {} CRC errors, {} restarts, {} shared-memory entries left\n",
@@ -14,6 +14,12 @@ pub fn summary_text(s: &Summary) -> String {
         out.push_str(&format!(
             "  FAILED: {} given up (restarts kept failing); the stage was down at the end\n",
             s.failed_services.join(", ")
+        ));
+    }
+    if !s.profile.is_empty() {
+        out.push_str(&format!(
+            "  profile: {} — {}\n",
+            s.profile, s.profile_reason
         ));
     }
     if s.nav_lane_switches > 0 {
@@ -149,6 +155,8 @@ mod tests {
             horiz_end_err_m: Some(1.11),
             horiz_end_err_pct: Some(0.882),
             shm_leaked: 0,
+            profile: String::new(),
+            profile_reason: String::new(),
             processes: Vec::new(),
             pipeline_cpu_pct: 0.0,
             pipeline_wakeups_per_frame: 0.0,
@@ -218,6 +226,27 @@ mod tests {
         assert!(
             text.contains(
                 "navigation lane switches: 3 (silent 2, behind 0, ring full 0, untrusted 1); last lane 1 → 0 at seq 9: lane 1 aligning, lane 0 trusted\n"
+            ),
+            "{text}"
+        );
+    }
+
+    /// The profile is a line of its own, after the failures, absent when none was recorded.
+    #[test]
+    fn the_profile_is_named_with_its_reason() {
+        assert!(!summary_text(&summary()).contains("profile"));
+        let text = summary_text(&Summary {
+            profile: "dedicated".into(),
+            profile_reason: "dedicated as asked: 4 usable CPUs (acquisition on CPU 3, fusion on \
+                             2, navigator on 1; the rest on 0)"
+                .into(),
+            ..summary()
+        });
+        assert_eq!(
+            text.lines().nth(1),
+            Some(
+                "  profile: dedicated — dedicated as asked: 4 usable CPUs (acquisition on CPU 3, \
+                 fusion on 2, navigator on 1; the rest on 0)"
             ),
             "{text}"
         );

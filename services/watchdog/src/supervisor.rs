@@ -158,6 +158,11 @@ impl Supervisor {
         Ok(pid)
     }
 
+    /// When the earliest restart is due, if one is pending.
+    pub fn next_restart(&self) -> Option<Instant> {
+        self.children.iter().filter_map(|m| m.restart_at).min()
+    }
+
     /// Reaps exited children and restarts the ones whose backoff has passed.
     pub fn poll(&mut self, events: &mut Vec<ChildEvent>) {
         let now = Instant::now();

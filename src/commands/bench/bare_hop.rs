@@ -2,7 +2,7 @@
 //! with nothing of a pipeline stage in between. Both ends are the same iceoryx2 ports the stages
 //! use (`TopicPublisher`: loan, write, send, notify; `TopicSubscriber`: the listener's wait, then
 //! receive), on topics of their own but with the same service settings, the same payload types
-//! and the same wait strategy (the event wake-up). So the ratio of a pipeline hop to its bare hop
+//! and the same wait strategy (the receiving stage's `[wait]`). So the ratio of a pipeline hop to its bare hop
 //! is what the stage adds: its work, its other wake-ups, and the scheduler's share of them.
 //!
 //! The publisher paces samples at the block's rate and stamps each with its send time; the
@@ -21,6 +21,7 @@ use rins_runtime::clock::monotonic_ns;
 use rins_runtime::ipc::{IpcNode, TopicPublisher, TopicSubscriber};
 use rins_runtime::payload::Stamped;
 use rins_runtime::shutdown::Shutdown;
+use rins_runtime::wait_strategy::WaitStrategy;
 use serde::{Deserialize, Serialize};
 
 use crate::commands::latency::latency_histogram;
@@ -98,7 +99,14 @@ fn bare_hop(phase: &Phase, h: &Histogram<u64>) -> BareHop {
 /// The receiving process: subscribes to every phase's topic, says `ready`, then per phase waits,
 /// receives and records until the phase's end, says `done PAYLOAD`; finally prints one JSON line
 /// with every phase's figures.
-pub fn receive(node: &IpcNode, shutdown: &Shutdown, phase_limit: Duration) -> Result<()> {
+/// `strategies` are how each phase's receiver waits, in [`PHASES`] order: as the pipeline stage
+/// that receives that payload.
+pub fn receive(
+    node: &IpcNode,
+    strategies: [WaitStrategy; 3],
+    shutdown: &Shutdown,
+    phase_limit: Duration,
+) -> Result<()> {
     let raw = TopicSubscriber::<RawImu>::new(node, PHASES[0].topic)?;
     let fused = TopicSubscriber::<FusedImu>::new(node, PHASES[1].topic)?;
     let nav = TopicSubscriber::<NavState>::new(node, PHASES[2].topic)?;
@@ -107,9 +115,18 @@ pub fn receive(node: &IpcNode, shutdown: &Shutdown, phase_limit: Duration) -> Re
     out.flush()?;
     let mut results = Vec::new();
     for (phase, h) in [
-        (&PHASES[0], receive_phase(&raw, shutdown, phase_limit)?),
-        (&PHASES[1], receive_phase(&fused, shutdown, phase_limit)?),
-        (&PHASES[2], receive_phase(&nav, shutdown, phase_limit)?),
+        (
+            &PHASES[0],
+            receive_phase(&raw, strategies[0], shutdown, phase_limit)?,
+        ),
+        (
+            &PHASES[1],
+            receive_phase(&fused, strategies[1], shutdown, phase_limit)?,
+        ),
+        (
+            &PHASES[2],
+            receive_phase(&nav, strategies[2], shutdown, phase_limit)?,
+        ),
     ] {
         results.push(bare_hop(phase, &h));
     }
@@ -119,6 +136,7 @@ pub fn receive(node: &IpcNode, shutdown: &Shutdown, phase_limit: Duration) -> Re
 
 fn receive_phase<T: Stamped + std::fmt::Debug + ZeroCopySend + Copy + 'static>(
     topic: &TopicSubscriber<T>,
+    strategy: WaitStrategy,
     shutdown: &Shutdown,
     limit: Duration,
 ) -> Result<Histogram<u64>> {
@@ -128,7 +146,7 @@ fn receive_phase<T: Stamped + std::fmt::Debug + ZeroCopySend + Copy + 'static>(
         if shutdown.requested() || Instant::now() > give_up {
             bail!("{}: the phase did not end", topic.name());
         }
-        topic.wait(Duration::from_millis(50))?;
+        strategy.wait(topic, Duration::from_millis(50))?;
         while let Some(sample) = topic.receive()? {
             let now = monotonic_ns();
             let header = sample.header();
@@ -162,7 +180,7 @@ pub fn publish(
     Ok(())
 }
 
-fn expect_line(receiver: &mut impl BufRead, expected: &str) -> Result<()> {
+pub fn expect_line(receiver: &mut impl BufRead, expected: &str) -> Result<()> {
     let mut line = String::new();
     receiver
         .read_line(&mut line)
@@ -182,26 +200,44 @@ fn publish_phase<T: Stamped + Default + std::fmt::Debug + ZeroCopySend + Copy + 
     shutdown: &Shutdown,
 ) -> Result<()> {
     let publisher = TopicPublisher::<T>::new(node, phase.topic)?;
+    publish_paced(&publisher, rate_hz, 0..samples, false, shutdown)?;
+    expect_line(receiver, &format!("done {}", phase.topic))
+}
+
+/// Publishes one sample per sequence number of `seqs` at `rate_hz`, paced like the block (sleep to
+/// the tick, then send at once), each stamped as published by acquisition just before it is sent
+/// (and as received, when `as_received`: the bare chain's source stands for the serial line too);
+/// then the end of the phase, which the receivers' queues (sized for the block's rate) hold however
+/// late they wake.
+pub fn publish_paced<T: Stamped + Default + std::fmt::Debug + ZeroCopySend + Copy + 'static>(
+    publisher: &TopicPublisher<T>,
+    rate_hz: f64,
+    seqs: impl Iterator<Item = u64>,
+    as_received: bool,
+    shutdown: &Shutdown,
+) -> Result<()> {
     let period = Duration::from_secs_f64(1.0 / rate_hz);
     let mut next = Instant::now() + period;
     let mut sample = T::default();
-    for seq in 0..samples {
+    for seq in seqs {
         if shutdown.requested() {
             bail!("stopped");
         }
-        // Paced like the block: sleep to the tick, then send at once.
         let now = Instant::now();
         if next > now {
             std::thread::sleep(next - now);
         }
         next += period;
+        let t = monotonic_ns();
         let header = sample.header_mut();
         header.origin_seq = seq;
-        header.stamp(Stage::Acquisition, monotonic_ns());
+        if as_received {
+            header.origin_rx_ns = t;
+        }
+        header.stamp(Stage::Acquisition, t);
         publisher.publish(sample)?;
     }
-    // The end of the phase: the receiver's queue (512 samples) holds it however late it wakes.
     sample.header_mut().origin_seq = END_OF_PHASE;
     publisher.publish(sample)?;
-    expect_line(receiver, &format!("done {}", phase.topic))
+    Ok(())
 }

@@ -3,31 +3,40 @@
 //! ratio to the bare hop measured a minute before it.
 //!
 //! First the bare hops ([`bare_hop`]): this process publishes each payload type at the block's
-//! rate to a receiver process (`rins bench ipc-receiver`). Then the pipeline: `rins up` on the
-//! simulator, on a deployment of the bench's own (prefix and root), measured after its warm-up
-//! from the header stamps as `rins latency` does. Everything the bench started is stopped and its
-//! shared memory removed, whatever happens.
+//! rate to a receiver process (`rins bench ipc-receiver`). Then the bare chain ([`chain`]): three
+//! processes relaying the data path's payloads with no work, measured from the same stamps as the
+//! pipeline. Then the pipeline: `rins up` on the simulator, on a deployment of the bench's own
+//! (prefix and root), measured after its warm-up from the header stamps as `rins latency` does.
+//! All three wait the way the one configuration's `[wait]` says (`--wait` sets it for every
+//! stage). Everything the bench started is stopped and its shared memory removed, whatever
+//! happens.
 
 mod bare_hop;
+mod chain;
+mod deployment;
 mod rates;
 
+pub use chain::run_chain_process;
 pub use rates::run_rates;
 
 use std::io::BufReader;
-use std::path::PathBuf;
-use std::process::{Child, Command, Stdio};
+use std::path::Path;
+use std::process::Stdio;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
 use rins_navigator::lanes::NavSubscriber;
 use rins_runtime::ipc::{IpcSettings, create_node};
-use rins_runtime::shm_cleanup;
 use rins_runtime::shutdown::Shutdown;
+use rins_runtime::wait_strategy::WaitStrategy;
 use serde::Serialize;
 
 use crate::cli::BenchIpcArgs;
-use crate::commands::latency::{END_TO_END, HopReport, measure_hops};
+use crate::commands::latency::{END_TO_END, HopReport, TailRecorder, TailReport, measure_hops};
+use crate::config::RinsConfig;
 use bare_hop::{BareHop, PHASES};
+use chain::measure_chain;
+use deployment::{ChildGuard, Deployment, bench_config, wait_name, write_config};
 
 /// One pipeline hop beside its bare hop.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -61,6 +70,26 @@ pub struct BenchReport {
     pub e2e_p99_us: f64,
     /// See `e2e_p50_us`.
     pub e2e_p999_us: f64,
+    /// The bare chain's serial rx to navigation state published, µs.
+    pub chain_p50_us: f64,
+    /// See `chain_p50_us`.
+    pub chain_p99_us: f64,
+    /// See `chain_p50_us`.
+    pub chain_p999_us: f64,
+    /// `e2e_p50_us / chain_p50_us`.
+    pub ratio_chain_p50: f64,
+    /// `e2e_p99_us / chain_p99_us`.
+    pub ratio_chain_p99: f64,
+    /// `e2e_p999_us / chain_p999_us`.
+    pub ratio_chain_p999: f64,
+    /// Every hop of the bare chain, named as the pipeline's.
+    pub chain: Vec<HopReport>,
+    /// The pipeline's slowest 0.1 % end to end, hop by hop.
+    pub tail: Option<TailReport>,
+    /// The bare chain's, the same way.
+    pub chain_tail: Option<TailReport>,
+    /// How the stages waited: `event`, `spin`, `hybrid` (every stage), or `mixed`.
+    pub wait: String,
     /// The IPC hops against their bare hops.
     pub hops: Vec<ComparedHop>,
     /// Every pipeline hop as measured.
@@ -73,9 +102,12 @@ pub struct BenchReport {
     pub rate_hz: f64,
 }
 
+fn ratio(a: f64, b: f64) -> f64 {
+    if b > 0.0 { a / b } else { f64::NAN }
+}
+
 /// The pipeline's hops beside the bare ones of the same payload.
 pub fn compare(pipeline: &[HopReport], bare: &[BareHop]) -> Vec<ComparedHop> {
-    let ratio = |a: f64, b: f64| if b > 0.0 { a / b } else { f64::NAN };
     PHASES
         .iter()
         .filter_map(|phase| {
@@ -96,75 +128,6 @@ pub fn compare(pipeline: &[HopReport], bare: &[BareHop]) -> Vec<ComparedHop> {
         .collect()
 }
 
-/// The bench's own deployment: a prefix and a private root nobody else uses, removed at the end.
-struct Deployment {
-    settings: IpcSettings,
-    root: PathBuf,
-}
-
-impl Deployment {
-    fn new() -> Result<Self> {
-        let id = std::process::id();
-        let root = std::env::temp_dir().join(format!("rins-bench-{id}"));
-        let settings = IpcSettings::new(
-            format!("rinsbench{id}_"),
-            root.to_string_lossy().into_owned(),
-        );
-        settings.ensure_root()?;
-        Ok(Self { settings, root })
-    }
-
-    /// `rins ARGS` on this deployment.
-    fn command(&self, args: &[&str]) -> Result<Command> {
-        let exe = std::env::current_exe().context("cannot locate the rins executable")?;
-        let mut cmd = Command::new(exe);
-        cmd.args(args)
-            .env(rins_runtime::ipc::PREFIX_ENV, &self.settings.prefix)
-            .env(rins_runtime::ipc::ROOT_ENV, &self.settings.root);
-        Ok(cmd)
-    }
-}
-
-impl Drop for Deployment {
-    fn drop(&mut self) {
-        shm_cleanup::remove_all(&self.settings, true);
-        let _ = std::fs::remove_dir_all(&self.root);
-    }
-}
-
-/// A child stopped and reaped when dropped: SIGTERM, then SIGKILL after `grace`.
-struct ChildGuard {
-    child: Child,
-    grace: Duration,
-}
-
-impl ChildGuard {
-    fn stop(&mut self) {
-        if matches!(self.child.try_wait(), Ok(Some(_))) {
-            return;
-        }
-        if let Ok(pid) = i32::try_from(self.child.id()) {
-            // SAFETY: kill(2) with our own child's pid; no memory is passed.
-            unsafe { libc::kill(pid, libc::SIGTERM) };
-        }
-        let until = Instant::now() + self.grace;
-        while Instant::now() < until {
-            if matches!(self.child.try_wait(), Ok(Some(_))) {
-                return;
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-impl Drop for ChildGuard {
-    fn drop(&mut self) {
-        self.stop();
-    }
-}
-
 pub fn run_ipc(args: &BenchIpcArgs) -> Result<()> {
     if !(args.seconds.is_finite() && args.seconds >= 1.0 && args.seconds <= 3600.0) {
         bail!("--seconds {}: must be 1..=3600", args.seconds);
@@ -172,25 +135,53 @@ pub fn run_ipc(args: &BenchIpcArgs) -> Result<()> {
     if !(args.rate.is_finite() && (100.0..=16_000.0).contains(&args.rate)) {
         bail!("--rate {}: must be 100..=16000 Hz", args.rate);
     }
+    let config = bench_config(args)?;
     let shutdown = Shutdown::install()?;
-    let deployment = Deployment::new()?;
+    let bare_deployment = Deployment::new("b")?;
+    let config_path = write_config(&bare_deployment, &config)?;
     let samples = (args.seconds * args.rate).round() as u64;
-    progress(
-        args.json,
-        &format!(
-            "bare iceoryx2 hops: 3 payloads × {} s at {} Hz",
-            args.seconds, args.rate
-        ),
-    );
-    let bare = measure_bare(&deployment, args, samples, &shutdown)?;
-    progress(args.json, "pipeline: rins up --scenario uav, warming up");
-    let pipeline = measure_pipeline(&deployment, args, &shutdown)?;
-    let e2e = &pipeline[END_TO_END];
+    let wait = wait_name(&config);
+    progress(&format!(
+        "bare iceoryx2 hops: 3 payloads × {} s at {} Hz, wait {wait}",
+        args.seconds, args.rate
+    ));
+    let bare = measure_bare(&bare_deployment, args, &config_path, samples, &shutdown)?;
+    drop(bare_deployment);
+    progress("bare chain: 3 processes relaying, no work");
+    let chain_deployment = Deployment::new("c")?;
+    let config_path = write_config(&chain_deployment, &config)?;
+    // Room for every sample measured, and some for a pipeline that runs fast.
+    let room = (samples + samples / 10 + 1000) as usize;
+    let mut chain_tail = TailRecorder::new(room);
+    let chain = measure_chain(
+        &chain_deployment,
+        args,
+        &config_path,
+        samples,
+        (&shutdown, &mut chain_tail),
+    )?;
+    drop(chain_deployment);
+    progress("pipeline: rins up --scenario uav, warming up");
+    let deployment = Deployment::new("p")?;
+    let config_path = write_config(&deployment, &config)?;
+    let mut tail = TailRecorder::new(room);
+    let pipeline = measure_pipeline(&deployment, args, &config_path, (&shutdown, &mut tail))?;
+    let (e2e, floor) = (&pipeline[END_TO_END], &chain[END_TO_END]);
     let report = BenchReport {
         e2e_p50_us: e2e.p50_us,
         e2e_p99_us: e2e.p99_us,
         e2e_p999_us: e2e.p999_us,
+        chain_p50_us: floor.p50_us,
+        chain_p99_us: floor.p99_us,
+        chain_p999_us: floor.p999_us,
+        ratio_chain_p50: ratio(e2e.p50_us, floor.p50_us),
+        ratio_chain_p99: ratio(e2e.p99_us, floor.p99_us),
+        ratio_chain_p999: ratio(e2e.p999_us, floor.p999_us),
+        wait,
+        tail: tail.report(),
+        chain_tail: chain_tail.report(),
         hops: compare(&pipeline, &bare),
+        chain,
         pipeline,
         bare,
         seconds: args.seconds,
@@ -204,21 +195,29 @@ pub fn run_ipc(args: &BenchIpcArgs) -> Result<()> {
     Ok(())
 }
 
-fn progress(json: bool, what: &str) {
+fn progress(what: &str) {
     // The JSON document is stdout's only line; progress goes to stderr either way.
-    let _ = json;
     eprintln!("rins bench ipc: {what}");
 }
 
 fn measure_bare(
     deployment: &Deployment,
     args: &BenchIpcArgs,
+    config: &Path,
     samples: u64,
     shutdown: &Shutdown,
 ) -> Result<Vec<BareHop>> {
     let phase_limit = format!("{}", args.seconds * 3.0 + 30.0);
+    let config = config.to_string_lossy();
     let child = deployment
-        .command(&["bench", "ipc-receiver", "--phase-limit", &phase_limit])?
+        .command(&[
+            "bench",
+            "ipc-receiver",
+            "--phase-limit",
+            &phase_limit,
+            "--config",
+            &config,
+        ])?
         .stdout(Stdio::piped())
         .stderr(Stdio::inherit())
         .spawn()
@@ -247,7 +246,8 @@ fn measure_bare(
 fn measure_pipeline(
     deployment: &Deployment,
     args: &BenchIpcArgs,
-    shutdown: &Shutdown,
+    config: &Path,
+    (shutdown, tail): (&Shutdown, &mut TailRecorder),
 ) -> Result<Vec<HopReport>> {
     // Long enough for a slow start and the measurement; stopped as soon as it is done.
     let duration = format!("{}", args.seconds + args.warmup + 300.0);
@@ -261,6 +261,8 @@ fn measure_pipeline(
             &duration,
             "--imu-rate",
             &rate,
+            "--config",
+            &config.to_string_lossy(),
             "--json",
         ])?
         .stdout(Stdio::null())
@@ -293,11 +295,8 @@ fn measure_pipeline(
         }
     }
     std::thread::sleep(Duration::from_secs_f64(args.warmup));
-    progress(
-        args.json,
-        &format!("pipeline: measuring {} s", args.seconds),
-    );
-    let hops = measure_hops(&node, Duration::from_secs_f64(args.seconds), shutdown)?;
+    progress(&format!("pipeline: measuring {} s", args.seconds));
+    let hops = measure_hops(&node, Duration::from_secs_f64(args.seconds), shutdown, tail)?;
     drop(node);
     guard.stop();
     if hops[END_TO_END].samples == 0 {
@@ -321,14 +320,55 @@ fn print_table(r: &BenchReport) {
         "serial rx -> nav state published: p50 {:.1} µs, p99 {:.1} µs, p99.9 {:.1} µs",
         r.e2e_p50_us, r.e2e_p99_us, r.e2e_p999_us
     );
+    println!(
+        "bare chain (3 processes, no work, wait {}): p50 {:.1} µs, p99 {:.1} µs, p99.9 {:.1} µs; pipeline × {:.2} / {:.2} / {:.2}",
+        r.wait,
+        r.chain_p50_us,
+        r.chain_p99_us,
+        r.chain_p999_us,
+        r.ratio_chain_p50,
+        r.ratio_chain_p99,
+        r.ratio_chain_p999
+    );
+    for (what, tail) in [("pipeline", &r.tail), ("bare chain", &r.chain_tail)] {
+        if let Some(t) = tail {
+            let hops: Vec<String> = t
+                .hops
+                .iter()
+                .map(|h| format!("{} {:.0} µs (longest in {})", h.hop, h.mean_us, h.dominant))
+                .collect();
+            println!(
+                "{what}'s slowest {} samples (≥ {:.0} µs): {}",
+                t.samples,
+                t.threshold_us,
+                hops.join("; ")
+            );
+        }
+    }
+}
+
+/// The wait strategies of the bare hops' receivers, in [`bare_hop::PHASES`] order: as the
+/// pipeline stage that receives each payload (the navigation state's consumer sleeps on events).
+fn receiver_strategies(config: &RinsConfig) -> [WaitStrategy; 3] {
+    [
+        config.wait.for_service("fusion"),
+        config.wait.for_service("navigator"),
+        WaitStrategy::Event,
+    ]
 }
 
 /// `rins bench ipc-receiver`: the receiving end of the bare hops.
-pub fn run_receiver(phase_limit_s: f64) -> Result<()> {
+pub fn run_receiver(phase_limit_s: f64, config: &Path) -> Result<()> {
+    let config = crate::config::load(Some(config))?;
     let shutdown = Shutdown::install()?;
     let settings = IpcSettings::from_env();
     let node = create_node("bench-receiver", &settings)?;
-    bare_hop::receive(&node, &shutdown, Duration::from_secs_f64(phase_limit_s))
+    bare_hop::receive(
+        &node,
+        receiver_strategies(&config),
+        &shutdown,
+        Duration::from_secs_f64(phase_limit_s),
+    )
 }
 
 #[cfg(test)]

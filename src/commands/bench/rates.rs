@@ -196,7 +196,7 @@ pub fn run_rates(args: &BenchRatesArgs) -> Result<()> {
         let (gyro_sigma, accel_sigma) = per_sample_sigmas(&cfg)?;
         step += 1;
         progress(step, total, rate, "fault-free run with latency");
-        let deployment = Deployment::new()?;
+        let deployment = Deployment::new("r")?;
         let (summary, e2e) = run_up(&deployment, args, rate, &[], true, &shutdown)?;
         drop(deployment);
         let mut row = RateRow {
@@ -217,7 +217,7 @@ pub fn run_rates(args: &BenchRatesArgs) -> Result<()> {
             step += 1;
             let names: Vec<String> = faults.iter().map(InjectedFault::spec).collect();
             progress(step, total, rate, &names.join(" "));
-            let deployment = Deployment::new()?;
+            let deployment = Deployment::new("f")?;
             let (summary, _) = run_up(&deployment, args, rate, &names, false, &shutdown)?;
             row.fault_run_false_alarms += false_alarms(&summary);
             row.faults
@@ -342,7 +342,14 @@ fn measure_latency(
     }
     drop(nav);
     std::thread::sleep(Duration::from_secs(2));
-    let hops = measure_hops(&node, Duration::from_secs_f64(duration_s / 3.0), shutdown)?;
+    // The tail is not reported per rate: a recorder of no capacity keeps nothing.
+    let mut tail = crate::commands::latency::TailRecorder::new(0);
+    let hops = measure_hops(
+        &node,
+        Duration::from_secs_f64(duration_s / 3.0),
+        shutdown,
+        &mut tail,
+    )?;
     let e2e = &hops[END_TO_END];
     Ok((e2e.samples > 0).then_some((e2e.p50_us, e2e.p99_us)))
 }

@@ -2,7 +2,10 @@
 //! optionally every sample's path as a Chrome trace and the hops as HDR interval logs.
 
 mod hdr_log;
+mod tail;
 mod trace;
+
+pub use tail::{TailRecorder, TailReport};
 
 use std::io::{BufWriter, Write};
 use std::path::Path;
@@ -235,6 +238,55 @@ fn write_intervals<W: Write>(
     Ok(())
 }
 
+/// How many of [`HOPS`] a navigation sample's stamps give (the altimeter's is the rest).
+const PATH_HOPS: usize = 5;
+
+/// The data path's hops of one navigation sample received at `now` (ns).
+fn record_path(hops: &mut [Hop], s: &ipc_types::NavState, now: u64) {
+    let h = &s.header;
+    let (rx, acq, fus, navp) = (
+        h.origin_rx_ns,
+        stage(h, Stage::Acquisition),
+        stage(h, Stage::Fusion),
+        stage(h, Stage::Navigator),
+    );
+    hops[0].record(rx, acq);
+    hops[1].record(acq, fus);
+    hops[2].record(fus, navp);
+    hops[3].record(rx, navp);
+    hops[4].record(navp, now);
+}
+
+/// The data path's hops recorded sample by sample, for a measurement that reads the navigation
+/// stream itself (the bench's bare chain): the same hops and names as the pipeline's.
+pub struct PathHops {
+    hops: [Hop; PATH_HOPS],
+}
+
+impl PathHops {
+    pub fn new() -> Result<Self> {
+        Ok(Self {
+            hops: [
+                Hop::new(HOPS[0])?,
+                Hop::new(HOPS[1])?,
+                Hop::new(HOPS[2])?,
+                Hop::new(HOPS[3])?,
+                Hop::new(HOPS[4])?,
+            ],
+        })
+    }
+
+    /// One navigation sample received at `now` (ns).
+    pub fn record(&mut self, s: &ipc_types::NavState, now: u64) {
+        record_path(&mut self.hops, s, now);
+    }
+
+    /// Every hop's percentiles, in [`HOPS`] order.
+    pub fn reports(&self) -> Vec<HopReport> {
+        self.hops.iter().map(report).collect()
+    }
+}
+
 /// Measures the hops of the deployment `node` belongs to for `length` (or until `shutdown`):
 /// the navigation stream consumers see (both lanes through the lane selector) and the altitude.
 /// `on_nav` sees each navigation sample and its receive time; `on_turn` the hops after each
@@ -261,18 +313,7 @@ fn measure(
         nav.wait(Duration::from_millis(50))?;
         while let Some(s) = nav.receive()? {
             let now = monotonic_ns();
-            let h = &s.header;
-            let (rx, acq, fus, navp) = (
-                h.origin_rx_ns,
-                stage(h, Stage::Acquisition),
-                stage(h, Stage::Fusion),
-                stage(h, Stage::Navigator),
-            );
-            hops[0].record(rx, acq);
-            hops[1].record(acq, fus);
-            hops[2].record(fus, navp);
-            hops[3].record(rx, navp);
-            hops[4].record(navp, now);
+            record_path(&mut hops[..PATH_HOPS], &s, now);
             on_nav(&s, now);
         }
         while let Some(a) = alt.receive()? {
@@ -288,11 +329,13 @@ fn measure(
 
 /// The hops of the deployment `node` belongs to over `length`: what `rins bench ipc` compares
 /// with the bare transport.
+/// Every navigation sample is also given to `tail`.
 pub fn measure_hops(
     node: &rins_runtime::ipc::IpcNode,
     length: Duration,
     shutdown: &Shutdown,
+    tail: &mut TailRecorder,
 ) -> Result<Vec<HopReport>> {
-    let hops = measure(node, length, shutdown, |_, _| {}, |_| Ok(()))?;
+    let hops = measure(node, length, shutdown, |s, _| tail.record(s), |_| Ok(()))?;
     Ok(hops.iter().map(report).collect())
 }

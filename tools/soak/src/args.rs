@@ -20,6 +20,9 @@ pub struct SoakArgs {
     pub faults: String,
     /// Print the summary as one JSON object (stdout holds nothing else) instead of text.
     pub json: bool,
+    /// The deployment profile `rins up` runs with (its `--profile`): `shared`, `dedicated` or
+    /// `auto`; `rins up` checks it.
+    pub profile: String,
 }
 
 /// Checks the arguments (each error names the option and its value); returns the fault kinds asked for.

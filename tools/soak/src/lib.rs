@@ -39,6 +39,9 @@ use fault_ledger::FaultLedger;
 use fault_plan::{Fault, FaultKind};
 use nav_watch::NavWatch;
 
+/// How `rins` starts the line of an error it exits with.
+const UP_ERROR: &str = "rins: error:";
+
 /// Quiet time at the end of the run, beyond the longest recovery of the kinds asked for, so the
 /// last fault is over and every service publishing again when the pipeline is stopped.
 const SETTLE: Duration = Duration::from_secs(3);
@@ -252,6 +255,8 @@ pub fn run(args: &SoakArgs) -> Result<()> {
             "--duration",
             &format!("{}", run_s + 60.0),
             "--json",
+            "--profile",
+            &args.profile,
         ])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -265,16 +270,27 @@ pub fn run(args: &SoakArgs) -> Result<()> {
     let (status_tx, status_lines) = std::sync::mpsc::channel::<String>();
     let stderr = up.stderr.take().context("rins up has no stderr")?;
     let status_reader = std::thread::spawn(move || {
-        forward_lines(stderr, &status_tx, |l| l.starts_with("t="));
+        forward_lines(stderr, &status_tx, |l| {
+            l.starts_with("t=") || l.starts_with(UP_ERROR)
+        });
     });
     // Join the deployment only once the watchdog runs (its first status line): it refuses to
     // start while another process holds a node on the prefix, and this one would be such a
     // process.
-    if status_lines.recv_timeout(Duration::from_secs(120)).is_err() {
-        // SAFETY: SIGTERM to our own child, not reaped yet.
-        unsafe { libc::kill(up.id() as libc::pid_t, libc::SIGTERM) };
-        let status = up.wait()?;
-        bail!("rins up printed nothing within 120 s ({status})");
+    match status_lines.recv_timeout(Duration::from_secs(120)) {
+        Ok(line) if line.starts_with(UP_ERROR) => {
+            // It refused to start (a --profile the machine cannot run, say): its own words.
+            let status = up.wait()?;
+            let why = line.trim_start_matches(UP_ERROR).trim();
+            bail!("rins up did not start ({status}): {why}");
+        }
+        Ok(_) => {}
+        Err(_) => {
+            // SAFETY: SIGTERM to our own child, not reaped yet.
+            unsafe { libc::kill(up.id() as libc::pid_t, libc::SIGTERM) };
+            let status = up.wait()?;
+            bail!("rins up printed nothing within 120 s ({status})");
+        }
     }
     // The deployment is the one this soak started, so its own user's: checked like any other
     // before it is joined (another user's files on the prefix are never read).
@@ -426,6 +442,7 @@ pub fn run(args: &SoakArgs) -> Result<()> {
         .and_then(|l| serde_json::from_str(&l).ok())
         .with_context(|| format!("rins up ended ({status}) without its JSON summary"))?;
     let number = |key: &str| up_summary[key].as_u64().unwrap_or(0);
+    let text = |key: &str| up_summary[key].as_str().unwrap_or_default().to_string();
     let summary = SoakSummary {
         minutes: start.elapsed().as_secs_f64() / 60.0,
         kills: ledger.count(FaultKind::Kill),
@@ -439,6 +456,8 @@ pub fn run(args: &SoakArgs) -> Result<()> {
         faults_deferred: deferred,
         faults: ledger.figures().clone(),
         shm_leaked: number("shm_leaked"),
+        profile: text("profile"),
+        profile_reason: text("profile_reason"),
     };
     if args.json {
         println!("{}", serde_json::to_string(&summary)?);

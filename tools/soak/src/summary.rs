@@ -34,6 +34,10 @@ pub struct SoakSummary {
     pub faults: std::collections::BTreeMap<&'static str, KindFigures>,
     /// Shared-memory entries left after the pipeline stopped (from the watchdog's summary).
     pub shm_leaked: u64,
+    /// The deployment profile that ran, `shared` or `dedicated` (from the watchdog's summary).
+    pub profile: String,
+    /// Why (from the watchdog's summary).
+    pub profile_reason: String,
 }
 
 impl SoakSummary {
@@ -44,6 +48,12 @@ impl SoakSummary {
             "soak: {:.1} min, {} kills, {} restarts, {} faults deferred, {} shared-memory entries left\n",
             self.minutes, self.kills, self.restarts, self.faults_deferred, self.shm_leaked
         );
+        if !self.profile.is_empty() {
+            out.push_str(&format!(
+                "profile: {} — {}\n",
+                self.profile, self.profile_reason
+            ));
+        }
         out.push_str(&format!(
             "navigation: {} samples, {} lost, longest gap {:.1} ms, {} not navigating, {} lane switches, {} filled from the other lane\n",
             self.nav_samples,
@@ -81,6 +91,8 @@ mod tests {
             restarts: 3,
             nav_samples: 120_000,
             lost_nav_samples: 7,
+            profile: "shared".into(),
+            profile_reason: "auto: 2 usable CPUs, 2 free; dedicated needs 4: shared".into(),
             ..SoakSummary::default()
         };
         let mut kill = KindFigures {
@@ -97,6 +109,12 @@ mod tests {
             "{text}"
         );
         assert!(text.contains("120000 samples, 7 lost"), "{text}");
+        assert!(
+            text.contains(
+                "\nprofile: shared — auto: 2 usable CPUs, 2 free; dedicated needs 4: shared\n"
+            ),
+            "{text}"
+        );
         assert!(
             text.contains("  kill: 3 faults (altimeter ×1, fusion ×2), 7 samples lost"),
             "{text}"

@@ -133,8 +133,9 @@ impl<T: Debug + ZeroCopySend + 'static> TopicPublisher<T> {
 pub struct TopicSubscriber<T: Debug + ZeroCopySend + 'static> {
     subscriber: Subscriber<ipc::Service, T, ()>,
     /// Shared with a [`super::TopicWaitSet`] that waits on this topic among others: the wait set
-    /// keeps the listener attached for as long as it lives.
-    listener: Rc<Listener<ipc::Service>>,
+    /// keeps the listener attached for as long as it lives. None for a subscriber that only polls
+    /// ([`TopicSubscriber::polled`]).
+    listener: Option<Rc<Listener<ipc::Service>>>,
     name: &'static str,
     /// Samples of another payload version received since start. A `Cell`: receiving takes `&self`
     /// (the port is not shared between threads).
@@ -142,8 +143,19 @@ pub struct TopicSubscriber<T: Debug + ZeroCopySend + 'static> {
 }
 
 impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
-    /// Opens (or creates) topic `name` and a subscriber on it.
+    /// Opens (or creates) topic `name` and a subscriber on it, with a listener to wait on.
     pub fn new(node: &IpcNode, name: &'static str) -> Result<Self, IpcError> {
+        Self::open(node, name, true)
+    }
+
+    /// A subscriber without a listener, for a reader that only polls (the watchdog's counts, a
+    /// lane's look at its peer): the publisher then has one listener fewer to notify on every
+    /// sample, a system call off the data path. Waiting on it only sleeps.
+    pub fn polled(node: &IpcNode, name: &'static str) -> Result<Self, IpcError> {
+        Self::open(node, name, false)
+    }
+
+    fn open(node: &IpcNode, name: &'static str, listen: bool) -> Result<Self, IpcError> {
         let subscriber = open_pubsub::<T>(node, name)?
             .subscriber_builder()
             .create()
@@ -152,16 +164,21 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
                 source,
             })?;
         super::own_ports::record_receiver(subscriber.id().value());
-        let listener = open_event(node, name)?
-            .listener_builder()
-            .create()
-            .map_err(|source| IpcError::Listener {
-                topic: name,
-                source,
-            })?;
+        let listener = match listen {
+            true => Some(Rc::new(
+                open_event(node, name)?
+                    .listener_builder()
+                    .create()
+                    .map_err(|source| IpcError::Listener {
+                        topic: name,
+                        source,
+                    })?,
+            )),
+            false => None,
+        };
         Ok(Self {
             subscriber,
-            listener: Rc::new(listener),
+            listener,
             name,
             rejected: Cell::new(0),
         })
@@ -169,7 +186,11 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
 
     /// Sleeps until a publisher signals new data or `timeout` passes. Returns whether a signal came.
     pub fn wait(&self, timeout: Duration) -> Result<bool, IpcError> {
-        match self.listener.timed_wait(|_| {}, timeout) {
+        let Some(listener) = &self.listener else {
+            std::thread::sleep(timeout);
+            return Ok(false);
+        };
+        match listener.timed_wait(|_| {}, timeout) {
             Ok(woken) => Ok(woken > 0),
             // A signal (the termination request the caller polls for) cut the wait short.
             Err(ListenerWaitError::InterruptSignal) => Ok(false),
@@ -192,7 +213,10 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
 
     /// Takes every pending notification off the listener without sleeping (a poller's chore).
     pub fn clear_signals(&self) -> Result<(), IpcError> {
-        match self.listener.try_wait(|_| {}) {
+        let Some(listener) = &self.listener else {
+            return Ok(());
+        };
+        match listener.try_wait(|_| {}) {
             Ok(_) | Err(ListenerWaitError::InterruptSignal) => Ok(()),
             Err(source) => Err(IpcError::Wait {
                 topic: self.name,
@@ -206,9 +230,9 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> TopicSubscriber<T> {
         self.name
     }
 
-    /// The listener a [`super::TopicWaitSet`] attaches (and keeps attached).
-    pub(super) fn listener(&self) -> Rc<Listener<ipc::Service>> {
-        Rc::clone(&self.listener)
+    /// The listener a [`super::TopicWaitSet`] attaches (and keeps attached); none when polled.
+    pub(super) fn listener(&self) -> Option<Rc<Listener<ipc::Service>>> {
+        self.listener.clone()
     }
 }
 

@@ -55,10 +55,15 @@ impl TopicWaitSet {
             .signal_handling_mode(SignalHandlingMode::Disabled)
             .create::<ipc::Service>()
             .map_err(|source| IpcError::WaitSetCreate { source })?;
-        let names: Vec<&'static str> = topics.iter().map(|t| t.name()).collect();
+        // A polled topic has no listener to attach: the wait never wakes for it.
+        let listening: Vec<_> = topics
+            .iter()
+            .filter_map(|t| Some((t.name(), t.listener()?)))
+            .collect();
+        let names: Vec<&'static str> = listening.iter().map(|(name, _)| *name).collect();
         let owner = Attachable {
             waitset,
-            listeners: topics.iter().map(|t| t.listener()).collect(),
+            listeners: listening.into_iter().map(|(_, l)| l).collect(),
         };
         let attached = AttachedTopics::try_new(owner, |owner| {
             owner

@@ -7,9 +7,11 @@
 //!   sequence (pure, allocation-free after construction);
 //! - [`trust`]: whether a lane's solution may be chosen for its quality;
 //! - [`switch`]: a lane change, its cause, and the changes counted by cause;
-//! - [`subscriber`]: both lanes' topics read and merged for a consumer process.
+//! - [`subscriber`]: both lanes' topics read and merged for a consumer process;
+//! - [`standby`]: when the standby lane reads its input in batches.
 
 pub mod selector;
+pub mod standby;
 pub mod subscriber;
 pub mod switch;
 #[cfg(test)]
@@ -17,6 +19,7 @@ mod test_samples;
 pub mod trust;
 
 pub use selector::{LANES, LaneSelector, PENDING, SelectorConfig};
+pub use standby::StandbyPacer;
 pub use subscriber::NavSubscriber;
 pub use switch::{Switch, SwitchCounts, SwitchReason};
 pub use trust::{Distrust, distrust, trusted};

@@ -143,6 +143,11 @@ impl LaneSelector {
         self.pending.get(lane).is_some_and(|q| q.len() < PENDING)
     }
 
+    /// Sequence number of `lane`'s oldest pending sample.
+    pub fn next_seq(&self, lane: usize) -> Option<u64> {
+        self.pending.get(lane)?.front().map(|s| s.header.origin_seq)
+    }
+
     /// Pending samples overwritten because a lane's ring was full (a consumer that pushes without
     /// asking [`LaneSelector::has_room`]).
     pub fn overwritten(&self) -> u64 {

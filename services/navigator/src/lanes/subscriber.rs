@@ -27,10 +27,22 @@ pub struct NavSubscriber {
 impl NavSubscriber {
     /// Subscribes to both lanes on `node`.
     pub fn new(node: &IpcNode) -> Result<Self, IpcError> {
-        let lanes = [
+        Self::with_lanes([
             TopicSubscriber::new(node, names::NAV_LANES[0])?,
             TopicSubscriber::new(node, names::NAV_LANES[1])?,
-        ];
+        ])
+    }
+
+    /// Subscribes to both lanes on `node` for a reader that only polls (no listener for the lanes
+    /// to notify; [`NavSubscriber::wait`] only sleeps).
+    pub fn polled(node: &IpcNode) -> Result<Self, IpcError> {
+        Self::with_lanes([
+            TopicSubscriber::polled(node, names::NAV_LANES[0])?,
+            TopicSubscriber::polled(node, names::NAV_LANES[1])?,
+        ])
+    }
+
+    fn with_lanes(lanes: [TopicSubscriber<NavState>; LANES]) -> Result<Self, IpcError> {
         let [a, b] = &lanes;
         let waitset = TopicWaitSet::new(&[a, b])?;
         Ok(Self {
@@ -46,7 +58,8 @@ impl NavSubscriber {
     /// Next sample of the merged stream, if one is due. Takes one sample of each lane at a time,
     /// so that a backlog (a consumer that slept) waits in the lanes' queues, which are deep, and
     /// not in the selector's ring, which holds only what a switch needs; a lane whose ring is full
-    /// is left in its queue until the selected lane delivers or is found dead.
+    /// is left in its queue until the selected lane delivers or is found dead. The other lane is
+    /// then taken up to the selected lane's next sample ([`Self::catch_up`]).
     pub fn receive(&mut self) -> Result<Option<NavState>, IpcError> {
         let now_ns = monotonic_ns();
         loop {
@@ -56,21 +69,41 @@ impl NavSubscriber {
                 return Ok(Some(s));
             }
             let mut pulled = false;
-            for (lane, sub) in self.lanes.iter().enumerate() {
-                if !self.selector.has_room(lane) {
-                    continue;
-                }
-                if let Some(s) = sub.receive()? {
-                    self.lane_totals[lane] += 1;
-                    self.lane_latest[lane] = Some(s);
-                    self.selector.push(lane, s);
-                    pulled = true;
-                }
+            for lane in 0..LANES {
+                pulled |= self.selector.has_room(lane) && self.pull(lane)?;
             }
             if !pulled {
                 return Ok(None);
             }
+            self.catch_up()?;
         }
+    }
+
+    /// One sample of `lane` into the selector; whether there was one.
+    fn pull(&mut self, lane: usize) -> Result<bool, IpcError> {
+        let Some(s) = self.lanes[lane].receive()? else {
+            return Ok(false);
+        };
+        self.lane_totals[lane] += 1;
+        self.lane_latest[lane] = Some(s);
+        self.selector.push(lane, s);
+        Ok(true)
+    }
+
+    /// Pulls the other lane up to the selected lane's next sample. A hole in the selected lane is
+    /// filled only from what the selector already holds, and the other lane may publish in
+    /// batches (the standby reads its input in batches while the primary serves): one sample of
+    /// it per round would leave the rest of a hole unfilled.
+    fn catch_up(&mut self) -> Result<(), IpcError> {
+        let other = 1 - self.selector.selected();
+        let Some(next) = self.selector.next_seq(self.selector.selected()) else {
+            return Ok(());
+        };
+        while self.lane_latest[other].is_none_or(|s| s.header.origin_seq + 1 < next)
+            && self.selector.has_room(other)
+            && self.pull(other)?
+        {}
+        Ok(())
     }
 
     /// One log line per switch, naming its cause; nothing while the lane stays.
