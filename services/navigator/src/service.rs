@@ -296,12 +296,23 @@ impl PipelineStage for NavigatorStage {
         counters.lost = self.nav.rejected_imu_samples();
         counters.late = self.aiding.late();
         if self.aiding.late() != self.late_logged {
-            // Rare by design (the hold is long): each one means the lanes may differ slightly.
-            tracing::warn!(
-                late = self.aiding.late(),
-                hold_us = HOLD_US,
-                "aiding readings arrived after their place in the IMU stream"
-            );
+            // Rare by design (the hold is long): each one means the lanes may differ slightly. While
+            // the lane aligns no filter runs for them to differ in, and a reading late at the start
+            // (the altimeter's first output on a loaded machine, behind a primary that no longer
+            // shares its CPU with the standby) is no news: counted, logged at debug.
+            if self.nav.mode() == NavMode::Aligning {
+                tracing::debug!(
+                    late = self.aiding.late(),
+                    hold_us = HOLD_US,
+                    "aiding readings arrived after their place in the IMU stream while aligning"
+                );
+            } else {
+                tracing::warn!(
+                    late = self.aiding.late(),
+                    hold_us = HOLD_US,
+                    "aiding readings arrived after their place in the IMU stream"
+                );
+            }
             self.late_logged = self.aiding.late();
         }
     }
