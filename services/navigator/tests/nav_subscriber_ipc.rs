@@ -63,3 +63,47 @@ fn a_backlog_of_both_lanes_is_delivered_whole() {
     let _ = std::fs::remove_dir_all(&settings.root);
     assert!(shm_cleanup::shm_entries(&settings).is_empty());
 }
+
+/// The standby publishes in batches while the primary serves. A primary that skips samples (it took
+/// the standby's solution over) leaves a hole the standby's batch covers: the consumer fills all of
+/// it, not only the first sample, even though the batch and the primary's next sample are queued
+/// together.
+#[test]
+fn a_hole_in_the_primary_is_filled_whole_from_the_standbys_batch() {
+    let settings = IpcSettings::new(
+        format!("lnavhole{}_", std::process::id()),
+        std::env::temp_dir()
+            .join(format!("lnavhole{}root/", std::process::id()))
+            .to_string_lossy()
+            .into_owned(),
+    );
+    {
+        let node = create_node("lanes", &settings).expect("node");
+        let mut sub = NavSubscriber::new(&node).expect("subscriber");
+        let primary = TopicPublisher::<NavState>::new(&node, names::NAV_LANES[0]).expect("lane 0");
+        let standby = TopicPublisher::<NavState>::new(&node, names::NAV_LANES[1]).expect("lane 1");
+        for seq in 1..=10 {
+            primary.publish(nav(0, seq)).expect("publish");
+        }
+        let mut got = Vec::new();
+        while let Some(s) = sub.receive().expect("receive") {
+            got.push(s.header.origin_seq);
+        }
+        // The standby's batch up to 22, then the primary goes on at 23 (11..=22 skipped).
+        for seq in 1..=22 {
+            standby.publish(nav(1, seq)).expect("publish");
+        }
+        for seq in 23..=30 {
+            primary.publish(nav(0, seq)).expect("publish");
+        }
+        while let Some(s) = sub.receive().expect("receive") {
+            got.push(s.header.origin_seq);
+        }
+        assert_eq!(got, (1..=30).collect::<Vec<_>>());
+        assert_eq!(sub.selected_lane(), 0, "a hole is filled, not switched for");
+        assert_eq!(sub.filled(), 12);
+    }
+    shm_cleanup::remove_all(&settings, true);
+    let _ = std::fs::remove_dir_all(&settings.root);
+    assert!(shm_cleanup::shm_entries(&settings).is_empty());
+}
