@@ -15,31 +15,18 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ipc_types::NavState;
-use rins_runtime::ipc::{IpcSettings, TopicPublisher, TopicSubscriber, create_node};
-use rins_runtime::shm_cleanup;
-
-fn settings() -> IpcSettings {
-    let id = std::process::id();
-    IpcSettings::new(
-        format!("rtbench{id}_"),
-        std::env::temp_dir()
-            .join(format!("rtbench{id}root/"))
-            .to_string_lossy()
-            .into_owned(),
-    )
-}
+use rins_runtime::ipc::{TopicPublisher, TopicSubscriber};
+use rins_test_support::private_ipc::on_private_node;
 
 fn publish(c: &mut Criterion) {
-    let settings = settings();
-    {
-        let node = create_node("bench", &settings).expect("node");
+    on_private_node("notifybench", |node| {
         for listeners in [0usize, 1, 3] {
             let topic: &'static str = ["notify-0", "notify-1", "notify-3"][listeners.min(2)];
-            let polled = TopicSubscriber::<NavState>::polled(&node, topic).expect("subscriber");
+            let polled = TopicSubscriber::<NavState>::polled(node, topic).expect("subscriber");
             let listening: Vec<TopicSubscriber<NavState>> = (0..listeners)
-                .map(|_| TopicSubscriber::new(&node, topic).expect("subscriber"))
+                .map(|_| TopicSubscriber::new(node, topic).expect("subscriber"))
                 .collect();
-            let publisher = TopicPublisher::<NavState>::new(&node, topic).expect("publisher");
+            let publisher = TopicPublisher::<NavState>::new(node, topic).expect("publisher");
             let mut seq = 0u64;
             c.bench_function(&format!("publish, {listeners} listeners"), |b| {
                 b.iter(|| {
@@ -57,8 +44,8 @@ fn publish(c: &mut Criterion) {
                 })
             });
         }
-        let sub = TopicSubscriber::<NavState>::new(&node, "notify-clear").expect("subscriber");
-        let publisher = TopicPublisher::<NavState>::new(&node, "notify-clear").expect("publisher");
+        let sub = TopicSubscriber::<NavState>::new(node, "notify-clear").expect("subscriber");
+        let publisher = TopicPublisher::<NavState>::new(node, "notify-clear").expect("publisher");
         c.bench_function("publish and receive, no notification taken off", |b| {
             b.iter(|| {
                 publisher.publish(NavState::default()).expect("publish");
@@ -72,9 +59,7 @@ fn publish(c: &mut Criterion) {
                 let _ = sub.clear_signals();
             })
         });
-    }
-    shm_cleanup::remove_all(&settings, true);
-    let _ = std::fs::remove_dir_all(&settings.root);
+    });
 }
 
 criterion_group!(benches, publish);

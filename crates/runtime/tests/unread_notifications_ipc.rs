@@ -6,22 +6,14 @@
 use std::time::Duration;
 
 use ipc_types::NavState;
-use rins_runtime::ipc::{IpcSettings, TopicPublisher, TopicSubscriber, create_node};
-use rins_runtime::shm_cleanup;
+use rins_runtime::ipc::{TopicPublisher, TopicSubscriber};
+use rins_test_support::private_ipc::on_private_node;
 
 #[test]
 fn notifications_left_unread_never_fail_the_publisher() {
-    let settings = IpcSettings::new(
-        format!("rtunread{}_", std::process::id()),
-        std::env::temp_dir()
-            .join(format!("rtunread{}root/", std::process::id()))
-            .to_string_lossy()
-            .into_owned(),
-    );
-    {
-        let node = create_node("unread", &settings).expect("node");
-        let subscriber = TopicSubscriber::<NavState>::new(&node, "unread").expect("subscriber");
-        let publisher = TopicPublisher::<NavState>::new(&node, "unread").expect("publisher");
+    on_private_node("unread", |node| {
+        let subscriber = TopicSubscriber::<NavState>::new(node, "unread").expect("subscriber");
+        let publisher = TopicPublisher::<NavState>::new(node, "unread").expect("publisher");
         // Far more notifications than a listener's socket holds; samples read as they come (the
         // queue is finite), notifications never.
         let mut received = 0u64;
@@ -42,8 +34,5 @@ fn notifications_left_unread_never_fail_the_publisher() {
             !subscriber.wait(Duration::from_millis(20)).expect("wait"),
             "every notification was taken off"
         );
-    }
-    shm_cleanup::remove_all(&settings, true);
-    let _ = std::fs::remove_dir_all(&settings.root);
-    assert!(shm_cleanup::shm_entries(&settings).is_empty());
+    });
 }

@@ -5,6 +5,7 @@ use ipc_types::{NavMode, NavState, names};
 use rins_navigator::lanes::NavSubscriber;
 use rins_runtime::ipc::{IpcSettings, TopicPublisher, create_node};
 use rins_runtime::shm_cleanup;
+use rins_test_support::private_ipc::on_private_node;
 
 fn nav(lane: u8, seq: u64) -> NavState {
     let mut s = NavState {
@@ -70,18 +71,10 @@ fn a_backlog_of_both_lanes_is_delivered_whole() {
 /// together.
 #[test]
 fn a_hole_in_the_primary_is_filled_whole_from_the_standbys_batch() {
-    let settings = IpcSettings::new(
-        format!("lnavhole{}_", std::process::id()),
-        std::env::temp_dir()
-            .join(format!("lnavhole{}root/", std::process::id()))
-            .to_string_lossy()
-            .into_owned(),
-    );
-    {
-        let node = create_node("lanes", &settings).expect("node");
-        let mut sub = NavSubscriber::new(&node).expect("subscriber");
-        let primary = TopicPublisher::<NavState>::new(&node, names::NAV_LANES[0]).expect("lane 0");
-        let standby = TopicPublisher::<NavState>::new(&node, names::NAV_LANES[1]).expect("lane 1");
+    on_private_node("lanehole", |node| {
+        let mut sub = NavSubscriber::new(node).expect("subscriber");
+        let primary = TopicPublisher::<NavState>::new(node, names::NAV_LANES[0]).expect("lane 0");
+        let standby = TopicPublisher::<NavState>::new(node, names::NAV_LANES[1]).expect("lane 1");
         for seq in 1..=10 {
             primary.publish(nav(0, seq)).expect("publish");
         }
@@ -102,8 +95,5 @@ fn a_hole_in_the_primary_is_filled_whole_from_the_standbys_batch() {
         assert_eq!(got, (1..=30).collect::<Vec<_>>());
         assert_eq!(sub.selected_lane(), 0, "a hole is filled, not switched for");
         assert_eq!(sub.filled(), 12);
-    }
-    shm_cleanup::remove_all(&settings, true);
-    let _ = std::fs::remove_dir_all(&settings.root);
-    assert!(shm_cleanup::shm_entries(&settings).is_empty());
+    });
 }
