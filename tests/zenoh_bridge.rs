@@ -69,16 +69,21 @@ fn reader_result(child: Child, out: &PathBuf) -> Value {
 
 /// Samples of `topic` received within `seconds` of the first.
 fn count_in_window(result: &Value, topic: &str, seconds: f64) -> usize {
-    let times: Vec<u64> = result["topics"][topic]["received_ns"]
+    // Windowed on when each sample was made (arrival minus its latency, both from the
+    // attachment's source stamp), not on arrival: under load the first samples can arrive
+    // late and the rest catch up, which would count more than the rate in an arrival window.
+    let t = &result["topics"][topic];
+    let times: Vec<i128> = t["received_ns"]
         .as_array()
         .expect("receive times")
         .iter()
-        .filter_map(Value::as_u64)
+        .zip(t["latency_ns"].as_array().expect("latencies"))
+        .filter_map(|(r, l)| Some(i128::from(r.as_u64()?) - i128::from(l.as_i64()?)))
         .collect();
-    let Some(&first) = times.first() else {
+    let Some(&first) = times.iter().min() else {
         return 0;
     };
-    let end = first + (seconds * 1e9) as u64;
+    let end = first + (seconds * 1e9) as i128;
     times.iter().filter(|&&t| t < end).count()
 }
 
