@@ -12,6 +12,10 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
+use iceoryx2::service::builder::event::{EventCreateError, EventOpenError, EventOpenOrCreateError};
+use iceoryx2::service::builder::publish_subscribe::{
+    PublishSubscribeCreateError, PublishSubscribeOpenError, PublishSubscribeOpenOrCreateError,
+};
 use iceoryx2::service::port_factory::{event, publish_subscribe};
 
 use super::error::IpcError;
@@ -53,29 +57,74 @@ fn open_pubsub<T: Debug + ZeroCopySend + 'static>(
     node: &IpcNode,
     topic: &'static str,
 ) -> Result<publish_subscribe::PortFactory<ipc::Service, T, ()>, IpcError> {
-    node.service_builder(&service_name(topic)?)
-        .publish_subscribe::<T>()
-        .max_publishers(MAX_PUBLISHERS)
-        .max_subscribers(MAX_SUBSCRIBERS)
-        .max_nodes(MAX_NODES)
-        .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
-        .history_size(history_size(topic))
-        .enable_safe_overflow(true)
-        .open_or_create()
-        .map_err(|source| IpcError::OpenTopic { topic, source })
+    let name = service_name(topic)?;
+    retry_interrupted(
+        || {
+            node.service_builder(&name)
+                .publish_subscribe::<T>()
+                .max_publishers(MAX_PUBLISHERS)
+                .max_subscribers(MAX_SUBSCRIBERS)
+                .max_nodes(MAX_NODES)
+                .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
+                .history_size(history_size(topic))
+                .enable_safe_overflow(true)
+                .open_or_create()
+        },
+        |e| {
+            matches!(
+                e,
+                PublishSubscribeOpenOrCreateError::PublishSubscribeOpenError(
+                    PublishSubscribeOpenError::Interrupt
+                ) | PublishSubscribeOpenOrCreateError::PublishSubscribeCreateError(
+                    PublishSubscribeCreateError::Interrupt
+                )
+            )
+        },
+    )
+    .map_err(|source| IpcError::OpenTopic { topic, source })
+}
+
+/// Tries `open` again while it fails by `interrupted`: a signal (a stop requested during start-up)
+/// interrupts a system call of the service's creation, and the process that asked to stop must still
+/// come to its loop to stop cleanly. Bounded, so a storm of signals still ends in the error.
+fn retry_interrupted<T, E>(
+    mut open: impl FnMut() -> Result<T, E>,
+    interrupted: impl Fn(&E) -> bool,
+) -> Result<T, E> {
+    const ATTEMPTS: usize = 8;
+    let mut result = open();
+    for _ in 1..ATTEMPTS {
+        match &result {
+            Err(e) if interrupted(e) => result = open(),
+            _ => break,
+        }
+    }
+    result
 }
 
 fn open_event(
     node: &IpcNode,
     topic: &'static str,
 ) -> Result<event::PortFactory<ipc::Service>, IpcError> {
-    node.service_builder(&service_name(topic)?)
-        .event()
-        .max_notifiers(MAX_PUBLISHERS)
-        .max_listeners(MAX_SUBSCRIBERS)
-        .max_nodes(MAX_NODES)
-        .open_or_create()
-        .map_err(|source| IpcError::OpenEvent { topic, source })
+    let name = service_name(topic)?;
+    retry_interrupted(
+        || {
+            node.service_builder(&name)
+                .event()
+                .max_notifiers(MAX_PUBLISHERS)
+                .max_listeners(MAX_SUBSCRIBERS)
+                .max_nodes(MAX_NODES)
+                .open_or_create()
+        },
+        |e| {
+            matches!(
+                e,
+                EventOpenOrCreateError::EventOpenError(EventOpenError::Interrupt)
+                    | EventOpenOrCreateError::EventCreateError(EventCreateError::Interrupt)
+            )
+        },
+    )
+    .map_err(|source| IpcError::OpenEvent { topic, source })
 }
 
 /// Publishing end of a topic: sends the sample, then wakes the topic's listeners.
