@@ -116,6 +116,27 @@ impl Drop for Stopped {
     }
 }
 
+/// Waits until `child` catches SIGTERM (its `SigCgt` mask in `/proc`), failing after 10 s.
+fn wait_for_stop_handler(child: &Child) {
+    let status = format!("/proc/{}/status", child.id());
+    let sigterm_bit = 1u64 << (libc::SIGTERM - 1);
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        let caught = std::fs::read_to_string(&status)
+            .ok()
+            .and_then(|text| {
+                let mask = text.lines().find_map(|l| l.strip_prefix("SigCgt:"))?;
+                u64::from_str_radix(mask.trim(), 16).ok()
+            })
+            .is_some_and(|mask| mask & sigterm_bit != 0);
+        if caught {
+            return;
+        }
+        assert!(Instant::now() < deadline, "no SIGTERM handler within 10 s");
+        std::thread::sleep(Duration::from_micros(200));
+    }
+}
+
 /// Waits for `child` to end, killing it (and failing) after `limit`.
 fn wait_within(mut child: Child, limit: Duration) -> Output {
     let deadline = Instant::now() + limit;
@@ -461,6 +482,10 @@ fn sigterm_during_start_up_is_a_clean_stop() {
             .stderr(Stdio::piped())
             .spawn()
             .expect("rins up");
+        // Counted from the handler's installation, its first act: before it (the loader, the
+        // command line) a stop signal ends the process by its default action, with nothing made
+        // yet, and a loaded machine can take more than 5 ms to get there.
+        wait_for_stop_handler(&up);
         std::thread::sleep(Duration::from_millis(ms));
         signal(&up, Signal::Terminate);
         let out = wait_within(up, Duration::from_secs(30));
