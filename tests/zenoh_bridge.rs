@@ -67,7 +67,7 @@ fn reader_result(child: Child, out: &PathBuf) -> Value {
     serde_json::from_str(&text).expect("the reader's result is not JSON")
 }
 
-/// Samples of `topic` received within `seconds` of the first.
+/// Samples of `topic` made within `seconds` of the earliest one.
 fn count_in_window(result: &Value, topic: &str, seconds: f64) -> usize {
     // Windowed on when each sample was made (arrival minus its latency, both from the
     // attachment's source stamp), not on arrival: under load the first samples can arrive

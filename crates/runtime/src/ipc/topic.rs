@@ -348,3 +348,49 @@ impl<T: Versioned + Debug + ZeroCopySend + Copy + 'static> SampleSource<T> for T
         TopicSubscriber::rejected(self)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::retry_interrupted;
+
+    /// Opens that fail `interrupts` times by an interrupt, then succeed; the number of calls made.
+    fn opened_after(interrupts: usize) -> (Result<(), &'static str>, usize) {
+        let mut calls = 0;
+        let result = retry_interrupted(
+            || {
+                calls += 1;
+                if calls <= interrupts {
+                    Err("interrupt")
+                } else {
+                    Ok(())
+                }
+            },
+            |e| *e == "interrupt",
+        );
+        (result, calls)
+    }
+
+    #[test]
+    fn an_interrupted_open_is_tried_again_until_it_succeeds() {
+        assert_eq!(opened_after(0), (Ok(()), 1));
+        assert_eq!(opened_after(3), (Ok(()), 4));
+    }
+
+    #[test]
+    fn a_storm_of_interrupts_ends_in_the_error_after_eight_tries() {
+        assert_eq!(opened_after(100), (Err("interrupt"), 8));
+    }
+
+    #[test]
+    fn any_other_error_is_returned_at_once() {
+        let mut calls = 0;
+        let result: Result<(), &str> = retry_interrupted(
+            || {
+                calls += 1;
+                Err("denied")
+            },
+            |e| *e == "interrupt",
+        );
+        assert_eq!((result, calls), (Err("denied"), 1));
+    }
+}
